@@ -1,0 +1,30 @@
+#pragma once
+// Errors at the library's boundaries (files, configuration, arguments) carry where the
+// bad value came from, so that a user can act on a single line of text.
+#include <stdexcept>
+#include <string>
+
+namespace viscera::tissue {
+
+/// Bad input from outside the core: a file, a field or an argument. what() is one line:
+/// "<source>[:<line>]: <field>: <message>".
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string source, long line, std::string field, const std::string& message);
+  const std::string& source() const { return source_; }
+  long line() const { return line_; }
+  const std::string& field() const { return field_; }
+
+ private:
+  std::string source_;
+  long line_;
+  std::string field_;
+};
+
+/// Numerical failure detected while integrating (instability, non-convergence).
+class SimulationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace viscera::tissue

@@ -1,0 +1,65 @@
+#pragma once
+// The generalized particle system (the paper's Eq. (1), MODEL.md section 1): every edge of a
+// tetrahedron carries a tension that depends on all six edge elongations,
+//     t = C dL,   C = diag(1/L0) H   (36 constants per tet, calibrated to linear FE),
+// and pushes its ends with +t_e Y_e (vertex a) and -t_e Y_e (vertex b).
+// Variants:
+//  - paper:             t_e = (H dL)_e / L0_e  (the published form; not conservative at
+//                       finite strain);
+//  - energy_consistent: t_e = (H dL)_e / L_e, the exact gradient of E = 0.5 dL^T H dL.
+// Optional signed-volume term E_V = 0.5 kappa V0 (V/V0 - 1)^2 (kappa = fraction x Reuss bulk
+// modulus): restores inverted elements, which the edge lengths alone cannot see. H is calibrated
+// with the term's small-strain stiffness removed, so the sum still equals linear FE there.
+#include <memory>
+#include <vector>
+
+#include "model/force_model.hpp"
+
+namespace viscera::tissue {
+
+enum class GpsVariant { paper, energy_consistent };
+
+struct GpsOptions {
+  GpsVariant variant = GpsVariant::paper;
+  /// kappa / (Reuss bulk modulus) of the signed-volume term, in [0, 1); 0 disables it.
+  double volume_stiffness_fraction = 0.0;
+};
+
+class GpsModel final : public ForceModel {
+ public:
+  GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
+           std::vector<std::uint16_t> material_of_tet = {}, GpsOptions options = {});
+
+  std::string_view name() const override;
+  ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const override;
+  double energy(std::span<const Vec3> x) const override;
+  Mat12 element_tangent(std::span<const Vec3> x, std::size_t e) const override;
+
+  const GpsOptions& options() const { return options_; }
+  /// The paper's 36 constants C = diag(1/L0) H of element e (the volume term excluded).
+  Mat6 paper_constants(std::size_t e) const;
+  /// H of element e (symmetric 6x6) as used by the model.
+  Mat6 edge_hessian(std::size_t e) const;
+
+  /// Per-element record, one contiguous stream for the force loop (280 bytes).
+  struct Element {
+    Tet v;
+    double rest_length[6];
+    double inv_rest_length[6];
+    double H[21];  ///< upper triangle of H, row by row
+  };
+  struct VolumeTerm {
+    double rest_volume;
+    double kappa;  ///< [Pa]
+  };
+
+ private:
+  template <bool kEnergyConsistent, bool kVolume>
+  ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f) const;
+
+  GpsOptions options_;
+  std::vector<Element> elements_;
+  std::vector<VolumeTerm> volume_;  ///< empty when the volume term is off
+};
+
+}  // namespace viscera::tissue

@@ -1,0 +1,90 @@
+#include "integrator/explicit_integrator.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/input_error.hpp"
+
+namespace viscera::tissue {
+
+ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
+                                       BoundaryConditions bc, ExplicitOptions options)
+    : model_(model), bc_(std::move(bc)), options_(options) {
+  if (!(options_.safety_factor > 0 && options_.safety_factor <= 1))
+    throw std::invalid_argument("ExplicitOptions.safety_factor must lie in (0, 1]");
+  if (!(options_.mass_damping_per_s >= 0))
+    throw std::invalid_argument("ExplicitOptions.mass_damping_per_s must be >= 0");
+  mass_ = lumped_masses(model.rest_mesh(), density_kg_m3);
+  critical_ = critical_time_step(model, density_kg_m3);
+  dt_ = options_.dt_s > 0 ? options_.dt_s : options_.safety_factor * critical_.dt_s;
+  const auto mask = bc_.constrained_mask(mass_.size());
+  inv_mass_.resize(mass_.size());
+  external_.resize(mass_.size());
+  for (std::size_t i = 0; i < mass_.size(); ++i) {
+    inv_mass_[i] = mask[i] ? 0.0 : 1.0 / mass_[i];
+    external_[i] = mass_[i] * bc_.gravity_m_s2;
+    if (!bc_.nodal_forces.empty()) external_[i] += bc_.nodal_forces.at(i);
+  }
+  force_.resize(mass_.size());
+}
+
+void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
+
+void ExplicitIntegrator::step_with(State& state, double dt) {
+  const std::size_t n = mass_.size();
+  for (std::size_t i = 0; i < n; ++i) force_[i] = external_[i];
+  const ForceStats stats = model_.add_forces(state.x, force_);
+  if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
+    const std::size_t e = find_max_strain_element(model_, state.x);
+    std::ostringstream msg;
+    msg << "explicit integration went unstable at t = " << state.time_s << " s: element " << e
+        << " has edge strain " << model_.element_max_edge_strain(state.x, e) << " (limit "
+        << options_.max_edge_strain << "); dt = " << dt << " s, critical step "
+        << critical_.dt_s << " s";
+    if (!x_prev_.empty()) {  // back to the last state that passed this check
+      state.x = x_prev_;
+      state.v = v_prev_;
+      state.time_s = t_prev_;
+    }
+    throw SimulationError(msg.str());
+  }
+  x_prev_ = state.x;
+  v_prev_ = state.v;
+  t_prev_ = state.time_s;
+  const double damping = std::exp(-options_.mass_damping_per_s * dt);
+  for (std::size_t i = 0; i < n; ++i) {
+    state.v[i] = (state.v[i] + (dt * inv_mass_[i]) * force_[i]) * damping;
+    if (inv_mass_[i] == 0.0) state.v[i].setZero();
+    state.x[i] += dt * state.v[i];
+  }
+  const double t1 = state.time_s + dt;
+  const auto& rest = model_.rest_mesh().nodes;
+  for (const auto& p : bc_.prescribed)
+    for (auto i : p.nodes) {
+      const Vec3 target = p.position(rest[i], t1);
+      state.v[i] = (target - x_prev_[i]) / dt;
+      state.x[i] = target;
+    }
+  state.time_s = t1;
+}
+
+long ExplicitIntegrator::advance(State& state, double duration_s) {
+  const double end = state.time_s + duration_s;
+  long steps = 0;
+  while (state.time_s < end - 1e-12 * dt_) {
+    const double dt = std::min(dt_, end - state.time_s);
+    step_with(state, dt);
+    ++steps;
+  }
+  state.time_s = end;
+  return steps;
+}
+
+double ExplicitIntegrator::kinetic_energy(const State& state) const {
+  double k = 0.0;
+  for (std::size_t i = 0; i < mass_.size(); ++i) k += 0.5 * mass_[i] * state.v[i].squaredNorm();
+  return k;
+}
+
+}  // namespace viscera::tissue

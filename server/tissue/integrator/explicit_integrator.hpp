@@ -1,0 +1,55 @@
+#pragma once
+// Explicit symplectic Euler (MODEL.md section 2): v += dt M^-1 (f_int + f_ext);
+// v *= exp(-alpha dt) (mass-proportional damping, integrated exactly); x += dt v.
+// The step is the computed critical step times a safety factor, never a guess.
+#include <vector>
+
+#include "integrator/boundary_conditions.hpp"
+#include "integrator/stable_step.hpp"
+#include "integrator/state.hpp"
+#include "model/force_model.hpp"
+
+namespace viscera::tissue {
+
+struct ExplicitOptions {
+  double safety_factor = 0.9;         ///< dt = safety x critical step (0 < s <= 1)
+  double dt_s = 0.0;                  ///< if > 0, used instead (for studies; may be unstable)
+  double mass_damping_per_s = 0.0;    ///< alpha >= 0 [1/s]
+  double max_edge_strain = 2.0;       ///< |dL|/L0 above this means the run went unstable
+};
+
+class ExplicitIntegrator {
+ public:
+  ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
+                     BoundaryConditions bc, ExplicitOptions options = {});
+
+  double dt_s() const { return dt_; }
+  const StableStep& critical_step() const { return critical_; }
+  const std::vector<double>& masses() const { return mass_; }
+
+  /// One step. On instability (edge strain above the limit, or NaN) throws SimulationError naming
+  /// the element and the time, and puts `state` back to the last step that passed the check.
+  void step(State& state);
+  /// Sub-steps until state.time_s has advanced by `duration_s` (last sub-step shortened).
+  /// Returns the number of sub-steps.
+  long advance(State& state, double duration_s);
+
+  /// Kinetic energy [J] of a state.
+  double kinetic_energy(const State& state) const;
+
+ private:
+  void step_with(State& state, double dt);
+
+  const ForceModel& model_;
+  BoundaryConditions bc_;
+  ExplicitOptions options_;
+  std::vector<double> mass_;
+  std::vector<double> inv_mass_;   // 0 for constrained nodes
+  std::vector<Vec3> external_;     // gravity + nodal forces
+  StableStep critical_;
+  double dt_;
+  std::vector<Vec3> force_, x_prev_, v_prev_;
+  double t_prev_ = 0.0;
+};
+
+}  // namespace viscera::tissue

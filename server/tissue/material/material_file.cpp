@@ -1,0 +1,72 @@
+#include "material/material_file.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common/input_error.hpp"
+#include "material/elasticity.hpp"
+
+namespace viscera::tissue {
+
+namespace {
+using nlohmann::json;
+
+double number(const json& j, const std::string& key, const std::string& source, const std::string& prefix) {
+  const std::string field = prefix + key;
+  if (!j.contains(key)) throw InputError(source, 0, field, "missing");
+  if (!j.at(key).is_number()) throw InputError(source, 0, field, j.at(key).dump() + " is not a number");
+  const double v = j.at(key).get<double>();
+  if (!std::isfinite(v)) throw InputError(source, 0, field, "is not finite");
+  return v;
+}
+}  // namespace
+
+Material parse_material(const std::string& text, const std::string& source) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(source, 0, "JSON", e.what());
+  }
+  if (!j.is_object()) throw InputError(source, 0, "", "expected a JSON object");
+  Material m;
+  m.name = j.value("name", source);
+  m.density_kg_m3 = number(j, "density_kg_m3", source, "");
+  if (!(m.density_kg_m3 > 0)) throw InputError(source, 0, "density_kg_m3", std::to_string(m.density_kg_m3) + " must be positive");
+  if (!j.contains("elasticity") || !j["elasticity"].is_object()) throw InputError(source, 0, "elasticity", "missing or not an object");
+  const json& e = j["elasticity"];
+  const std::string type = e.value("type", "");
+  const std::string where = source;
+  if (type == "isotropic") {
+    m.elasticity = elasticity_matrix(IsotropicElasticity{number(e, "youngs_modulus_pa", source, "elasticity."),
+                                                         number(e, "poisson_ratio", source, "elasticity.")},
+                                     where);
+  } else if (type == "transversely_isotropic") {
+    TransverselyIsotropicElasticity t;
+    t.plane_youngs_modulus_pa = number(e, "plane_youngs_modulus_pa", source, "elasticity.");
+    t.plane_poisson_ratio = number(e, "plane_poisson_ratio", source, "elasticity.");
+    t.fibre_youngs_modulus_pa = number(e, "fibre_youngs_modulus_pa", source, "elasticity.");
+    t.fibre_plane_poisson_ratio = number(e, "fibre_plane_poisson_ratio", source, "elasticity.");
+    t.fibre_shear_modulus_pa = number(e, "fibre_shear_modulus_pa", source, "elasticity.");
+    if (!e.contains("fibre_direction") || !e["fibre_direction"].is_array() || e["fibre_direction"].size() != 3)
+      throw InputError(source, 0, "elasticity.fibre_direction", "must be an array of three numbers");
+    for (int k = 0; k < 3; ++k) t.fibre_direction[k] = e["fibre_direction"][static_cast<std::size_t>(k)].get<double>();
+    m.elasticity = elasticity_matrix(t, where);
+  } else {
+    throw InputError(source, 0, "elasticity.type", "'" + type + "' is not isotropic or transversely_isotropic");
+  }
+  return m;
+}
+
+Material read_material_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, 0, "", "cannot open file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_material(ss.str(), path);
+}
+
+}  // namespace viscera::tissue

@@ -1,0 +1,24 @@
+#pragma once
+// Material files (JSON), documented in docs/MATERIAL.md:
+//   { "density_kg_m3": 1060,
+//     "elasticity": { "type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45 } }
+// or "type": "transversely_isotropic" with plane_youngs_modulus_pa, plane_poisson_ratio,
+// fibre_youngs_modulus_pa, fibre_plane_poisson_ratio, fibre_shear_modulus_pa, fibre_direction [x,y,z].
+#include <string>
+
+#include "element/tet_geometry.hpp"
+
+namespace viscera::tissue {
+
+struct Material {
+  std::string name;
+  double density_kg_m3 = 0.0;
+  Mat6 elasticity = Mat6::Zero();
+};
+
+/// Reads and checks a material file; InputError names the file and the field.
+Material read_material_file(const std::string& path);
+/// Parses material JSON text (source names it in errors).
+Material parse_material(const std::string& json_text, const std::string& source);
+
+}  // namespace viscera::tissue

@@ -1,0 +1,42 @@
+#include "mesh/mesh_builder.hpp"
+
+#include "common/input_error.hpp"
+#include "mesh/mesh_validation.hpp"
+
+namespace viscera::tissue {
+
+void MeshBuilder::add_node(long long id, const Vec3& p, long line) {
+  if (!p.allFinite())
+    throw InputError(source_, line, "node " + std::to_string(id), "coordinates are not finite");
+  const auto [it, inserted] = index_of_.emplace(id, static_cast<std::int32_t>(nodes_.size()));
+  if (!inserted) throw InputError(source_, line, "node " + std::to_string(id), "duplicate node id");
+  nodes_.push_back(p);
+  node_ids_.push_back(id);
+}
+
+void MeshBuilder::add_tet(const std::array<long long, 4>& ids, long long element, long line) {
+  tets_.push_back({ids, element, line});
+}
+
+TetMesh MeshBuilder::build() {
+  TetMesh mesh;
+  mesh.source = source_;
+  mesh.nodes = std::move(nodes_);
+  mesh.tets.reserve(tets_.size());
+  for (const PendingTet& p : tets_) {
+    Tet t;
+    for (int k = 0; k < 4; ++k) {
+      const auto it = index_of_.find(p.ids[k]);
+      if (it == index_of_.end())
+        throw InputError(source_, p.line, "element " + std::to_string(p.element),
+                         "references node " + std::to_string(p.ids[k]) + ", which does not exist");
+      t[k] = it->second;
+    }
+    mesh.tets.push_back(t);
+  }
+  if (mesh.tets.empty()) throw InputError(source_, 0, "", "contains no tetrahedra");
+  validate_mesh(mesh);
+  return mesh;
+}
+
+}  // namespace viscera::tissue

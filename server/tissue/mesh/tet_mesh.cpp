@@ -1,0 +1,35 @@
+#include "mesh/tet_mesh.hpp"
+
+#include "element/tet_geometry.hpp"
+
+namespace viscera::tissue {
+
+void scale_mesh(TetMesh& mesh, double factor) {
+  for (auto& p : mesh.nodes) p *= factor;
+}
+
+Box bounding_box(const TetMesh& mesh) {
+  Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
+        Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  for (const auto& p : mesh.nodes) {
+    b.lo = b.lo.cwiseMin(p);
+    b.hi = b.hi.cwiseMax(p);
+  }
+  return b;
+}
+
+double mesh_volume(const TetMesh& mesh) {
+  double v = 0.0;
+  for (const auto& t : mesh.tets)
+    v += signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+  return v;
+}
+
+double mean_edge_length(const TetMesh& mesh) {
+  double sum = 0.0;
+  for (const auto& t : mesh.tets)
+    for (const auto& e : kTetEdges) sum += (mesh.nodes[t[e[1]]] - mesh.nodes[t[e[0]]]).norm();
+  return mesh.tets.empty() ? 0.0 : sum / (6.0 * static_cast<double>(mesh.tets.size()));
+}
+
+}  // namespace viscera::tissue

@@ -1,0 +1,97 @@
+#include "mesh/text_cursor.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "common/input_error.hpp"
+
+namespace viscera::tissue {
+
+TextCursor::TextCursor(std::string source, std::string text)
+    : source_(std::move(source)), text_(std::move(text)) {}
+
+TextCursor TextCursor::from_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "", "cannot open file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return TextCursor(path, ss.str());
+}
+
+void TextCursor::skip_space() {
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == '\n') {
+      ++line_;
+    } else if (c != ' ' && c != '\t' && c != '\r') {
+      break;
+    }
+    ++pos_;
+  }
+}
+
+bool TextCursor::at_end() {
+  skip_space();
+  return pos_ >= text_.size();
+}
+
+void TextCursor::fail(std::string_view field, const std::string& message) const {
+  throw InputError(source_, line_, std::string(field), message);
+}
+
+std::string_view TextCursor::token(std::string_view field) {
+  skip_space();
+  if (pos_ >= text_.size()) fail(field, "unexpected end of file (truncated?)");
+  const std::size_t start = pos_;
+  while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+  return std::string_view(text_).substr(start, pos_ - start);
+}
+
+double TextCursor::real(std::string_view field) {
+  const std::string_view t = token(field);
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || end != t.data() + t.size())
+    fail(field, "'" + std::string(t) + "' is not a number");
+  if (!std::isfinite(v)) fail(field, "'" + std::string(t) + "' is not a finite number");
+  return v;
+}
+
+long long TextCursor::integer(std::string_view field) {
+  const std::string_view t = token(field);
+  long long v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || end != t.data() + t.size())
+    fail(field, "'" + std::string(t) + "' is not an integer");
+  return v;
+}
+
+long long TextCursor::integer_in(std::string_view field, long long lo, long long hi) {
+  const long long v = integer(field);
+  if (v < lo || v > hi)
+    fail(field, std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
+                    std::to_string(hi) + "]");
+  return v;
+}
+
+std::string TextCursor::rest_of_line() {
+  const std::size_t start = pos_;
+  while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+  std::string s = text_.substr(start, pos_ - start);
+  if (pos_ < text_.size()) {
+    ++pos_;
+    ++line_;
+  }
+  while (!s.empty() && (s.back() == '\r' || s.back() == ' ')) s.pop_back();
+  return s;
+}
+
+bool TextCursor::skip_past(std::string_view marker) {
+  while (!at_end())
+    if (token("") == marker) return true;
+  return false;
+}
+
+}  // namespace viscera::tissue

@@ -1,0 +1,62 @@
+#pragma once
+// The one interface the integrators use: internal elastic forces, the potential energy, and
+// per-element tangent stiffness blocks. A model is immutable after construction, so the same
+// positions give the same forces bit for bit (no hidden state).
+#include <memory>
+#include <span>
+#include <string_view>
+
+#include "element/tet_geometry.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace viscera::tissue {
+
+/// By-product of one force evaluation: the largest absolute edge strain |L - L0| / L0 seen
+/// (NaN if any was NaN). The explicit integrator uses it to detect instability cheaply.
+struct ForceStats {
+  double max_edge_strain = 0.0;
+};
+
+class ForceModel {
+ public:
+  explicit ForceModel(std::shared_ptr<const TetMesh> rest_mesh);
+  virtual ~ForceModel() = default;
+  ForceModel(const ForceModel&) = delete;
+  ForceModel& operator=(const ForceModel&) = delete;
+
+  /// Short name used in benchmarks and reports ("gps", "gps_energy", "corotational", "linear").
+  virtual std::string_view name() const = 0;
+
+  /// f += internal forces [N] at positions x [m].
+  virtual ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const = 0;
+
+  /// Elastic potential energy [J]. For the paper-form GPS (not conservative at finite strain)
+  /// this is the energy of its energy-consistent sibling, 0.5 dL^T H dL.
+  virtual double energy(std::span<const Vec3> x) const = 0;
+
+  /// Tangent stiffness K = -df/dx of element e (12x12, in the tet's vertex order) at x.
+  /// Non-conservative models return their non-symmetric tangent; integrators symmetrise.
+  virtual Mat12 element_tangent(std::span<const Vec3> x, std::size_t e) const = 0;
+
+  const TetMesh& rest_mesh() const { return *mesh_; }
+  std::size_t node_count() const { return mesh_->nodes.size(); }
+  std::size_t element_count() const { return mesh_->tets.size(); }
+  const Tet& element(std::size_t e) const { return mesh_->tets[e]; }
+
+  /// Positions of element e's four vertices in x.
+  std::array<Vec3, 4> gather(std::span<const Vec3> x, std::size_t e) const {
+    const Tet& t = mesh_->tets[e];
+    return {x[t[0]], x[t[1]], x[t[2]], x[t[3]]};
+  }
+
+  /// Largest |L - L0| / L0 over the six edges of element e at x (NaN if non-finite).
+  double element_max_edge_strain(std::span<const Vec3> x, std::size_t e) const;
+
+ protected:
+  std::shared_ptr<const TetMesh> mesh_;
+};
+
+/// The element with the largest edge strain at x (a NaN strain counts as the largest).
+std::size_t find_max_strain_element(const ForceModel& model, std::span<const Vec3> x);
+
+}  // namespace viscera::tissue

@@ -1,0 +1,28 @@
+#include "model/model_factory.hpp"
+
+#include "common/input_error.hpp"
+#include "fem/finite_element_model.hpp"
+#include "gps/gps_model.hpp"
+
+namespace viscera::tissue {
+
+const std::vector<std::string>& force_model_names() {
+  static const std::vector<std::string> names{"gps", "gps_energy", "corotational", "linear"};
+  return names;
+}
+
+std::unique_ptr<ForceModel> make_force_model(const std::string& name, std::shared_ptr<const TetMesh> mesh,
+                                             std::vector<Mat6> materials, double volume_fraction) {
+  if (name == "gps" || name == "gps_energy") {
+    const GpsVariant v = name == "gps" ? GpsVariant::paper : GpsVariant::energy_consistent;
+    return std::make_unique<GpsModel>(std::move(mesh), std::move(materials), std::vector<std::uint16_t>{},
+                                      GpsOptions{v, volume_fraction});
+  }
+  if (name == "corotational")
+    return std::make_unique<FiniteElementModel>(std::move(mesh), FeKind::corotational, std::move(materials));
+  if (name == "linear")
+    return std::make_unique<FiniteElementModel>(std::move(mesh), FeKind::linear, std::move(materials));
+  throw InputError("model", 0, "name", "'" + name + "' is not one of gps, gps_energy, corotational, linear");
+}
+
+}  // namespace viscera::tissue

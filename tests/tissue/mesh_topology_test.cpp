@@ -1,0 +1,88 @@
+// Boundary extraction and 1:8 refinement, checked against topology and geometry identities.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+#include "element/tet_geometry.hpp"
+#include "mesh/boundary_surface.hpp"
+#include "mesh/box_mesh.hpp"
+#include "mesh/refinement.hpp"
+#include "test_support.hpp"
+
+using namespace viscera::tissue;
+namespace test = viscera::tissue::test;
+
+namespace {
+
+// Volume enclosed by the surface (divergence theorem): sum over triangles of x . n A / 3.
+double enclosed_volume(const TetMesh& m, const BoundarySurface& s) {
+  double v = 0.0;
+  for (const auto& t : s.triangles)
+    v += m.nodes[t[0]].dot(m.nodes[t[1]].cross(m.nodes[t[2]])) / 6.0;
+  return v;
+}
+
+int euler_characteristic(const BoundarySurface& s) {
+  std::set<std::pair<int, int>> edges;
+  for (const auto& t : s.triangles)
+    for (int k = 0; k < 3; ++k) edges.emplace(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
+  return static_cast<int>(s.nodes.size()) - static_cast<int>(edges.size()) + static_cast<int>(s.triangles.size());
+}
+
+}  // namespace
+
+TEST(BoundarySurface, OrganSurfacesAreClosedOutwardAndEncloseTheMeshVolume) {
+  struct Case {
+    const char* file;
+    std::size_t triangles;  // -1: not documented
+    int euler;
+  } cases[] = {{"meshes/liver.msh", 276, 2}, {"meshes/liver2.msh", 860, 2}, {"meshes/heart_imstk-unity.vtk", 0, -2}};
+  for (const auto& c : cases) {
+    const TetMesh m = read_tet_mesh(test::data_path(c.file));
+    const BoundarySurface s = extract_boundary(m);
+    if (c.triangles) {
+      EXPECT_EQ(s.triangles.size(), c.triangles) << c.file;
+    }
+    EXPECT_EQ(euler_characteristic(s), c.euler) << c.file;  // closed, genus 0 (liver) or 2 (heart)
+    EXPECT_NEAR(enclosed_volume(m, s) / mesh_volume(m), 1.0, 1e-12) << c.file;
+    for (std::size_t k = 0; k < s.triangles.size(); ++k) {
+      const auto& t = s.triangles[k];
+      const Tet& owner = m.tets[s.owner_tet[k]];
+      const Vec3 n = (m.nodes[t[1]] - m.nodes[t[0]]).cross(m.nodes[t[2]] - m.nodes[t[0]]);
+      const Vec3 tc = (m.nodes[owner[0]] + m.nodes[owner[1]] + m.nodes[owner[2]] + m.nodes[owner[3]]) / 4.0;
+      const Vec3 fc = (m.nodes[t[0]] + m.nodes[t[1]] + m.nodes[t[2]]) / 3.0;
+      ASSERT_GT(n.dot(fc - tc), 0.0) << c.file << " triangle " << k << " points inward";
+    }
+  }
+}
+
+TEST(Refinement, LiverAtThreeLevelsKeepsVolumeSurfaceAndValidity) {
+  const TetMesh l0 = read_tet_mesh(test::data_path("meshes/liver2.msh"));
+  const TetMesh l1 = refine_uniform(l0);
+  const TetMesh l2 = refine_uniform(l1);
+  EXPECT_EQ(l1.tet_count(), 8 * 1493u);
+  EXPECT_EQ(l2.tet_count(), 64 * 1493u);
+  EXPECT_NO_THROW(validate_mesh(l1));
+  EXPECT_NO_THROW(validate_mesh(l2));
+  EXPECT_NEAR(mesh_volume(l2) / mesh_volume(l0), 1.0, 1e-12);
+  const auto s0 = extract_boundary(l0), s2 = extract_boundary(l2);
+  EXPECT_EQ(s2.triangles.size(), 16 * s0.triangles.size());
+  EXPECT_EQ(euler_characteristic(s2), 2);
+  // Quality stays bounded: the shortest-diagonal split loses at most a fixed factor.
+  const auto min_quality = [](const TetMesh& m) {
+    double q = 1.0;
+    for (const auto& t : m.tets) q = std::min(q, tet_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]));
+    return q;
+  };
+  EXPECT_GT(min_quality(l2), 0.25 * min_quality(l0));
+}
+
+TEST(BoxMesh, IsConformingAndFillsTheBox) {
+  const TetMesh m = make_box_mesh(Vec3(0, 0, 0), Vec3(0.1, 0.02, 0.03), 5, 2, 3);
+  EXPECT_EQ(m.tet_count(), 6u * 5 * 2 * 3);
+  EXPECT_NO_THROW(validate_mesh(m));
+  EXPECT_NEAR(mesh_volume(m), 0.1 * 0.02 * 0.03, 1e-15);
+  const auto s = extract_boundary(m);
+  EXPECT_EQ(s.triangles.size(), 4u * (5 * 2 + 2 * 3 + 5 * 3));  // conforming: no interior faces left
+}

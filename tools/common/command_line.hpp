@@ -1,0 +1,51 @@
+#pragma once
+// A small, strict command-line parser shared by viscera's programs: every flag is declared with
+// its help text; unknown flags, missing values and bad numbers give one clear line.
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace viscera::cli {
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class CommandLine {
+ public:
+  CommandLine(std::string program, std::string summary);
+
+  /// Declares --name VALUE (default shown in help) or, with is_switch, a boolean --name.
+  void flag(const std::string& name, const std::string& value_name, const std::string& help,
+            std::optional<std::string> default_value = std::nullopt);
+  void option_switch(const std::string& name, const std::string& help);
+
+  /// Parses argv. Returns false if --help was given (help already printed to stdout).
+  bool parse(int argc, char** argv);
+
+  bool has(const std::string& name) const;
+  std::string text(const std::string& name) const;
+  double number(const std::string& name) const;
+  /// A number that must satisfy lo <= v <= hi.
+  double number_in(const std::string& name, double lo, double hi) const;
+  long integer(const std::string& name) const;
+  /// Comma-separated numbers, exactly `count` of them.
+  std::vector<double> numbers(const std::string& name, std::size_t count) const;
+  std::string help() const;
+
+ private:
+  struct Flag {
+    std::string value_name, help;
+    std::optional<std::string> default_value;
+    bool is_switch = false;
+  };
+  std::string program_, summary_;
+  std::vector<std::string> order_;
+  std::map<std::string, Flag> flags_;
+  std::map<std::string, std::string> values_;
+};
+
+}  // namespace viscera::cli
