@@ -1,6 +1,8 @@
 #include "gps/gps_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "gps/gps_calibration.hpp"
@@ -9,26 +11,7 @@
 namespace viscera::tissue {
 
 namespace {
-Mat6 unpack(const double* h) {
-  Mat6 H;
-  int k = 0;
-  for (int i = 0; i < 6; ++i)
-    for (int j = i; j < 6; ++j) H(i, j) = H(j, i) = h[k++];
-  return H;
-}
-
-// h = H dL with H packed as an upper triangle; fully unrolled by the compiler.
-inline void packed_symmetric_multiply(const double* H, const double* dL, double* h) {
-  for (int i = 0; i < 6; ++i) h[i] = 0.0;
-  int k = 0;
-  for (int i = 0; i < 6; ++i) {
-    h[i] += H[k++] * dL[i];
-    for (int j = i + 1; j < 6; ++j, ++k) {
-      h[i] += H[k] * dL[j];
-      h[j] += H[k] * dL[i];
-    }
-  }
-}
+constexpr int L = GpsModel::kLanes;
 }  // namespace
 
 GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
@@ -39,119 +22,206 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
     throw std::invalid_argument("GpsModel: material_of_tet size differs from tet count");
   if (!(options_.volume_stiffness_fraction >= 0.0 && options_.volume_stiffness_fraction < 1.0))
     throw std::invalid_argument("GpsModel: volume_stiffness_fraction must lie in [0, 1)");
-  const bool with_volume = options_.volume_stiffness_fraction > 0.0;
+  with_volume_ = options_.volume_stiffness_fraction > 0.0;
   std::vector<double> kappa(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
 
-  elements_.resize(element_count());
-  if (with_volume) volume_.resize(element_count());
-  for (std::size_t e = 0; e < element_count(); ++e) {
+  const std::size_t n = element_count();
+  blocks_.resize((n + L - 1) / L);
+  for (std::size_t slot = 0; slot < blocks_.size() * L; ++slot) {
+    const bool padding = slot >= n;
+    const std::size_t e = padding ? (slot / L) * L : slot;  // padding copies the block's first element
+    Block& b = blocks_[slot / L];
+    const int j = static_cast<int>(slot % L);
     const auto rest = gather(mesh_->nodes, e);
     const std::size_t m = material_of_tet.empty() ? 0 : material_of_tet[e];
     Mat6 H = gps_edge_hessian(rest, materials[m]);
-    Element& el = elements_[e];
-    el.v = mesh_->tets[e];
-    for (int k = 0; k < 6; ++k) {
-      el.rest_length[k] = (rest[kTetEdges[k][1]] - rest[kTetEdges[k][0]]).norm();
-      el.inv_rest_length[k] = 1.0 / el.rest_length[k];
-    }
-    if (with_volume) {
-      const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
-      volume_[e] = {V0, kappa[m]};
+    const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
+    if (with_volume_) {
+      // Remove the volume term's small-strain stiffness so that the sum still equals linear FE.
       const Vec6 hv = volume_in_elongations(rest);
       H -= (kappa[m] / V0) * hv * hv.transpose();
     }
+    if (padding) H.setZero();
+    for (int k = 0; k < 4; ++k) b.v[k][j] = mesh_->tets[e][k];
+    for (int k = 0; k < 6; ++k) {
+      b.rest_length[k][j] = (rest[kTetEdges[k][1]] - rest[kTetEdges[k][0]]).norm();
+      b.inv_rest_length[k][j] = 1.0 / b.rest_length[k][j];
+    }
     int k = 0;
-    for (int i = 0; i < 6; ++i)
-      for (int j = i; j < 6; ++j) el.H[k++] = H(i, j);
+    for (int r = 0; r < 6; ++r)
+      for (int c = r; c < 6; ++c) b.H[k++][j] = H(r, c);
+    b.rest_volume[j] = V0;
+    b.kappa[j] = (with_volume_ && !padding) ? kappa[m] : 0.0;
   }
 }
 
 std::string_view GpsModel::name() const {
-  if (options_.variant == GpsVariant::paper)
-    return volume_.empty() ? "gps" : "gps_volume";
-  return volume_.empty() ? "gps_energy" : "gps_energy_volume";
+  if (options_.variant == GpsVariant::paper) return with_volume_ ? "gps_volume" : "gps";
+  return with_volume_ ? "gps_energy_volume" : "gps_energy";
 }
 
-Mat6 GpsModel::edge_hessian(std::size_t e) const { return unpack(elements_[e].H); }
+Mat6 GpsModel::packed_hessian(std::size_t e) const {
+  const Block& b = blocks_[e / L];
+  const std::size_t j = e % L;
+  Mat6 H;
+  int k = 0;
+  for (int r = 0; r < 6; ++r)
+    for (int c = r; c < 6; ++c, ++k) H(r, c) = H(c, r) = b.H[k][j];
+  return H;
+}
+
+double GpsModel::edge_length(std::size_t e, int k) const { return blocks_[e / L].rest_length[k][e % L]; }
+
+Mat6 GpsModel::edge_hessian(std::size_t e) const { return packed_hessian(e); }
 
 Mat6 GpsModel::paper_constants(std::size_t e) const {
-  Mat6 H = edge_hessian(e);
-  if (!volume_.empty()) {
+  Mat6 H = packed_hessian(e);
+  if (with_volume_) {
+    const Block& b = blocks_[e / L];
     const Vec6 hv = volume_in_elongations(gather(mesh_->nodes, e));
-    H += (volume_[e].kappa / volume_[e].rest_volume) * hv * hv.transpose();
+    H += (b.kappa[e % L] / b.rest_volume[e % L]) * hv * hv.transpose();
   }
   Vec6 inv;
-  for (int k = 0; k < 6; ++k) inv(k) = elements_[e].inv_rest_length[k];
+  for (int k = 0; k < 6; ++k) inv(k) = 1.0 / edge_length(e, k);
   return inv.asDiagonal() * H;
 }
 
 template <bool kEnergyConsistent, bool kVolume>
 ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f) const {
-  double max_strain = 0.0;
-  const std::size_t n = elements_.size();
-  for (std::size_t e = 0; e < n; ++e) {
-    const Element& el = elements_[e];
-    const Vec3 p[4] = {x[el.v[0]], x[el.v[1]], x[el.v[2]], x[el.v[3]]};
-    double Y[6][3], L[6], dL[6];
+  const Vec3* X = mesh_->nodes.data();
+  double max_strain[L] = {}, nan_probe[L] = {};
+  for (const Block& b : blocks_) {
+    // Gather: current positions, and displacements u = x - X (exact for x near X).
+    double p[4][3][L], u[4][3][L];
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < L; ++j) {
+        const Vec3& xi = x[b.v[i][j]];
+        const Vec3& Xi = X[b.v[i][j]];
+        for (int c = 0; c < 3; ++c) {
+          p[i][c][j] = xi[c];
+          u[i][c][j] = xi[c] - Xi[c];
+        }
+      }
+    double Y[6][3][L], len[6][L], dL[6][L];
     for (int k = 0; k < 6; ++k) {
-      const Vec3& a = p[kTetEdges[k][0]];
-      const Vec3& b = p[kTetEdges[k][1]];
-      Y[k][0] = b[0] - a[0];
-      Y[k][1] = b[1] - a[1];
-      Y[k][2] = b[2] - a[2];
-      L[k] = std::sqrt(Y[k][0] * Y[k][0] + Y[k][1] * Y[k][1] + Y[k][2] * Y[k][2]);
-      dL[k] = L[k] - el.rest_length[k];
-      const double s = std::abs(dL[k]) * el.inv_rest_length[k];
-      max_strain = s > max_strain ? s : max_strain;
-      if (s != s) max_strain = s;  // keep NaN visible
+      const int a = kTetEdges[k][0], c = kTetEdges[k][1];
+#pragma omp simd
+      for (int j = 0; j < L; ++j) {
+        // Elongation from displacements, free of the cancellation in |Y| - L0 at small strain:
+        // |Y|^2 - L0^2 = (2 Y0 + du) . du with du = u_b - u_a and Y0 = Y - du.
+        const double y0 = p[c][0][j] - p[a][0][j], y1 = p[c][1][j] - p[a][1][j], y2 = p[c][2][j] - p[a][2][j];
+        const double d0 = u[c][0][j] - u[a][0][j], d1 = u[c][1][j] - u[a][1][j], d2 = u[c][2][j] - u[a][2][j];
+        Y[k][0][j] = y0;
+        Y[k][1][j] = y1;
+        Y[k][2][j] = y2;
+        const double l = std::sqrt(y0 * y0 + y1 * y1 + y2 * y2);
+        const double s = (2.0 * y0 - d0) * d0 + (2.0 * y1 - d1) * d1 + (2.0 * y2 - d2) * d2;
+        len[k][j] = l;
+        dL[k][j] = s / (l + b.rest_length[k][j]);
+      }
+#pragma omp simd
+      for (int j = 0; j < L; ++j) {
+        max_strain[j] = std::max(max_strain[j], std::fabs(dL[k][j]) * b.inv_rest_length[k][j]);
+        nan_probe[j] += dL[k][j];  // a NaN anywhere survives in the sum; max() would drop it
+      }
     }
-    double t[6];
-    packed_symmetric_multiply(el.H, dL, t);
-    for (int k = 0; k < 6; ++k) t[k] *= kEnergyConsistent ? 1.0 / L[k] : el.inv_rest_length[k];
-    Vec3 fv[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    // Tensions t = S H dL (H packed, symmetric).
+    double t[6][L];
+    for (int k = 0; k < 6; ++k)
+#pragma omp simd
+      for (int j = 0; j < L; ++j) t[k][j] = 0.0;
+    int h = 0;
+    for (int r = 0; r < 6; ++r) {
+#pragma omp simd
+      for (int j = 0; j < L; ++j) t[r][j] += b.H[h][j] * dL[r][j];
+      ++h;
+      for (int c = r + 1; c < 6; ++c, ++h)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) {
+          t[r][j] += b.H[h][j] * dL[c][j];
+          t[c][j] += b.H[h][j] * dL[r][j];
+        }
+    }
+    for (int k = 0; k < 6; ++k)
+#pragma omp simd
+      for (int j = 0; j < L; ++j) t[k][j] *= kEnergyConsistent ? 1.0 / len[k][j] : b.inv_rest_length[k][j];
+    // Vertex forces: +t Y on a, -t Y on b, plus the signed-volume term.
+    double fv[4][3][L] = {};
     for (int k = 0; k < 6; ++k) {
-      const Vec3 fk(t[k] * Y[k][0], t[k] * Y[k][1], t[k] * Y[k][2]);
-      fv[kTetEdges[k][0]] += fk;
-      fv[kTetEdges[k][1]] -= fk;
+      const int a = kTetEdges[k][0], c = kTetEdges[k][1];
+      for (int d = 0; d < 3; ++d)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) {
+          const double fk = t[k][j] * Y[k][d][j];
+          fv[a][d][j] += fk;
+          fv[c][d][j] -= fk;
+        }
     }
     if constexpr (kVolume) {
-      const VolumeTerm& vt = volume_[e];
-      const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0], e3 = p[3] - p[0];
-      const Vec3 g1 = e2.cross(e3) / 6.0, g2 = e3.cross(e1) / 6.0, g3 = e1.cross(e2) / 6.0;
-      const double V = e1.dot(g1);
-      const double s = -vt.kappa * (V / vt.rest_volume - 1.0);
-      fv[1] += s * g1;
-      fv[2] += s * g2;
-      fv[3] += s * g3;
-      fv[0] -= s * (g1 + g2 + g3);
+#pragma omp simd
+      for (int j = 0; j < L; ++j) {
+        double e1[3], e2[3], e3[3];
+        for (int d = 0; d < 3; ++d) {
+          e1[d] = p[1][d][j] - p[0][d][j];
+          e2[d] = p[2][d][j] - p[0][d][j];
+          e3[d] = p[3][d][j] - p[0][d][j];
+        }
+        const double g1[3] = {(e2[1] * e3[2] - e2[2] * e3[1]) / 6, (e2[2] * e3[0] - e2[0] * e3[2]) / 6, (e2[0] * e3[1] - e2[1] * e3[0]) / 6};
+        const double g2[3] = {(e3[1] * e1[2] - e3[2] * e1[1]) / 6, (e3[2] * e1[0] - e3[0] * e1[2]) / 6, (e3[0] * e1[1] - e3[1] * e1[0]) / 6};
+        const double g3[3] = {(e1[1] * e2[2] - e1[2] * e2[1]) / 6, (e1[2] * e2[0] - e1[0] * e2[2]) / 6, (e1[0] * e2[1] - e1[1] * e2[0]) / 6};
+        const double V = e1[0] * g1[0] + e1[1] * g1[1] + e1[2] * g1[2];
+        const double scale = -b.kappa[j] * (V / b.rest_volume[j] - 1.0);
+        for (int d = 0; d < 3; ++d) {
+          fv[1][d][j] += scale * g1[d];
+          fv[2][d][j] += scale * g2[d];
+          fv[3][d][j] += scale * g3[d];
+          fv[0][d][j] -= scale * (g1[d] + g2[d] + g3[d]);
+        }
+      }
     }
-    for (int i = 0; i < 4; ++i) f[el.v[i]] += fv[i];
+    // Scatter (lanes may share vertices: scalar adds).
+    for (int j = 0; j < L; ++j)
+      for (int i = 0; i < 4; ++i) {
+        Vec3& fi = f[b.v[i][j]];
+        fi[0] += fv[i][0][j];
+        fi[1] += fv[i][1][j];
+        fi[2] += fv[i][2][j];
+      }
   }
-  return {max_strain};
+  double worst = 0.0, probe = 0.0;
+  for (int j = 0; j < L; ++j) {
+    worst = std::max(worst, max_strain[j]);
+    probe += nan_probe[j];
+  }
+  return {std::isnan(probe) ? std::numeric_limits<double>::quiet_NaN() : worst};
 }
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) const {
   const bool ec = options_.variant == GpsVariant::energy_consistent;
-  if (volume_.empty())
-    return ec ? add_forces_impl<true, false>(x, f) : add_forces_impl<false, false>(x, f);
+  if (!with_volume_) return ec ? add_forces_impl<true, false>(x, f) : add_forces_impl<false, false>(x, f);
   return ec ? add_forces_impl<true, true>(x, f) : add_forces_impl<false, true>(x, f);
 }
 
 double GpsModel::energy(std::span<const Vec3> x) const {
   double sum = 0.0;
-  for (std::size_t e = 0; e < elements_.size(); ++e) {
-    const Element& el = elements_[e];
+  for (std::size_t e = 0; e < element_count(); ++e) {
     const auto p = gather(x, e);
-    double dL[6], h[6];
-    for (int k = 0; k < 6; ++k)
-      dL[k] = (p[kTetEdges[k][1]] - p[kTetEdges[k][0]]).norm() - el.rest_length[k];
-    packed_symmetric_multiply(el.H, dL, h);
-    for (int k = 0; k < 6; ++k) sum += 0.5 * dL[k] * h[k];
-    if (!volume_.empty()) {
-      const double r = signed_volume(p[0], p[1], p[2], p[3]) / volume_[e].rest_volume - 1.0;
-      sum += 0.5 * volume_[e].kappa * volume_[e].rest_volume * r * r;
+    const auto r = gather(mesh_->nodes, e);
+    Vec6 dL;
+    for (int k = 0; k < 6; ++k) {
+      const int a = kTetEdges[k][0], b = kTetEdges[k][1];
+      const Vec3 du = (p[b] - r[b]) - (p[a] - r[a]);
+      const Vec3 y = p[b] - p[a];
+      dL(k) = (2.0 * y - du).dot(du) / (y.norm() + edge_length(e, k));
+    }
+    sum += 0.5 * dL.dot(packed_hessian(e) * dL);
+    if (with_volume_) {
+      const Block& b = blocks_[e / L];
+      const double V0 = b.rest_volume[e % L];
+      const double q = signed_volume(p[0], p[1], p[2], p[3]) / V0 - 1.0;
+      sum += 0.5 * b.kappa[e % L] * V0 * q * q;
     }
   }
   return sum;
@@ -160,30 +230,29 @@ double GpsModel::energy(std::span<const Vec3> x) const {
 Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const {
   // f = P t with P_e = (+Y_e at a, -Y_e at b), t = S h, h = H dL, dL = G dx,
   // G_e = (-y_e at a, +y_e at b), y_e = Y_e / L_e. K = -df/dx (see MODEL.md section 1).
-  const Element& el = elements_[e];
   const auto p = gather(x, e);
-  const Mat6 H = unpack(el.H);
+  const Mat6 H = packed_hessian(e);
   Mat6x12 G = Mat6x12::Zero();
-  Vec6 L, dL;
+  Vec6 len, dL;
   Eigen::Matrix<double, 3, 6> Y;
   for (int k = 0; k < 6; ++k) {
     const int a = kTetEdges[k][0], b = kTetEdges[k][1];
     Y.col(k) = p[b] - p[a];
-    L(k) = Y.col(k).norm();
-    dL(k) = L(k) - el.rest_length[k];
-    G.block<1, 3>(k, 3 * a) = -Y.col(k).transpose() / L(k);
-    G.block<1, 3>(k, 3 * b) = Y.col(k).transpose() / L(k);
+    len(k) = Y.col(k).norm();
+    dL(k) = len(k) - edge_length(e, k);
+    G.block<1, 3>(k, 3 * a) = -Y.col(k).transpose() / len(k);
+    G.block<1, 3>(k, 3 * b) = Y.col(k).transpose() / len(k);
   }
   const Vec6 h = H * dL;
   const bool ec = options_.variant == GpsVariant::energy_consistent;
   Mat12 K = Mat12::Zero();
   for (int k = 0; k < 6; ++k) {
     const int a = kTetEdges[k][0], b = kTetEdges[k][1];
-    const double s = ec ? 1.0 / L(k) : el.inv_rest_length[k];
+    const double s = ec ? 1.0 / len(k) : 1.0 / edge_length(e, k);
     const double tk = s * h(k);
     // Material part: -P_k dt_k/dx with dt_k/dx = s (H G)_k [- h_k / L_k^2 G_k for EC].
     Eigen::Matrix<double, 1, 12> dt = s * (H.row(k) * G);
-    if (ec) dt -= h(k) / (L(k) * L(k)) * G.row(k);
+    if (ec) dt -= h(k) / (len(k) * len(k)) * G.row(k);
     K.block<3, 12>(3 * a, 0) -= Y.col(k) * dt;
     K.block<3, 12>(3 * b, 0) += Y.col(k) * dt;
     // Geometric part: -t_k dP_k/dx, dP_k/dx = [[-I, I], [I, -I]] on (a, b).
@@ -193,12 +262,12 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const {
     K.block<3, 3>(3 * b, 3 * a) -= I;
     K.block<3, 3>(3 * b, 3 * b) += I;
   }
-  if (!volume_.empty()) {
-    const VolumeTerm& vt = volume_[e];
+  if (with_volume_) {
+    const Block& bl = blocks_[e / L];
+    const double kappa = bl.kappa[e % L], V0 = bl.rest_volume[e % L];
     const Vec12 g = volume_gradient(p);
     const double V = signed_volume(p[0], p[1], p[2], p[3]);
-    K += (vt.kappa / vt.rest_volume) * g * g.transpose() +
-         vt.kappa * (V / vt.rest_volume - 1.0) * volume_hessian(p);
+    K += (kappa / V0) * g * g.transpose() + kappa * (V / V0 - 1.0) * volume_hessian(p);
   }
   return K;
 }

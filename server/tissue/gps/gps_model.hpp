@@ -41,25 +41,27 @@ class GpsModel final : public ForceModel {
   /// H of element e (symmetric 6x6) as used by the model.
   Mat6 edge_hessian(std::size_t e) const;
 
-  /// Per-element record, one contiguous stream for the force loop (280 bytes).
-  struct Element {
-    Tet v;
-    double rest_length[6];
-    double inv_rest_length[6];
-    double H[21];  ///< upper triangle of H, row by row
-  };
-  struct VolumeTerm {
-    double rest_volume;
-    double kappa;  ///< [Pa]
+  /// The hot loop's data: tetrahedra in blocks of kLanes, structure-of-arrays inside a block, so
+  /// that one block streams contiguously and every arithmetic line vectorises across the lanes.
+  static constexpr int kLanes = 8;
+  struct Block {
+    std::int32_t v[4][kLanes];
+    double rest_length[6][kLanes];
+    double inv_rest_length[6][kLanes];
+    double H[21][kLanes];  ///< upper triangle of H, row by row
+    double rest_volume[kLanes];
+    double kappa[kLanes];  ///< signed-volume stiffness [Pa] (0 when the term is off)
   };
 
  private:
   template <bool kEnergyConsistent, bool kVolume>
   ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f) const;
+  Mat6 packed_hessian(std::size_t e) const;
+  double edge_length(std::size_t e, int k) const;
 
   GpsOptions options_;
-  std::vector<Element> elements_;
-  std::vector<VolumeTerm> volume_;  ///< empty when the volume term is off
+  bool with_volume_ = false;
+  std::vector<Block> blocks_;  ///< padding lanes have H = 0 and copy a real element
 };
 
 }  // namespace viscera::tissue
