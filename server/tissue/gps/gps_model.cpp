@@ -7,6 +7,7 @@
 
 #include "gps/gps_calibration.hpp"
 #include "material/elasticity.hpp"
+#include "viscoelastic/standard_linear_solids.hpp"
 
 namespace viscera::tissue {
 
@@ -23,12 +24,20 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   if (!(options_.volume_stiffness_fraction >= 0.0 && options_.volume_stiffness_fraction < 1.0))
     throw std::invalid_argument("GpsModel: volume_stiffness_fraction must lie in [0, 1)");
   with_volume_ = options_.volume_stiffness_fraction > 0.0;
+  const GpsViscoelasticity& ve = options_.viscoelasticity;
+  mechanisms_ = ve.omega_rad_s.size();
+  if (ve.shear_weight.size() != mechanisms_ || (!ve.bulk_weight.empty() && ve.bulk_weight.size() != mechanisms_))
+    throw std::invalid_argument("GpsModel: one shear (and bulk) weight per relaxation frequency expected");
+  if (!(ve.kelvin_voigt_time_s >= 0) || !(ve.qlv_stiffening >= 0))
+    throw std::invalid_argument("GpsModel: Kelvin-Voigt time and QLV stiffening must be >= 0");
+  const bool bulk_differs = !ve.bulk_weight.empty() && ve.bulk_weight != ve.shear_weight;
   std::vector<double> kappa(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
 
   const std::size_t n = element_count();
   blocks_.resize((n + L - 1) / L);
+  if (bulk_differs) bulk_.resize(blocks_.size());
   for (std::size_t slot = 0; slot < blocks_.size() * L; ++slot) {
     const bool padding = slot >= n;
     const std::size_t e = padding ? (slot / L) * L : slot;  // padding copies the block's first element
@@ -38,10 +47,16 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
     const std::size_t m = material_of_tet.empty() ? 0 : material_of_tet[e];
     Mat6 H = gps_edge_hessian(rest, materials[m]);
     const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
+    const Vec6 hv = volume_in_elongations(rest);
     if (with_volume_) {
       // Remove the volume term's small-strain stiffness so that the sum still equals linear FE.
-      const Vec6 hv = volume_in_elongations(rest);
       H -= (kappa[m] / V0) * hv * hv.transpose();
+    }
+    if (bulk_differs) {
+      // The volumetric part of H is rank one: (K_Reuss / V0) hv hv^T (hv: J^T hv = grad V).
+      BulkBlock& bb = bulk_[slot / L];
+      for (int k = 0; k < 6; ++k) bb.hv[k][slot % L] = hv(k);
+      bb.scale[slot % L] = padding ? 0.0 : (reuss_bulk_modulus(materials[m]) - (with_volume_ ? kappa[m] : 0.0)) / V0;
     }
     if (padding) H.setZero();
     for (int k = 0; k < 4; ++k) b.v[k][j] = mesh_->tets[e][k];
@@ -88,11 +103,31 @@ Mat6 GpsModel::paper_constants(std::size_t e) const {
   return inv.asDiagonal() * H;
 }
 
-template <bool kEnergyConsistent, bool kVolume>
-ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f) const {
+template <bool kEnergyConsistent, bool kVolume, bool kMemory>
+ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory) const {
   const Vec3* X = mesh_->nodes.data();
   double max_strain[L] = {}, nan_probe[L] = {};
-  for (const Block& b : blocks_) {
+  // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l.
+  const GpsViscoelasticity& ve = options_.viscoelasticity;
+  const std::size_t nm = mechanisms_;
+  const std::size_t stride = (1 + nm) * 6 * L;
+  double me[8], ma[8], mc[8], ys[8], yb[8];
+  double rate_scale = 0.0;
+  const double dt = memory ? memory->dt_s : 0.0;
+  if constexpr (kMemory) {
+    for (std::size_t l = 0; l < nm; ++l) {
+      const MemoryStep st = MemoryStep::make(ve.omega_rad_s[l], dt);
+      me[l] = st.e;
+      ma[l] = st.a;
+      mc[l] = st.c;
+      ys[l] = ve.shear_weight[l];
+      yb[l] = ve.bulk_weight.empty() ? ve.shear_weight[l] : ve.bulk_weight[l];
+    }
+    rate_scale = dt > 0 ? ve.kelvin_voigt_time_s / dt : 0.0;
+  }
+  const double qlv = ve.qlv_stiffening;
+  for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
+    const Block& b = blocks_[bi];
     // Gather: current positions, and displacements u = x - X (exact for x near X).
     double p[4][3][L], u[4][3][L];
     for (int i = 0; i < 4; ++i)
@@ -127,6 +162,34 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f)
         nan_probe[j] += dL[k][j];  // a NaN anywhere survives in the sum; max() would drop it
       }
     }
+    if (qlv > 0) {  // Fung: elongation measure L0 (exp(B e) - 1) / B, e = dL / L0
+      for (int k = 0; k < 6; ++k)
+        for (int j = 0; j < L; ++j)
+          dL[k][j] = b.rest_length[k][j] * std::expm1(qlv * dL[k][j] * b.inv_rest_length[k][j]) / qlv;
+    }
+    double bulk_part[6][L];  // a_b - a_s, for bulk relaxation that differs from shear
+    if constexpr (kMemory) {
+      const double* in = memory->before.data() + bi * stride;
+      double* out = memory->after.data() + bi * stride;
+      for (int k = 0; k < 6; ++k)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) {
+          const double prev = in[k * L + j];
+          const double dl = dL[k][j];
+          const double rate = (dl - prev) * rate_scale;  // Kelvin-Voigt: tau d(dL)/dt
+          double zs = 0.0, zb = 0.0;
+          for (std::size_t l = 0; l < nm; ++l) {
+            const std::size_t at = ((1 + l) * 6 + static_cast<std::size_t>(k)) * L + static_cast<std::size_t>(j);
+            const double z = dt > 0 ? me[l] * in[at] + ma[l] * prev + mc[l] * (dl - prev) : in[at];
+            out[at] = z;
+            zs += ys[l] * z;
+            zb += yb[l] * z;
+          }
+          out[k * L + j] = dl;
+          dL[k][j] = dl - zs + rate;  // a_s: the relaxed (shear) elongation
+          bulk_part[k][j] = zs - zb;  // a_b - a_s
+        }
+    }
     // Tensions t = S H dL (H packed, symmetric).
     double t[6][L];
     for (int k = 0; k < 6; ++k)
@@ -143,6 +206,17 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f)
           t[r][j] += b.H[h][j] * dL[c][j];
           t[c][j] += b.H[h][j] * dL[r][j];
         }
+    }
+    if constexpr (kMemory) {
+      if (!bulk_.empty()) {  // + (K/V0) hv (hv . (a_b - a_s))
+        const BulkBlock& bb = bulk_[bi];
+#pragma omp simd
+        for (int j = 0; j < L; ++j) {
+          double proj = 0.0;
+          for (int k = 0; k < 6; ++k) proj += bb.hv[k][j] * bulk_part[k][j];
+          for (int k = 0; k < 6; ++k) t[k][j] += bb.scale[j] * bb.hv[k][j] * proj;
+        }
+      }
     }
     for (int k = 0; k < 6; ++k)
 #pragma omp simd
@@ -200,8 +274,20 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f)
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) const {
   const bool ec = options_.variant == GpsVariant::energy_consistent;
-  if (!with_volume_) return ec ? add_forces_impl<true, false>(x, f) : add_forces_impl<false, false>(x, f);
-  return ec ? add_forces_impl<true, true>(x, f) : add_forces_impl<false, true>(x, f);
+  if (!with_volume_) return ec ? add_forces_impl<true, false, false>(x, f, nullptr) : add_forces_impl<false, false, false>(x, f, nullptr);
+  return ec ? add_forces_impl<true, true, false>(x, f, nullptr) : add_forces_impl<false, true, false>(x, f, nullptr);
+}
+
+std::size_t GpsModel::memory_size() const {
+  return options_.viscoelasticity.has_memory() ? blocks_.size() * (1 + mechanisms_) * 6 * L : 0;
+}
+
+ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
+  if (memory_size() == 0 || memory.before.size() != memory_size() || memory.after.size() != memory_size())
+    return add_forces(x, f);  // no memory attached: the unrelaxed (instantaneous) response
+  const bool ec = options_.variant == GpsVariant::energy_consistent;
+  if (!with_volume_) return ec ? add_forces_impl<true, false, true>(x, f, &memory) : add_forces_impl<false, false, true>(x, f, &memory);
+  return ec ? add_forces_impl<true, true, true>(x, f, &memory) : add_forces_impl<false, true, true>(x, f, &memory);
 }
 
 double GpsModel::energy(std::span<const Vec3> x) const {
@@ -227,11 +313,34 @@ double GpsModel::energy(std::span<const Vec3> x) const {
   return sum;
 }
 
-Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const {
+Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const { return tangent(x, e, 1.0, 0.0); }
+
+Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const {
+  // d(relaxed elongation)/d(dL) over a step of dt: 1 - sum Y_l c_l (+ tau / dt for Kelvin-Voigt).
+  const GpsViscoelasticity& ve = options_.viscoelasticity;
+  if (!ve.has_memory()) return tangent(x, e, 1.0, 0.0);
+  double shear = 1.0, bulk = 1.0;
+  for (std::size_t l = 0; l < mechanisms_; ++l) {
+    const double c = dt_s > 0 ? MemoryStep::make(ve.omega_rad_s[l], dt_s).c : 0.0;
+    shear -= ve.shear_weight[l] * c;
+    bulk -= (ve.bulk_weight.empty() ? ve.shear_weight[l] : ve.bulk_weight[l]) * c;
+  }
+  const double kv = dt_s > 0 ? ve.kelvin_voigt_time_s / dt_s : 0.0;
+  return tangent(x, e, shear + kv, bulk - shear);
+}
+
+Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra) const {
   // f = P t with P_e = (+Y_e at a, -Y_e at b), t = S h, h = H dL, dL = G dx,
   // G_e = (-y_e at a, +y_e at b), y_e = Y_e / L_e. K = -df/dx (see MODEL.md section 1).
   const auto p = gather(x, e);
-  const Mat6 H = packed_hessian(e);
+  Mat6 H = stiffness_scale * packed_hessian(e);
+  if (bulk_extra != 0.0 && !bulk_.empty()) {
+    const BulkBlock& bb = bulk_[e / L];
+    Vec6 hv;
+    for (int k = 0; k < 6; ++k) hv(k) = bb.hv[k][e % L];
+    H += bulk_extra * bb.scale[e % L] * hv * hv.transpose();
+  }
+  const double qlv = options_.viscoelasticity.qlv_stiffening;
   Mat6x12 G = Mat6x12::Zero();
   Vec6 len, dL;
   Eigen::Matrix<double, 3, 6> Y;
@@ -243,6 +352,13 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const {
     G.block<1, 3>(k, 3 * a) = -Y.col(k).transpose() / len(k);
     G.block<1, 3>(k, 3 * b) = Y.col(k).transpose() / len(k);
   }
+  Mat6x12 Gm = G;  // derivative of the (possibly QLV-mapped) elongation measure
+  if (qlv > 0)
+    for (int k = 0; k < 6; ++k) {
+      const double strain = dL(k) / edge_length(e, k);
+      Gm.row(k) *= std::exp(qlv * strain);
+      dL(k) = edge_length(e, k) * std::expm1(qlv * strain) / qlv;
+    }
   const Vec6 h = H * dL;
   const bool ec = options_.variant == GpsVariant::energy_consistent;
   Mat12 K = Mat12::Zero();
@@ -251,7 +367,7 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const {
     const double s = ec ? 1.0 / len(k) : 1.0 / edge_length(e, k);
     const double tk = s * h(k);
     // Material part: -P_k dt_k/dx with dt_k/dx = s (H G)_k [- h_k / L_k^2 G_k for EC].
-    Eigen::Matrix<double, 1, 12> dt = s * (H.row(k) * G);
+    Eigen::Matrix<double, 1, 12> dt = s * (H.row(k) * Gm);
     if (ec) dt -= h(k) / (len(k) * len(k)) * G.row(k);
     K.block<3, 12>(3 * a, 0) -= Y.col(k) * dt;
     K.block<3, 12>(3 * b, 0) += Y.col(k) * dt;

@@ -19,10 +19,29 @@ namespace viscera::tissue {
 
 enum class GpsVariant { paper, energy_consistent };
 
+/// Viscoelasticity of the GPS (MODEL.md section 3). With memory variables the elasticity matrices
+/// given to the model are the UNRELAXED ones; every tetrahedron keeps per mechanism a 6-vector
+/// zeta_l of filtered edge elongations (d zeta_l / dt = w_l (dL - zeta_l), updated exactly), and
+/// the tension becomes t = S [H_dev (dL - sum Y^s_l zeta_l) + H_vol (dL - sum Y^b_l zeta_l)].
+/// Shear and bulk share the relaxation frequencies and have their own weights (their own Q).
+struct GpsViscoelasticity {
+  std::vector<double> omega_rad_s;   ///< relaxation frequencies w_l
+  std::vector<double> shear_weight;  ///< Y^s_l
+  std::vector<double> bulk_weight;   ///< Y^b_l (same size; zeros: no bulk relaxation)
+  /// Kelvin-Voigt baseline: t += S H tau d(dL)/dt (one relaxation time; 0 = off).
+  double kelvin_voigt_time_s = 0.0;
+  /// Fung's quasi-linear viscoelasticity: each edge strain e = dL/L0 is replaced by
+  /// (exp(B e) - 1) / B before the elastic and relaxation response (B = 0: linear).
+  double qlv_stiffening = 0.0;
+
+  bool has_memory() const { return !omega_rad_s.empty() || kelvin_voigt_time_s > 0; }
+};
+
 struct GpsOptions {
   GpsVariant variant = GpsVariant::paper;
   /// kappa / (Reuss bulk modulus) of the signed-volume term, in [0, 1); 0 disables it.
   double volume_stiffness_fraction = 0.0;
+  GpsViscoelasticity viscoelasticity;
 };
 
 class GpsModel final : public ForceModel {
@@ -32,6 +51,10 @@ class GpsModel final : public ForceModel {
 
   std::string_view name() const override;
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const override;
+  ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const override;
+  std::size_t memory_size() const override;
+  Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const override;
+  double stiffness_damping_time_s() const override { return options_.viscoelasticity.kelvin_voigt_time_s; }
   double energy(std::span<const Vec3> x) const override;
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e) const override;
 
@@ -53,15 +76,24 @@ class GpsModel final : public ForceModel {
     double kappa[kLanes];  ///< signed-volume stiffness [Pa] (0 when the term is off)
   };
 
+  /// Per block, for bulk weights that differ from the shear weights: H_vol = s hv hv^T.
+  struct BulkBlock {
+    double hv[6][kLanes];
+    double scale[kLanes];  ///< (K_Reuss - kappa) / V0 [Pa/m^3]
+  };
+
  private:
-  template <bool kEnergyConsistent, bool kVolume>
-  ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f) const;
+  template <bool kEnergyConsistent, bool kVolume, bool kMemory>
+  ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory) const;
+  Mat12 tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra) const;
   Mat6 packed_hessian(std::size_t e) const;
   double edge_length(std::size_t e, int k) const;
 
   GpsOptions options_;
   bool with_volume_ = false;
   std::vector<Block> blocks_;  ///< padding lanes have H = 0 and copy a real element
+  std::vector<BulkBlock> bulk_;  ///< only when bulk and shear relax differently
+  std::size_t mechanisms_ = 0;
 };
 
 }  // namespace viscera::tissue

@@ -25,10 +25,20 @@ std::vector<double> lumped_masses(const TetMesh& mesh, double density_kg_m3) {
 }
 
 std::vector<char> BoundaryConditions::constrained_mask(std::size_t node_count) const {
-  std::vector<char> mask(node_count, 0);
-  for (auto i : fixed_nodes) mask.at(static_cast<std::size_t>(i)) = 1;
+  std::vector<char> mask(3 * node_count, 0);
+  const auto node = [&](std::int32_t i) {
+    if (i < 0 || static_cast<std::size_t>(i) >= node_count)
+      throw std::invalid_argument("BoundaryConditions: node " + std::to_string(i) + " out of range");
+    for (int k = 0; k < 3; ++k) mask[3 * static_cast<std::size_t>(i) + k] = 1;
+  };
+  for (auto i : fixed_nodes) node(i);
   for (const auto& p : prescribed)
-    for (auto i : p.nodes) mask.at(static_cast<std::size_t>(i)) = 1;
+    for (auto i : p.nodes) node(i);
+  for (const auto& c : fixed_axes) {
+    if (c.node < 0 || static_cast<std::size_t>(c.node) >= node_count || c.axis < 0 || c.axis > 2)
+      throw std::invalid_argument("BoundaryConditions: bad axis constraint");
+    mask[3 * static_cast<std::size_t>(c.node) + c.axis] = 1;
+  }
   return mask;
 }
 

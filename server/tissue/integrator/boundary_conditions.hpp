@@ -19,15 +19,28 @@ struct PrescribedMotion {
   std::function<Vec3(const Vec3& rest, double t)> position;
 };
 
+/// One coordinate of one node held at its rest value (a roller or symmetry plane).
+struct AxisConstraint {
+  std::int32_t node;
+  int axis;  ///< 0 = x, 1 = y, 2 = z
+};
+
 struct BoundaryConditions {
   Vec3 gravity_m_s2 = Vec3::Zero();
   std::vector<std::int32_t> fixed_nodes;        ///< held at their rest positions
+  std::vector<AxisConstraint> fixed_axes;       ///< single coordinates held at rest
   std::vector<PrescribedMotion> prescribed;     ///< moved as prescribed
-  /// Constant external forces [N] per node (empty = none).
+  /// External forces [N] per node (empty = none), scaled by force_amplitude(t) if given.
   std::vector<Vec3> nodal_forces;
+  std::function<double(double t)> force_amplitude;
 
-  /// 1 for nodes that are fixed or prescribed, else 0.
+  /// 1 for each coordinate (3 per node) that is fixed or prescribed, else 0.
   std::vector<char> constrained_mask(std::size_t node_count) const;
+  /// External force on node i at time t (gravity excluded).
+  Vec3 nodal_force(std::size_t i, double t) const {
+    if (nodal_forces.empty()) return Vec3::Zero();
+    return force_amplitude ? Vec3(force_amplitude(t) * nodal_forces[i]) : nodal_forces[i];
+  }
 };
 
 /// Node selections for fixed regions.

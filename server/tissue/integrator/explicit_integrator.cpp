@@ -20,12 +20,13 @@ ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<doub
   dt_ = options_.dt_s > 0 ? options_.dt_s : options_.safety_factor * critical_.dt_s;
   const auto mask = bc_.constrained_mask(mass_.size());
   inv_mass_.resize(mass_.size());
-  external_.resize(mass_.size());
+  gravity_.resize(mass_.size());
   for (std::size_t i = 0; i < mass_.size(); ++i) {
-    inv_mass_[i] = mask[i] ? 0.0 : 1.0 / mass_[i];
-    external_[i] = mass_[i] * bc_.gravity_m_s2;
-    if (!bc_.nodal_forces.empty()) external_[i] += bc_.nodal_forces.at(i);
+    for (int k = 0; k < 3; ++k) inv_mass_[i][k] = mask[3 * i + k] ? 0.0 : 1.0 / mass_[i];
+    gravity_[i] = mass_[i] * bc_.gravity_m_s2;
   }
+  if (!bc_.nodal_forces.empty() && bc_.nodal_forces.size() != mass_.size())
+    throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");
   force_.resize(mass_.size());
 }
 
@@ -33,8 +34,13 @@ void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
 
 void ExplicitIntegrator::step_with(State& state, double dt) {
   const std::size_t n = mass_.size();
-  for (std::size_t i = 0; i < n; ++i) force_[i] = external_[i];
-  const ForceStats stats = model_.add_forces(state.x, force_);
+  for (std::size_t i = 0; i < n; ++i) force_[i] = gravity_[i] + bc_.nodal_force(i, state.time_s);
+  // Memory variables advance from their last evaluation to this one into a scratch buffer, which
+  // becomes the state's only if the step passes the instability check.
+  const std::size_t nm = model_.memory_size();
+  if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
+  memory_scratch_.resize(nm);
+  const ForceStats stats = model_.add_forces(state.x, force_, {state.memory, memory_scratch_, state.time_s - state.memory_time_s});
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
     std::ostringstream msg;
@@ -52,10 +58,13 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   x_prev_ = state.x;
   v_prev_ = state.v;
   t_prev_ = state.time_s;
+  state.memory.swap(memory_scratch_);
+  state.memory_time_s = state.time_s;
   const double damping = std::exp(-options_.mass_damping_per_s * dt);
   for (std::size_t i = 0; i < n; ++i) {
-    state.v[i] = (state.v[i] + (dt * inv_mass_[i]) * force_[i]) * damping;
-    if (inv_mass_[i] == 0.0) state.v[i].setZero();
+    state.v[i] = (state.v[i] + dt * inv_mass_[i].cwiseProduct(force_[i])) * damping;
+    for (int k = 0; k < 3; ++k)
+      if (inv_mass_[i][k] == 0.0) state.v[i][k] = 0.0;
     state.x[i] += dt * state.v[i];
   }
   const double t1 = state.time_s + dt;

@@ -44,12 +44,13 @@ class ExplicitIntegrator {
   BoundaryConditions bc_;
   ExplicitOptions options_;
   std::vector<double> mass_;
-  std::vector<double> inv_mass_;   // 0 for constrained nodes
-  std::vector<Vec3> external_;     // gravity + nodal forces
+  std::vector<Vec3> inv_mass_;     // per coordinate; 0 where constrained
+  std::vector<Vec3> gravity_;      // m g per node
   StableStep critical_;
   double dt_;
   std::vector<Vec3> force_, x_prev_, v_prev_;
   double t_prev_ = 0.0;
+  std::vector<double> memory_scratch_;
 };
 
 }  // namespace viscera::tissue

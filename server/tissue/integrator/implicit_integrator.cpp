@@ -24,17 +24,12 @@ ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<doub
   mass_ = lumped_masses(model.rest_mesh(), density_kg_m3);
   const std::size_t n = mass_.size();
   external_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    external_[i] = mass_[i] * bc_.gravity_m_s2;
-    if (!bc_.nodal_forces.empty()) external_[i] += bc_.nodal_forces.at(i);
-  }
+  if (!bc_.nodal_forces.empty() && bc_.nodal_forces.size() != n)
+    throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");
   const auto mask = bc_.constrained_mask(n);
-  dof_.assign(n, -1);
-  for (std::size_t i = 0; i < n; ++i)
-    if (!mask[i]) {
-      dof_[i] = free_dofs_;
-      free_dofs_ += 3;
-    }
+  dof_.assign(3 * n, -1);
+  for (std::size_t c = 0; c < 3 * n; ++c)
+    if (!mask[c]) dof_[c] = free_dofs_++;
   force_.resize(n);
   if (free_dofs_ == 0) return;
 
@@ -42,13 +37,10 @@ ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<doub
   std::vector<std::vector<int>> rows(static_cast<std::size_t>(free_dofs_));
   for (std::size_t e = 0; e < model.element_count(); ++e) {
     const Tet& t = model.element(e);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        const int da = dof_[t[a]], db = dof_[t[b]];
-        if (da < 0 || db < 0) continue;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            if (da + i <= db + j) rows[static_cast<std::size_t>(db + j)].push_back(da + i);
+    for (int p = 0; p < 12; ++p)
+      for (int q = 0; q < 12; ++q) {
+        const int dp = dof_[3 * t[p / 3] + p % 3], dq = dof_[3 * t[q / 3] + q % 3];
+        if (dp >= 0 && dq >= 0 && dp <= dq) rows[static_cast<std::size_t>(dq)].push_back(dp);
       }
   }
   std::vector<int> colptr(1, 0), rowidx;
@@ -64,10 +56,8 @@ ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<doub
     const Tet& t = model.element(e);
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 12; ++q) {
-        const int dp = dof_[t[p / 3]], dq = dof_[t[q / 3]];
-        if (dp < 0 || dq < 0) continue;
-        const int r = dp + p % 3, c = dq + q % 3;
-        if (r <= c) element_slots_[144 * e + 12 * p + q] = solver_->slot(r, c);
+        const int r = dof_[3 * t[p / 3] + p % 3], c = dof_[3 * t[q / 3] + q % 3];
+        if (r >= 0 && c >= 0 && r <= c) element_slots_[144 * e + 12 * p + q] = solver_->slot(r, c);
       }
   }
   diagonal_slots_.resize(static_cast<std::size_t>(free_dofs_));
@@ -79,6 +69,7 @@ ImplicitIntegrator::~ImplicitIntegrator() = default;
 void ImplicitIntegrator::apply_constraints(State& state, double t) {
   const auto& rest = model_.rest_mesh().nodes;
   for (auto i : bc_.fixed_nodes) state.x[i] = rest[i];
+  for (const auto& c : bc_.fixed_axes) state.x[c.node][c.axis] = rest[c.node][c.axis];
   for (const auto& p : bc_.prescribed)
     for (auto i : p.nodes) state.x[i] = p.position(rest[i], t);
 }
@@ -86,15 +77,20 @@ void ImplicitIntegrator::apply_constraints(State& state, double t) {
 double ImplicitIntegrator::residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n,
                                     const std::vector<Vec3>& v_n, std::vector<double>& r) {
   std::fill(force_.begin(), force_.end(), Vec3::Zero());
-  model_.add_forces(x, force_);
+  if (dynamic && memory_before_) {
+    memory_trial_.resize(memory_before_->size());
+    model_.add_forces(x, force_, {*memory_before_, memory_trial_, options_.dt_s});
+  } else {
+    model_.add_forces(x, force_);
+  }
   const double dt = options_.dt_s;
   const double mass_scale = (1.0 + options_.mass_damping_per_s * dt) / (dt * dt);
   r.assign(static_cast<std::size_t>(free_dofs_), 0.0);
   for (std::size_t i = 0; i < mass_.size(); ++i) {
-    if (dof_[i] < 0) continue;
     Vec3 ri = -force_[i] - external_[i];
     if (dynamic) ri += mass_[i] * (mass_scale * (x[i] - x_n[i]) - v_n[i] / dt);
-    for (int k = 0; k < 3; ++k) r[static_cast<std::size_t>(dof_[i] + k)] = ri[k];
+    for (int k = 0; k < 3; ++k)
+      if (dof_[3 * i + k] >= 0) r[static_cast<std::size_t>(dof_[3 * i + k])] = ri[k];
   }
   return norm(r);
 }
@@ -103,18 +99,16 @@ void ImplicitIntegrator::assemble(const std::vector<Vec3>& x, double mass_scale,
   std::span<double> values = solver_->values();
   std::fill(values.begin(), values.end(), 0.0);
   for (std::size_t e = 0; e < model_.element_count(); ++e) {
-    const Mat12 K = model_.element_tangent(x, e);
+    const Mat12 K = mass_scale > 0 ? model_.element_tangent(x, e, options_.dt_s) : model_.element_tangent(x, e);
     const long* slots = &element_slots_[144 * e];
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 12; ++q)
         if (slots[12 * p + q] >= 0) values[static_cast<std::size_t>(slots[12 * p + q])] += 0.5 * (K(p, q) + K(q, p));
   }
   double mean_diagonal = 0.0;
-  for (std::size_t i = 0; i < mass_.size(); ++i) {
-    if (dof_[i] < 0) continue;
-    for (int k = 0; k < 3; ++k)
-      values[static_cast<std::size_t>(diagonal_slots_[static_cast<std::size_t>(dof_[i] + k)])] += mass_scale * mass_[i];
-  }
+  for (std::size_t c = 0; c < dof_.size(); ++c)
+    if (dof_[c] >= 0)
+      values[static_cast<std::size_t>(diagonal_slots_[static_cast<std::size_t>(dof_[c])])] += mass_scale * mass_[c / 3];
   if (regularisation > 0) {
     for (long s : diagonal_slots_) mean_diagonal += values[static_cast<std::size_t>(s)];
     mean_diagonal /= static_cast<double>(diagonal_slots_.size());
@@ -122,15 +116,20 @@ void ImplicitIntegrator::assemble(const std::vector<Vec3>& x, double mass_scale,
   }
 }
 
+void ImplicitIntegrator::update_external(double t) {
+  for (std::size_t i = 0; i < mass_.size(); ++i) external_[i] = mass_[i] * bc_.gravity_m_s2 + bc_.nodal_force(i, t);
+}
+
 NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::vector<Vec3>& x_n,
                                         const std::vector<Vec3>& v_n) {
   NewtonReport rep;
   std::vector<double> r, dx(static_cast<std::size_t>(free_dofs_));
   double rn = residual(state.x, dynamic, x_n, v_n, r);
+  memory_accepted_.swap(memory_trial_);
   rep.initial_residual_n = rn;
   double ext = 0.0;
-  for (std::size_t i = 0; i < mass_.size(); ++i)
-    if (dof_[i] >= 0) ext += external_[i].squaredNorm();
+  for (std::size_t c = 0; c < dof_.size(); ++c)
+    if (dof_[c] >= 0) ext += external_[c / 3][c % 3] * external_[c / 3][c % 3];
   rep.force_scale_n = std::max(rn, std::sqrt(ext));
   const double dt = options_.dt_s;
   const double mass_scale = dynamic ? (1.0 + options_.mass_damping_per_s * dt) / (dt * dt) : 0.0;
@@ -151,14 +150,14 @@ NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::v
     double alpha = 1.0;
     for (int ls = 0; ls < 12; ++ls, alpha *= 0.5) {
       trial = state.x;
-      for (std::size_t i = 0; i < mass_.size(); ++i)
-        if (dof_[i] >= 0)
-          for (int k = 0; k < 3; ++k) trial[i][k] -= alpha * dx[static_cast<std::size_t>(dof_[i] + k)];
+      for (std::size_t c = 0; c < dof_.size(); ++c)
+        if (dof_[c] >= 0) trial[c / 3][c % 3] -= alpha * dx[static_cast<std::size_t>(dof_[c])];
       std::vector<double> r_trial;
       const double rt = residual(trial, dynamic, x_n, v_n, r_trial);
       if (rt < rn || ls == 11) {
         state.x.swap(trial);
         r.swap(r_trial);
+        memory_accepted_.swap(memory_trial_);
         rn = rt;
         break;
       }
@@ -177,8 +176,20 @@ NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::v
 NewtonReport ImplicitIntegrator::step(State& state) {
   const double dt = options_.dt_s;
   const std::vector<Vec3> x_n = state.x, v_n = state.v;
+  const std::size_t nm = model_.memory_size();
+  if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
+  if (nm > 0 && state.memory_time_s != state.time_s) {
+    // Memory must belong to the start of the step: bring it there at the current positions.
+    std::vector<Vec3> f(mass_.size(), Vec3::Zero());
+    std::vector<double> m(nm);
+    model_.add_forces(state.x, f, {state.memory, m, state.time_s - state.memory_time_s});
+    state.memory.swap(m);
+    state.memory_time_s = state.time_s;
+  }
+  memory_before_ = nm > 0 ? &state.memory : nullptr;
   for (std::size_t i = 0; i < mass_.size(); ++i) state.x[i] += dt * state.v[i];  // predictor
   apply_constraints(state, state.time_s + dt);
+  update_external(state.time_s + dt);
   NewtonReport rep = free_dofs_ > 0 ? newton(state, true, x_n, v_n) : NewtonReport{0, 0, 0, 0, 0, true, false};
   if (!rep.converged) {
     std::ostringstream msg;
@@ -187,15 +198,27 @@ NewtonReport ImplicitIntegrator::step(State& state) {
         << options_.relative_tolerance * rep.force_scale_n << " N)";
     state.x = x_n;
     state.v = v_n;
+    memory_before_ = nullptr;
     throw SimulationError(msg.str());
   }
   for (std::size_t i = 0; i < mass_.size(); ++i) state.v[i] = (state.x[i] - x_n[i]) / dt;
   state.time_s += dt;
+  if (memory_before_) {
+    if (free_dofs_ == 0) {  // no Newton ran: evaluate once at the constrained positions
+      std::vector<double> r;
+      residual(state.x, true, x_n, v_n, r);
+      memory_accepted_.swap(memory_trial_);
+    }
+    state.memory.swap(memory_accepted_);
+    state.memory_time_s = state.time_s;
+    memory_before_ = nullptr;
+  }
   return rep;
 }
 
 NewtonReport ImplicitIntegrator::solve_static(State& state) {
   apply_constraints(state, state.time_s);
+  update_external(state.time_s);
   NewtonReport rep = free_dofs_ > 0 ? newton(state, false, state.x, state.v) : NewtonReport{0, 0, 0, 0, 0, true, false};
   std::fill(state.v.begin(), state.v.end(), Vec3::Zero());
   if (!rep.converged) {

@@ -41,6 +41,7 @@ class ImplicitIntegrator {
   /// One backward Euler step of options.dt_s. Throws SimulationError if Newton fails to converge.
   NewtonReport step(State& state);
   /// Static equilibrium at time state.time_s (prescribed motions evaluated then); v is zeroed.
+  /// Memory variables are not used: the response is the instantaneous (unrelaxed) one.
   NewtonReport solve_static(State& state);
 
   const std::vector<double>& masses() const { return mass_; }
@@ -53,18 +54,21 @@ class ImplicitIntegrator {
                   const std::vector<Vec3>& v_n, std::vector<double>& r);
   void assemble(const std::vector<Vec3>& x, double mass_scale, double regularisation);
   void apply_constraints(State& state, double t);
+  void update_external(double t);
 
   const ForceModel& model_;
   BoundaryConditions bc_;
   ImplicitOptions options_;
   std::vector<double> mass_;
   std::vector<Vec3> external_;
-  std::vector<int> dof_;          // first free dof of each node, -1 if constrained
+  std::vector<int> dof_;          // dof of each coordinate (3 per node), -1 if constrained
   int free_dofs_ = 0;
   std::unique_ptr<SparseCholesky> solver_;
   std::vector<long> element_slots_;  // 144 per element: slot of (i, j) or -1
   std::vector<long> diagonal_slots_;
   std::vector<Vec3> force_;
+  const std::vector<double>* memory_before_ = nullptr;  // during a dynamic step
+  std::vector<double> memory_trial_, memory_accepted_;
 };
 
 }  // namespace viscera::tissue

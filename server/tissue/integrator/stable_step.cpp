@@ -27,7 +27,10 @@ StableStep critical_time_step(const ForceModel& model, std::span<const double> d
     }
   }
   const double omega = std::sqrt(worst);
-  return {2.0 / omega, omega, worst_element};
+  // Stiffness-proportional damping (Kelvin-Voigt, time tau) shortens the step of central
+  // differences to (2 / omega) (sqrt(1 + xi^2) - xi), xi = tau omega / 2 (Belytschko et al.).
+  const double xi = 0.5 * model.stiffness_damping_time_s() * omega;
+  return {2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi), omega, worst_element};
 }
 
 }  // namespace viscera::tissue

@@ -11,6 +11,16 @@
 
 namespace viscera::tissue {
 
+/// Memory variables (viscoelasticity) of a model live in State::memory, not in the model, so that
+/// models stay immutable and a state can be copied, rolled back or replayed. An evaluation
+/// advances them from `before` (at the previous evaluation) by dt_s to the positions x into
+/// `after` (which may be the same storage: each element reads its values before writing them).
+struct MemoryUpdate {
+  std::span<const double> before;
+  std::span<double> after;
+  double dt_s = 0.0;
+};
+
 /// By-product of one force evaluation: the largest absolute edge strain |L - L0| / L0 seen
 /// (NaN if any was NaN). The explicit integrator uses it to detect instability cheaply.
 struct ForceStats {
@@ -29,6 +39,22 @@ class ForceModel {
 
   /// f += internal forces [N] at positions x [m].
   virtual ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const = 0;
+
+  /// Models with memory variables: the number of doubles they keep in State::memory (0: none).
+  virtual std::size_t memory_size() const { return 0; }
+  /// f += forces at x with the memory advanced as described by `memory`. Models without memory
+  /// ignore it.
+  virtual ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
+    (void)memory;
+    return add_forces(x, f);
+  }
+  /// Tangent of the forces of a step of dt_s (memory variables make the stiffness depend on dt).
+  virtual Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const {
+    (void)dt_s;
+    return element_tangent(x, e);
+  }
+  /// Stiffness-proportional (Kelvin-Voigt) damping time [s], which shortens the explicit step.
+  virtual double stiffness_damping_time_s() const { return 0.0; }
 
   /// Elastic potential energy [J]. For the paper-form GPS (not conservative at finite strain)
   /// this is the energy of its energy-consistent sibling, 0.5 dL^T H dL.
