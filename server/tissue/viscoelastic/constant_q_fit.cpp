@@ -99,14 +99,17 @@ ConstantQFit fit_constant_q(const ConstantQTarget& t, const std::string& source)
   if (!(t.modulus_pa > 0) || !std::isfinite(t.modulus_pa)) bad("modulus_pa", t.modulus_pa, "must be positive");
   if (!(t.reference_frequency_hz > 0)) bad("reference_frequency_hz", t.reference_frequency_hz, "must be positive");
 
-  const int L = t.mechanisms;
+  const int L = t.fixed_frequencies_rad_s.empty() ? t.mechanisms : static_cast<int>(t.fixed_frequencies_rad_s.size());
+  const bool move = t.optimise_frequencies && t.fixed_frequencies_rad_s.empty();
   const double w1 = 2 * M_PI * t.band_low_hz, w2 = 2 * M_PI * t.band_high_hz;
   const std::vector<double> w = band_samples(w1, w2, kSamples);
 
   // Start: log-spaced frequencies, weights from the linearised least squares of
   // 1/Q ~ sum Y_l w_l w / (w_l^2 + w^2) at 2L-1 frequencies (SeisSol's fitAttenuation).
   Eigen::VectorXd p(2 * L);
-  for (int l = 0; l < L; ++l) p(l) = std::log(L == 1 ? std::sqrt(w1 * w2) : w1 * std::pow(w2 / w1, l / double(L - 1)));
+  for (int l = 0; l < L; ++l)
+    p(l) = !t.fixed_frequencies_rad_s.empty() ? std::log(t.fixed_frequencies_rad_s[static_cast<std::size_t>(l)])
+                                              : std::log(L == 1 ? std::sqrt(w1 * w2) : w1 * std::pow(w2 / w1, l / double(L - 1)));
   {
     const std::vector<double> wk = band_samples(w1, w2, 2 * L - 1);
     Eigen::MatrixXd A(static_cast<Eigen::Index>(wk.size()), L);
@@ -121,14 +124,14 @@ ConstantQFit fit_constant_q(const ConstantQTarget& t, const std::string& source)
   }
   // Least squares, then Lawson-type reweighting towards the minimax (equi-ripple) solution.
   Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(w.size()));
-  p = levenberg_marquardt(p, L, w, t.q, weights, t.optimise_frequencies, 200);
+  p = levenberg_marquardt(p, L, w, t.q, weights, move, 200);
   Eigen::VectorXd best = p;
   double best_err = residuals(p, L, w, t.q).cwiseAbs().maxCoeff();
   for (int round = 0; round < 40; ++round) {
     const Eigen::VectorXd r = residuals(p, L, w, t.q).cwiseAbs();
     weights = (weights.array() * (r.array() + 1e-3 * r.maxCoeff()).sqrt()).matrix();
     weights /= weights.maxCoeff();
-    p = levenberg_marquardt(p, L, w, t.q, weights, t.optimise_frequencies, 60);
+    p = levenberg_marquardt(p, L, w, t.q, weights, move, 60);
     const double err = residuals(p, L, w, t.q).cwiseAbs().maxCoeff();
     if (err < best_err) {
       best_err = err;

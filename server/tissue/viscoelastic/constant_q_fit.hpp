@@ -24,6 +24,9 @@ struct ConstantQTarget {
   double modulus_pa = 1e3;              ///< |M| at the reference frequency
   double reference_frequency_hz = 2.0;
   bool optimise_frequencies = true;     ///< false: log-spaced relaxation frequencies, weights only
+  /// If not empty: use these relaxation frequencies [rad/s] as they are and fit only the weights
+  /// (to give bulk and shear the same frequencies).
+  std::vector<double> fixed_frequencies_rad_s;
 };
 
 /// Throws InputError naming `source` and the field for Q <= 0, f1 >= f2, L outside 1..8, etc.

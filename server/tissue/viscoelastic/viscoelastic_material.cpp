@@ -1,0 +1,74 @@
+#include "viscoelastic/viscoelastic_material.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "common/input_error.hpp"
+#include "material/elasticity.hpp"
+
+namespace viscera::tissue {
+
+namespace {
+Mat6 volumetric_part(const Mat6& D) {
+  Vec6 m;
+  m << 1, 1, 1, 0, 0, 0;
+  return reuss_bulk_modulus(D) * m * m.transpose();
+}
+}  // namespace
+
+ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec, const std::string& source) {
+  if (!(spec.shear_q > 0) || !std::isfinite(spec.shear_q))
+    throw InputError(source, 0, "shear_q", std::to_string(spec.shear_q) + " must be a positive number");
+  if (spec.bulk_q && (!(*spec.bulk_q > 0) || !std::isfinite(*spec.bulk_q)))
+    throw InputError(source, 0, "bulk_q", std::to_string(*spec.bulk_q) + " must be a positive number (or absent)");
+  if (!(spec.qlv_stiffening >= 0) || !std::isfinite(spec.qlv_stiffening))
+    throw InputError(source, 0, "qlv_stiffening", std::to_string(spec.qlv_stiffening) + " must be >= 0");
+  if (!(spec.reference_frequency_hz > 0))
+    throw InputError(source, 0, "reference_frequency_hz", std::to_string(spec.reference_frequency_hz) + " must be positive");
+  ViscoelasticSetup out;
+  out.gps.qlv_stiffening = spec.qlv_stiffening;
+  const Mat6 D_vol = volumetric_part(D), D_dev = D - D_vol;
+  const double w_ref = 2 * M_PI * spec.reference_frequency_hz;
+  if (spec.model == ViscoelasticSpec::Model::kelvin_voigt) {
+    // One relaxation time tau with Q(w_ref) = 1 / (w_ref tau), and |M(w_ref)| kept: E_kv = |M| / sqrt(1 + 1/Q^2).
+    out.gps.kelvin_voigt_time_s = 1.0 / (spec.shear_q * w_ref);
+    out.unrelaxed_elasticity = D / std::sqrt(1.0 + 1.0 / (spec.shear_q * spec.shear_q));
+    std::ostringstream s;
+    s << "Kelvin-Voigt: relaxation time " << out.gps.kelvin_voigt_time_s << " s (Q = " << spec.shear_q
+      << " at " << spec.reference_frequency_hz << " Hz only; Q(f) = Q f_ref / f)\n";
+    out.table = s.str();
+    return out;
+  }
+  // Targets in the material's own moduli (shear modulus D_xy,xy; Reuss bulk modulus) so the table
+  // shows pascals; the factors M_U / |M(w_ref)| scale the deviatoric and volumetric parts of D.
+  ConstantQTarget shear{spec.shear_q, spec.band_low_hz, spec.band_high_hz, spec.mechanisms, D(5, 5), spec.reference_frequency_hz};
+  out.shear_fit = fit_constant_q(shear, source);
+  const double shear_factor = out.shear_fit.solids.unrelaxed_modulus_pa / D(5, 5);
+  out.gps.omega_rad_s = out.shear_fit.solids.omega_rad_s;
+  out.gps.shear_weight = out.shear_fit.solids.weight;
+  double bulk_factor = 1.0;
+  if (spec.bulk_q) {
+    ConstantQTarget bulk = shear;
+    bulk.q = *spec.bulk_q;
+    bulk.modulus_pa = reuss_bulk_modulus(D);
+    bulk.fixed_frequencies_rad_s = out.gps.omega_rad_s;
+    out.bulk_fit = fit_constant_q(bulk, source);
+    out.gps.bulk_weight = out.bulk_fit->solids.weight;
+    bulk_factor = out.bulk_fit->solids.unrelaxed_modulus_pa / bulk.modulus_pa;
+  } else {
+    out.gps.bulk_weight.assign(out.gps.omega_rad_s.size(), 0.0);
+  }
+  out.unrelaxed_elasticity = shear_factor * D_dev + bulk_factor * D_vol;
+  out.table = "shear: " + describe(out.shear_fit, shear);
+  if (out.bulk_fit) {
+    ConstantQTarget bulk = shear;
+    bulk.q = *spec.bulk_q;
+    bulk.modulus_pa = reuss_bulk_modulus(D);
+    out.table += "bulk (same relaxation frequencies): " + describe(*out.bulk_fit, bulk);
+  } else {
+    out.table += "bulk: elastic (no bulk relaxation)\n";
+  }
+  return out;
+}
+
+}  // namespace viscera::tissue

@@ -1,0 +1,25 @@
+#pragma once
+// Minimal line plots as SVG (no dependency): axes with ticks, labelled series, a legend.
+#include <string>
+#include <vector>
+
+namespace viscera::plot {
+
+struct Series {
+  std::string label;
+  std::vector<double> x, y;
+  std::string colour = "#1f77b4";
+  std::string dash;  ///< SVG stroke-dasharray, empty = solid
+  double width = 1.6;
+};
+
+struct Figure {
+  std::string title, x_label, y_label;
+  std::vector<Series> series;
+  int width_px = 900, height_px = 520;
+};
+
+/// Writes the figure; throws std::runtime_error naming the path if it cannot be written.
+void write_svg(const std::string& path, const Figure& figure);
+
+}  // namespace viscera::plot
