@@ -37,6 +37,13 @@ def main(path):
                 row.append(f"{ns[model]:.1f} ns ({b['tet_updates_per_s']/1e6:.1f} M/s)")
             ratio = ns["corotational"] / ns["gps"] if "gps" in ns and "corotational" in ns else float("nan")
             print(f"| {m} | {tets} | " + " | ".join(row) + f" | {ratio:.1f}x |")
+    print("\nViscoelastic step (3 memory variables) / elastic step, same mesh:")
+    print("| mesh | gps step | gps_visco3 step | ratio |")
+    print("|---|---|---|---|")
+    for m in meshes:
+        a, b = med.get(f"Step/gps/{m}"), med.get(f"Step/gps_visco3/{m}")
+        if a and b:
+            print(f"| {m} | {a['real_time']:.1f} us | {b['real_time']:.1f} us | {b['real_time']/a['real_time']:.2f}x |")
     print("\nMemory limit for the GPS force loop (296 bytes streamed per tet):")
     print("| working set | read bandwidth | limit ns/tet | gps ns/tet | gps / limit |")
     print("|---|---|---|---|---|")

@@ -17,6 +17,7 @@
 #include "mesh/mesh_reader.hpp"
 #include "mesh/vtu_writer.hpp"
 #include "model/model_factory.hpp"
+#include "viscoelastic/viscoelastic_material.hpp"
 
 using namespace viscera::tissue;
 namespace fs = std::filesystem;
@@ -121,7 +122,15 @@ int run(int argc, char** argv) {
     material.elasticity = elasticity_matrix(IsotropicElasticity{cl.number("youngs-modulus"), cl.number("poisson-ratio")}, "command line");
   }
   const double volume = cl.number_in("volume-term", 0.0, 0.999);
-  const auto model = make_force_model(cl.text("model"), mesh, {material.elasticity}, volume);
+  Mat6 elasticity = material.elasticity;
+  GpsViscoelasticity viscoelasticity;
+  if (material.viscoelasticity) {
+    const ViscoelasticSetup ve = make_viscoelastic(material.elasticity, *material.viscoelasticity, cl.text("material"));
+    std::printf("viscoelasticity\n%s", ve.table.c_str());
+    elasticity = ve.unrelaxed_elasticity;
+    viscoelasticity = ve.gps;
+  }
+  const auto model = make_force_model(cl.text("model"), mesh, {elasticity}, volume, viscoelasticity);
 
   BoundaryConditions bc;
   const auto g = cl.numbers("gravity", 3);

@@ -26,6 +26,7 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   with_volume_ = options_.volume_stiffness_fraction > 0.0;
   const GpsViscoelasticity& ve = options_.viscoelasticity;
   mechanisms_ = ve.omega_rad_s.size();
+  if (mechanisms_ > 8) throw std::invalid_argument("GpsModel: at most 8 relaxation mechanisms");
   if (ve.shear_weight.size() != mechanisms_ || (!ve.bulk_weight.empty() && ve.bulk_weight.size() != mechanisms_))
     throw std::invalid_argument("GpsModel: one shear (and bulk) weight per relaxation frequency expected");
   if (!(ve.kelvin_voigt_time_s >= 0) || !(ve.qlv_stiffening >= 0))
@@ -168,27 +169,43 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
           dL[k][j] = b.rest_length[k][j] * std::expm1(qlv * dL[k][j] * b.inv_rest_length[k][j]) / qlv;
     }
     double bulk_part[6][L];  // a_b - a_s, for bulk relaxation that differs from shear
-    if constexpr (kMemory) {
-      const double* in = memory->before.data() + bi * stride;
-      double* out = memory->after.data() + bi * stride;
+    double block_probe = 0.0;  // NaN if any elongation of the block is not finite
+    if constexpr (kMemory)
       for (int k = 0; k < 6; ++k)
+        for (int j = 0; j < L; ++j) block_probe += 0.0 * dL[k][j];
+    if constexpr (kMemory) {
+      // zeta_l <- e zeta_l + a dL_prev + c (dL - dL_prev): exact for dL linear over the step
+      // (dt = 0 gives e = 1, a = c = 0: the memory stays).
+      const double* in = memory->before.data() + bi * stride;
+      // A block with a non-finite elongation leaves its memory untouched (it is reported as an
+      // instability by the caller); its new values go to a local scratch instead.
+      double scratch[(1 + 8) * 6 * L];
+      double* out = block_probe == 0.0 ? memory->after.data() + bi * stride : scratch;
+      for (int k = 0; k < 6; ++k) {
+        double zs[L] = {}, zb[L] = {};
+        const double* prev = in + k * L;
+        for (std::size_t l = 0; l < nm; ++l) {
+          const double* zin = in + ((1 + l) * 6 + static_cast<std::size_t>(k)) * L;
+          double* zout = out + ((1 + l) * 6 + static_cast<std::size_t>(k)) * L;
+          const double e = me[l], a = ma[l], c = mc[l], y_s = ys[l], y_b = yb[l];
+#pragma omp simd
+          for (int j = 0; j < L; ++j) {
+            const double z = e * zin[j] + a * prev[j] + c * (dL[k][j] - prev[j]);
+            zout[j] = z;
+            zs[j] += y_s * z;
+            zb[j] += y_b * z;
+          }
+        }
+        double* prev_out = out + k * L;
 #pragma omp simd
         for (int j = 0; j < L; ++j) {
-          const double prev = in[k * L + j];
           const double dl = dL[k][j];
-          const double rate = (dl - prev) * rate_scale;  // Kelvin-Voigt: tau d(dL)/dt
-          double zs = 0.0, zb = 0.0;
-          for (std::size_t l = 0; l < nm; ++l) {
-            const std::size_t at = ((1 + l) * 6 + static_cast<std::size_t>(k)) * L + static_cast<std::size_t>(j);
-            const double z = dt > 0 ? me[l] * in[at] + ma[l] * prev + mc[l] * (dl - prev) : in[at];
-            out[at] = z;
-            zs += ys[l] * z;
-            zb += yb[l] * z;
-          }
-          out[k * L + j] = dl;
-          dL[k][j] = dl - zs + rate;  // a_s: the relaxed (shear) elongation
-          bulk_part[k][j] = zs - zb;  // a_b - a_s
+          const double rate = (dl - prev[j]) * rate_scale;  // Kelvin-Voigt: tau d(dL)/dt
+          prev_out[j] = dl;
+          dL[k][j] = dl - zs[j] + rate;  // a_s: the relaxed (shear) elongation
+          bulk_part[k][j] = zs[j] - zb[j];  // a_b - a_s
         }
+      }
     }
     // Tensions t = S H dL (H packed, symmetric).
     double t[6][L];

@@ -35,12 +35,13 @@ void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
 void ExplicitIntegrator::step_with(State& state, double dt) {
   const std::size_t n = mass_.size();
   for (std::size_t i = 0; i < n; ++i) force_[i] = gravity_[i] + bc_.nodal_force(i, state.time_s);
-  // Memory variables advance from their last evaluation to this one into a scratch buffer, which
-  // becomes the state's only if the step passes the instability check.
+  // Memory variables advance in place from their last evaluation to this one (a second buffer
+  // would cost a third memory stream; see docs/PERFORMANCE.md). If the step then fails the
+  // instability check, positions and velocities roll back but the memory stays advanced (the
+  // model never writes non-finite values into it).
   const std::size_t nm = model_.memory_size();
   if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
-  memory_scratch_.resize(nm);
-  const ForceStats stats = model_.add_forces(state.x, force_, {state.memory, memory_scratch_, state.time_s - state.memory_time_s});
+  const ForceStats stats = model_.add_forces(state.x, force_, {state.memory, state.memory, state.time_s - state.memory_time_s});
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
     std::ostringstream msg;
@@ -58,7 +59,6 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   x_prev_ = state.x;
   v_prev_ = state.v;
   t_prev_ = state.time_s;
-  state.memory.swap(memory_scratch_);
   state.memory_time_s = state.time_s;
   const double damping = std::exp(-options_.mass_damping_per_s * dt);
   for (std::size_t i = 0; i < n; ++i) {

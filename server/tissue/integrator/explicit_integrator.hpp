@@ -50,7 +50,6 @@ class ExplicitIntegrator {
   double dt_;
   std::vector<Vec3> force_, x_prev_, v_prev_;
   double t_prev_ = 0.0;
-  std::vector<double> memory_scratch_;
 };
 
 }  // namespace viscera::tissue

@@ -58,6 +58,46 @@ Material parse_material(const std::string& text, const std::string& source) {
   } else {
     throw InputError(source, 0, "elasticity.type", "'" + type + "' is not isotropic or transversely_isotropic");
   }
+  if (j.contains("viscoelasticity")) {
+    const json& v = j["viscoelasticity"];
+    if (!v.is_object()) throw InputError(source, 0, "viscoelasticity", "must be an object");
+    ViscoelasticSpec spec;
+    const std::string model = v.value("model", "constant_q");
+    if (model == "kelvin_voigt") spec.model = ViscoelasticSpec::Model::kelvin_voigt;
+    else if (model != "constant_q")
+      throw InputError(source, 0, "viscoelasticity.model", "'" + model + "' is not constant_q or kelvin_voigt");
+    spec.shear_q = number(v, "shear_q", source, "viscoelasticity.");
+    if (!(spec.shear_q > 0)) throw InputError(source, 0, "viscoelasticity.shear_q", v["shear_q"].dump() + " must be positive");
+    if (v.contains("bulk_q") && !v["bulk_q"].is_null()) {
+      spec.bulk_q = number(v, "bulk_q", source, "viscoelasticity.");
+      if (!(*spec.bulk_q > 0)) throw InputError(source, 0, "viscoelasticity.bulk_q", v["bulk_q"].dump() + " must be positive");
+    }
+    if (v.contains("band_hz")) {
+      const json& b = v["band_hz"];
+      if (!b.is_array() || b.size() != 2 || !b[0].is_number() || !b[1].is_number())
+        throw InputError(source, 0, "viscoelasticity.band_hz", "must be [low, high] in hertz");
+      spec.band_low_hz = b[0].get<double>();
+      spec.band_high_hz = b[1].get<double>();
+      if (!(spec.band_low_hz > 0 && spec.band_high_hz > spec.band_low_hz))
+        throw InputError(source, 0, "viscoelasticity.band_hz", b.dump() + " must satisfy 0 < low < high");
+    }
+    if (v.contains("mechanisms")) {
+      if (!v["mechanisms"].is_number_integer() || v["mechanisms"].get<int>() < 1 || v["mechanisms"].get<int>() > 8)
+        throw InputError(source, 0, "viscoelasticity.mechanisms", v["mechanisms"].dump() + " must be an integer from 1 to 8");
+      spec.mechanisms = v["mechanisms"].get<int>();
+    }
+    if (v.contains("reference_frequency_hz")) {
+      spec.reference_frequency_hz = number(v, "reference_frequency_hz", source, "viscoelasticity.");
+      if (!(spec.reference_frequency_hz > 0))
+        throw InputError(source, 0, "viscoelasticity.reference_frequency_hz", v["reference_frequency_hz"].dump() + " must be positive");
+    }
+    if (v.contains("qlv_stiffening")) {
+      spec.qlv_stiffening = number(v, "qlv_stiffening", source, "viscoelasticity.");
+      if (!(spec.qlv_stiffening >= 0))
+        throw InputError(source, 0, "viscoelasticity.qlv_stiffening", v["qlv_stiffening"].dump() + " must be >= 0");
+    }
+    m.viscoelasticity = spec;
+  }
   return m;
 }
 
