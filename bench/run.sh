@@ -7,5 +7,6 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 mkdir -p "$root/bench/results"
 "$root/build/bench/tissue_bench" --benchmark_repetitions="${REPETITIONS:-5}" \
   --benchmark_report_aggregates_only=true --benchmark_min_time="${MIN_TIME:-0.3}" \
+  --benchmark_enable_random_interleaving=true \
   --benchmark_out="$root/bench/results/tissue.json" --benchmark_out_format=json "$@"
 python3 "$root/bench/summarize.py" "$root/bench/results/tissue.json"

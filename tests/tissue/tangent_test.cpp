@@ -37,8 +37,12 @@ TEST(Tangent, MatchesFiniteDifferencesAtLargeDeformation) {
     const GpsModel energy(mesh, {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.0});
     const GpsModel volume(mesh, {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.6});
     const FiniteElementModel linear(mesh, FeKind::linear, {test::soft_tissue()});
+    GpsOptions qlv_options;
+    qlv_options.viscoelasticity.qlv_stiffening = 8.0;
+    const GpsModel qlv(mesh, {test::soft_tissue()}, {}, qlv_options);
     for (const ForceModel* m : {static_cast<const ForceModel*>(&paper), static_cast<const ForceModel*>(&energy),
-                                static_cast<const ForceModel*>(&volume), static_cast<const ForceModel*>(&linear)}) {
+                                static_cast<const ForceModel*>(&volume), static_cast<const ForceModel*>(&linear),
+                                static_cast<const ForceModel*>(&qlv)}) {
       const Mat12 K = m->element_tangent(x, 0);
       const Mat12 Kfd = finite_difference_tangent(*m, x, 1e-7);
       EXPECT_LT((K - Kfd).norm(), 1e-6 * K.norm()) << m->name();

@@ -56,6 +56,9 @@ int main(int argc, char** argv) {
   } catch (const viscera::cli::UsageError& e) {
     std::fprintf(stderr, "viscera-figure2: %s\n", e.what());
     return 2;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "viscera-figure2: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "viscera-figure2: %s\n", e.what());
     return 1;

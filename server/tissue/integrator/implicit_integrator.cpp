@@ -31,6 +31,10 @@ ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<doub
   for (std::size_t c = 0; c < 3 * n; ++c)
     if (!mask[c]) dof_[c] = free_dofs_++;
   force_.resize(n);
+  // Largest diagonal stiffness at rest: with the largest displacement it gives the size of the
+  // element forces, whose round-off bounds how small a residual can get.
+  for (std::size_t e = 0; e < model.element_count(); ++e)
+    stiffness_scale_ = std::max(stiffness_scale_, model.element_tangent(model.rest_mesh().nodes, e).diagonal().cwiseAbs().maxCoeff());
   if (free_dofs_ == 0) return;
 
   // Sparsity pattern of the upper triangle over free dofs: 3x3 blocks between nodes of a tet.
@@ -86,6 +90,10 @@ double ImplicitIntegrator::residual(const std::vector<Vec3>& x, bool dynamic, co
   const double dt = options_.dt_s;
   const double mass_scale = (1.0 + options_.mass_damping_per_s * dt) / (dt * dt);
   r.assign(static_cast<std::size_t>(free_dofs_), 0.0);
+  internal_norm_ = 0.0;
+  for (std::size_t c = 0; c < dof_.size(); ++c)
+    if (dof_[c] >= 0) internal_norm_ += force_[c / 3][c % 3] * force_[c / 3][c % 3];
+  internal_norm_ = std::sqrt(internal_norm_);
   for (std::size_t i = 0; i < mass_.size(); ++i) {
     Vec3 ri = -force_[i] - external_[i];
     if (dynamic) ri += mass_[i] * (mass_scale * (x[i] - x_n[i]) - v_n[i] / dt);
@@ -130,7 +138,12 @@ NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::v
   double ext = 0.0;
   for (std::size_t c = 0; c < dof_.size(); ++c)
     if (dof_[c] >= 0) ext += external_[c / 3][c % 3] * external_[c / 3][c % 3];
-  rep.force_scale_n = std::max(rn, std::sqrt(ext));
+  // Scale of the forces in play: residual, loads, and the internal forces (whose round-off sets
+  // the floor the residual can reach).
+  double displacement = 0.0;
+  for (std::size_t i = 0; i < state.x.size(); ++i)
+    displacement = std::max(displacement, (state.x[i] - model_.rest_mesh().nodes[i]).cwiseAbs().maxCoeff());
+  rep.force_scale_n = std::max({rn, std::sqrt(ext), internal_norm_, stiffness_scale_ * displacement});
   const double dt = options_.dt_s;
   const double mass_scale = dynamic ? (1.0 + options_.mass_damping_per_s * dt) / (dt * dt) : 0.0;
   std::vector<Vec3> trial;
@@ -162,8 +175,13 @@ NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::v
         break;
       }
     }
-    // Round-off floor: a full Newton step that no longer halves an already tiny residual.
-    if (!converged() && rn > 0.5 * rn_before && rn <= 1e-6 * rep.force_scale_n) {
+    // Round-off floor: a Newton step that no longer halves an already tiny residual, or one too
+    // small to change the positions' representation (the linear solve's accuracy is reached).
+    double step = 0.0, size = 0.0;
+    for (std::size_t c = 0; c < dof_.size(); ++c)
+      if (dof_[c] >= 0) step = std::max(step, std::abs(dx[static_cast<std::size_t>(dof_[c])]));
+    for (const Vec3& p : state.x) size = std::max(size, p.cwiseAbs().maxCoeff());
+    if (!converged() && rn <= 1e-6 * rep.force_scale_n && (rn > 0.5 * rn_before || step <= 1e-14 * size)) {
       rep.roundoff_limited = true;
       break;
     }

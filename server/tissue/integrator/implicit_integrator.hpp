@@ -26,7 +26,7 @@ struct NewtonReport {
   int iterations = 0;
   double initial_residual_n = 0.0;   ///< |r| before the first iteration [N]
   double residual_n = 0.0;           ///< |r| at the end [N]
-  double force_scale_n = 0.0;        ///< scale the tolerance is relative to [N]
+  double force_scale_n = 0.0;        ///< max(|r0|, |f_ext|, |f_int|, k_max |u|_max) [N]: the tolerance is relative to it
   int regularised_factorisations = 0;  ///< tangents that were not positive definite
   bool converged = false;
   bool roundoff_limited = false;  ///< stopped at the floating-point floor above the tolerance
@@ -69,6 +69,8 @@ class ImplicitIntegrator {
   std::vector<Vec3> force_;
   const std::vector<double>* memory_before_ = nullptr;  // during a dynamic step
   std::vector<double> memory_trial_, memory_accepted_;
+  double internal_norm_ = 0.0;
+  double stiffness_scale_ = 0.0;  // largest diagonal entry of the element tangents at rest [N/m]  // |f_int| over free dofs at the last residual evaluation
 };
 
 }  // namespace viscera::tissue

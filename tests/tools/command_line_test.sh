@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The programs' command lines: --help works, bad arguments and bad files give one clear line on
+# stderr and a non-zero exit. Usage: command_line_test.sh BUILD_DIR SOURCE_DIR
+set -u
+build="$1"; src="$2"
+sim="$build/tools/viscera-sim/viscera-sim"; fig="$build/tools/viscera-figure2/viscera-figure2"
+tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
+failures=0; passed=0
+expect() {  # expect NAME EXIT_CODE PATTERN -- command...
+  local name="$1" code="$2" pattern="$3"; shift 4
+  "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
+  local lines; lines=$(wc -l <"$tmp/err")
+  if [ "$rc" -ne "$code" ] || ! grep -q -- "$pattern" "$tmp/err" "$tmp/out" || { [ "$code" -ne 0 ] && [ "$lines" -ne 1 ]; }; then
+    echo "FAIL $name: exit $rc (want $code), stderr:"; cat "$tmp/err"; failures=$((failures+1))
+  else
+    passed=$((passed+1))
+  fi
+}
+printf '$NOD\n1\n1 0 0 0\n$ENDNOD\n$ELM\n1\n1 4 1 1 4 1 1 1 2\n$ENDELM\n' >"$tmp/bad.msh"
+echo '{"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.7}}' >"$tmp/bad.json"
+expect sim-help 0 "Usage: viscera-sim" -- "$sim" --help
+expect fig-help 0 "Usage: viscera-figure2" -- "$fig" --help
+expect sim-unknown 2 "unknown option --frobnicate" -- "$sim" --frobnicate 3
+expect sim-missing-mesh 2 "mesh is required" -- "$sim"
+expect sim-no-file 2 "nowhere.msh: cannot open file" -- "$sim" --mesh "$tmp/nowhere.msh"
+expect sim-bad-mesh 2 "bad.msh" -- "$sim" --mesh "$tmp/bad.msh"
+expect sim-bad-number 2 "'abc' is not a finite number" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale abc
+expect sim-bad-material 2 "bad.json: poisson_ratio: 0.7" -- "$sim" --mesh "$src/data/meshes/liver.msh" --material "$tmp/bad.json"
+expect sim-bad-model 2 "'fem' is not one of" -- "$sim" --mesh "$src/data/meshes/liver.msh" --model fem
+expect sim-bad-slab 2 "fix-slab: axis 'w'" -- "$sim" --mesh "$src/data/meshes/liver.msh" --fix-slab w,max,0.1
+expect sim-runs 0 "wrote" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale 0.035 --fix-slab z,max,0.2 --duration 0.05 --out "$tmp/frames"
+expect fig-bad-mechanisms 2 "mechanisms" -- "$fig" --mechanisms 9 --csv "$tmp/f.csv" --svg "$tmp/f.svg"
+echo "command_line_test: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]
