@@ -1,0 +1,181 @@
+#include "analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <future>
+#include <sstream>
+
+#include "common/input_error.hpp"
+#include "fit.hpp"
+
+namespace viscera::lab {
+
+namespace {
+
+// Acceptance: a mechanism must lower the held-out mean square error by more than kNoiseFraction
+// of the noise variance, and the held-out RMS by at least kMinGain relatively.
+constexpr double kNoiseFraction = 0.5;
+constexpr double kMinGain = 0.05;
+
+double rms(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x * x;
+  return std::sqrt(s / static_cast<double>(std::max<std::size_t>(v.size(), 1)));
+}
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+// Residual signatures of a fitted model (data - model), the evidence behind each mechanism.
+std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) {
+  double hold_drift = 0, hold_n = 0, big = 0, big_n = 0, mid = 0, mid_n = 0, comp = 0, comp_n = 0, tens = 0, tens_n = 0;
+  double virgin = 0, virgin_n = 0, reload = 0, reload_n = 0;
+  double max_strain = 0;
+  for (const auto& t : d.tests)
+    for (double e : t.strain) max_strain = std::max(max_strain, std::abs(e));
+  for (const auto& t : d.tests) {
+    const auto y = predict_stress(model, t);
+    double peak_t = 0, peak_c = 0;
+    for (std::size_t k = 0; k < y.size(); ++k) {
+      const double r = t.stress_pa[k] - y[k], e = t.strain[k];
+      if (k > 1 && std::abs(e - t.strain[k - 1]) < 1e-4 * max_strain && std::abs(t.strain[k - 1] - t.strain[k - 2]) < 1e-4 * max_strain) {
+        hold_drift += r - (t.stress_pa[k - 1] - y[k - 1]);
+        ++hold_n;
+      }
+      if (std::abs(e) > 0.7 * max_strain) big += r, ++big_n;
+      else if (std::abs(e) > 0.2 * max_strain) mid += r, ++mid_n;
+      if (e < -0.05 * max_strain) comp += r * (e < 0 ? -1 : 1), ++comp_n;
+      if (e > 0.05 * max_strain) tens += r, ++tens_n;
+      const double peak = e >= 0 ? peak_t : peak_c;
+      if (std::abs(e) > 0.3 * max_strain) {
+        if (std::abs(e) >= peak) virgin += r * (e >= 0 ? 1 : -1), ++virgin_n;
+        else reload += r * (e >= 0 ? 1 : -1), ++reload_n;
+      }
+      if (e >= 0) peak_t = std::max(peak_t, e);
+      else peak_c = std::max(peak_c, -e);
+    }
+  }
+  const auto mean = [](double s, double n) { return n > 0 ? s / n : 0.0; };
+  switch (m) {
+    case Mechanism::broadband_relaxation:
+      return fmt("during holds the measured stress keeps changing against the model: mean drift %.3g Pa per sample over %.0f hold samples", mean(hold_drift, hold_n), hold_n);
+    case Mechanism::strain_stiffening:
+      return fmt("secant stiffness grows with strain: mean residual %.3g Pa above 70%% of the largest strain, %.3g Pa at 20-70%%", mean(big, big_n), mean(mid, mid_n));
+    case Mechanism::tension_compression_asymmetry:
+      return fmt("tension and compression differ: mean residual %.3g Pa in tension, %.3g Pa (sign-corrected) in compression", mean(tens, tens_n), mean(comp, comp_n));
+    case Mechanism::first_load_softening:
+      return fmt("first loading stiffer than reloading: mean residual %.3g Pa on virgin loading, %.3g Pa on reloading", mean(virgin, virgin_n), mean(reload, reload_n));
+  }
+  return "";
+}
+
+double rms_over_tests(const std::vector<TestFigures>& t, double TestFigures::*f) {
+  double s = 0;
+  for (const auto& x : t) s += (x.*f) * (x.*f);
+  return std::sqrt(s / static_cast<double>(t.size()));
+}
+
+}  // namespace
+
+double noise_level_pa(const TestData& t) {
+  if (!t.stress_sd_pa.empty()) return rms(t.stress_sd_pa);
+  std::vector<double> d2;
+  for (std::size_t k = 2; k < t.stress_pa.size(); ++k) d2.push_back(std::abs(t.stress_pa[k] - 2 * t.stress_pa[k - 1] + t.stress_pa[k - 2]));
+  if (d2.empty()) return 0.0;
+  std::nth_element(d2.begin(), d2.begin() + static_cast<long>(d2.size() / 2), d2.end());
+  return d2[d2.size() / 2] / 0.6745 / std::sqrt(6.0);
+}
+
+ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d) {
+  if (d.tests.size() < 2)
+    throw tissue::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
+  ModelEvaluation ev;
+  std::vector<const TestData*> all;
+  for (const auto& t : d.tests) all.push_back(&t);
+  // The full fit and the leave-one-out fits are independent: use both cores.
+  auto full = std::async(std::launch::async, [&] { return fit_model(structure, all); });
+  std::vector<double> heldout(d.tests.size());
+  for (std::size_t k = 0; k < d.tests.size(); ++k) {
+    std::vector<const TestData*> others;
+    for (std::size_t j = 0; j < d.tests.size(); ++j)
+      if (j != k) others.push_back(&d.tests[j]);
+    heldout[k] = rms_error_pa(fit_model(structure, others), d.tests[k]);
+  }
+  ev.model = full.get();
+  for (std::size_t k = 0; k < d.tests.size(); ++k)
+    ev.tests.push_back({d.tests[k].file, rms_error_pa(ev.model, d.tests[k]), heldout[k], noise_level_pa(d.tests[k])});
+  ev.fit_rms_pa = rms_over_tests(ev.tests, &TestFigures::fit_rms_pa);
+  ev.heldout_rms_pa = rms_over_tests(ev.tests, &TestFigures::heldout_rms_pa);
+  return ev;
+}
+
+Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress) {
+  const auto say = [&](const std::string& s) {
+    if (progress) progress(s);
+  };
+  Analysis a;
+  a.dataset = d.name;
+  double n2 = 0;
+  for (const auto& t : d.tests) n2 += noise_level_pa(t) * noise_level_pa(t);
+  a.noise_pa = std::sqrt(n2 / static_cast<double>(d.tests.size()));
+  MaterialModel structure;
+  structure.relaxation_time_s = relaxation_times_for(d);
+  say("fitting the baseline (linear elastic + Kelvin-Voigt) to " + std::to_string(d.tests.size()) + " tests, leaving each out in turn");
+  a.baseline = evaluate(structure, d);
+  say(fmt("baseline: fit RMS %.4g Pa, held-out RMS %.4g Pa, noise %.4g Pa", a.baseline.fit_rms_pa, a.baseline.heldout_rms_pa, a.noise_pa));
+  ModelEvaluation current = a.baseline;
+  std::vector<Mechanism> remaining(kMechanisms.begin(), kMechanisms.end());
+  for (int round = 1; !remaining.empty(); ++round) {
+    const Mechanism* best = nullptr;
+    ModelEvaluation best_eval;
+    double best_gain = 0.0;
+    for (const Mechanism& m : remaining) {
+      MaterialModel s = current.model;
+      s.mechanisms |= 1u << static_cast<unsigned>(m);
+      say(std::string("round ") + std::to_string(round) + ": trying " + name(m));
+      const ModelEvaluation ev = evaluate(s, d);
+      Candidate c{m, round, current.heldout_rms_pa, ev.heldout_rms_pa, false, evidence(m, current.model, d)};
+      const double reduction = current.heldout_rms_pa * current.heldout_rms_pa - ev.heldout_rms_pa * ev.heldout_rms_pa;
+      const bool above_noise = reduction > kNoiseFraction * a.noise_pa * a.noise_pa &&
+                               ev.heldout_rms_pa < (1.0 - kMinGain) * current.heldout_rms_pa;
+      say(fmt("  held-out RMS %.4g -> %.4g Pa (noise %.4g Pa)", current.heldout_rms_pa, ev.heldout_rms_pa, a.noise_pa) +
+          (above_noise ? ": gain above noise" : ": no gain above noise"));
+      if (above_noise && reduction > best_gain) {
+        best_gain = reduction;
+        best = &m;
+        best_eval = ev;
+      }
+      a.candidates.push_back(c);
+    }
+    if (!best) break;
+    for (auto& c : a.candidates)
+      if (c.round == round && c.mechanism == *best) c.accepted = true;
+    a.causes.push_back(*best);
+    say(std::string("accepted ") + name(*best));
+    current = best_eval;
+    remaining.erase(std::find(remaining.begin(), remaining.end(), *best));
+  }
+  a.final = current;
+  a.gain = a.baseline.heldout_rms_pa / a.final.heldout_rms_pa;
+  std::ostringstream v;
+  if (a.causes.empty()) {
+    v << "The baseline (linear elasticity with Kelvin-Voigt damping) explains the data: no candidate mechanism lowers "
+         "the held-out error by more than the noise allows.";
+  } else {
+    v << "The baseline misses: ";
+    for (std::size_t k = 0; k < a.causes.size(); ++k) v << (k ? ", " : "") << name(a.causes[k]);
+    v << ". Adding them lowers the held-out RMS error from " << a.baseline.heldout_rms_pa << " Pa to "
+      << a.final.heldout_rms_pa << " Pa (gain " << a.gain << "x; noise " << a.noise_pa << " Pa).";
+  }
+  const double excess = a.final.heldout_rms_pa / std::max(a.noise_pa, 1e-300);
+  if (excess > 2.0)
+    v << " The final model is still " << excess << "x the noise on held-out tests: something the candidate mechanisms do not describe remains.";
+  a.verdict = v.str();
+  return a;
+}
+
+}  // namespace viscera::lab

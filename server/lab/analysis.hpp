@@ -1,0 +1,54 @@
+#pragma once
+// viscera-lab's method (MODEL.md section 4): fit the baseline, show where it is wrong (per test,
+// on held-out tests), name the cause from candidate mechanisms whose held-out gain is clearly
+// above the noise of the data, extend the model, refit and measure the gain on held-out tests.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dataset.hpp"
+#include "material_model.hpp"
+
+namespace viscera::lab {
+
+struct TestFigures {
+  std::string file;
+  double fit_rms_pa = 0.0;      ///< model fitted to all tests
+  double heldout_rms_pa = 0.0;  ///< model fitted to the other tests (leave one test out)
+  double noise_pa = 0.0;
+};
+
+struct ModelEvaluation {
+  MaterialModel model;  ///< fitted to all tests
+  std::vector<TestFigures> tests;
+  double fit_rms_pa = 0.0, heldout_rms_pa = 0.0;  ///< root mean square over tests
+};
+
+struct Candidate {
+  Mechanism mechanism;
+  int round = 0;                 ///< 1: tried on the baseline; 2..: on the extended model
+  double heldout_before_pa = 0.0, heldout_after_pa = 0.0;
+  bool accepted = false;
+  std::string evidence;          ///< the residual signature that points at it
+};
+
+struct Analysis {
+  std::string dataset;
+  double noise_pa = 0.0;
+  ModelEvaluation baseline, final;
+  std::vector<Candidate> candidates;
+  std::vector<Mechanism> causes;  ///< accepted, strongest first
+  double gain = 1.0;              ///< baseline held-out RMS / final held-out RMS
+  std::string verdict;            ///< one paragraph: what is wrong, why, what still does not fit
+};
+
+/// Noise of one test [Pa]: RMS of stress_sd_pa if given, else from second differences (MAD).
+double noise_level_pa(const TestData& t);
+
+/// Fits `structure` to all tests and, for every test, to the others (held-out prediction).
+ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d);
+
+/// The whole analysis; `progress` receives one line per stage.
+Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace viscera::lab

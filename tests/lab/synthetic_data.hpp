@@ -1,0 +1,26 @@
+#pragma once
+// Synthetic data sets with one hidden effect (or none), chosen by a seed, for testing viscera-lab.
+// The truth is computed on a different code path from the lab's: closed-form hereditary integrals
+// of piecewise-linear strain histories (strain control), and a finely integrated ODE (stress
+// control, RK4 at 1/200 of the sampling interval). The lab only ever sees the written folder.
+#include <string>
+
+#include "dataset.hpp"
+
+namespace viscera::lab::test {
+
+enum class Effect { none, broadband_relaxation, strain_stiffening, tension_compression_asymmetry, first_load_softening };
+const char* effect_name(Effect e);
+
+struct Truth {
+  Effect effect = Effect::none;
+  double modulus_pa = 0, tau_s = 0;          // Kelvin-Voigt baseline: sigma = E (s + tau ds/dt)
+  double spectrum_pa[2] = {0, 0}, spectrum_tau_s[2] = {1, 1};  // broadband: two off-grid relaxations
+  double stiffening_b = 0, compression_ratio = 1, softening_d = 0;
+  double noise_pa = 0;
+};
+
+/// Writes the data set for `seed` into `folder` and returns its truth (for messages only).
+Truth write_synthetic_dataset(unsigned seed, const std::string& folder);
+
+}  // namespace viscera::lab::test

@@ -1,0 +1,91 @@
+// viscera-lab: confronts viscera's tissue model with measured data.
+//   viscera-lab analyze DATASET_DIR --out OUT_DIR
+//   viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "analysis.hpp"
+#include "common/input_error.hpp"
+#include "model_file.hpp"
+#include "report.hpp"
+
+using namespace viscera::lab;
+
+namespace {
+const char* kHelp =
+    "Usage: viscera-lab analyze DATASET_DIR --out OUT_DIR\n"
+    "       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR\n\n"
+    "analyze: fits the baseline (linear elasticity + Kelvin-Voigt damping) to the data set, shows where it is wrong\n"
+    "  (per test, and on tests left out of the fit), names the cause among broadband_relaxation, strain_stiffening,\n"
+    "  tension_compression_asymmetry and first_load_softening (accepted only if the held-out gain is clearly above the\n"
+    "  noise of the data), extends the model, refits, and writes OUT_DIR/report.json, report.md (with SVG plots) and\n"
+    "  model.json.\n"
+    "predict: runs a fitted model.json on another data set and writes OUT_DIR/report.json with per-test RMS errors.\n\n"
+    "Data set format: README.md, section \"The data a user brings\". Units are SI.\n\n"
+    "Options:\n  --out DIR   output folder (required)\n  --quiet     no progress lines\n  --help      this text\n";
+
+int usage_error(const std::string& what) {
+  std::fprintf(stderr, "viscera-lab: %s (see --help)\n", what.c_str());
+  return 2;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> positional;
+  std::string out;
+  bool quiet = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    } else if (a == "--out") {
+      if (i + 1 >= argc) return usage_error("--out needs a folder");
+      out = argv[++i];
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (a.starts_with("--")) {
+      return usage_error("unknown option " + a);
+    } else {
+      positional.push_back(a);
+    }
+  }
+  if (positional.empty()) return usage_error("missing command (analyze or predict)");
+  if (out.empty()) return usage_error("--out OUT_DIR is required");
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (positional[0] == "analyze") {
+      if (positional.size() != 2) return usage_error("analyze takes one DATASET_DIR");
+      const Dataset d = read_dataset(positional[1]);
+      if (!quiet) std::fprintf(stderr, "viscera-lab: %s: %zu tests, %s\n", d.name.c_str(), d.tests.size(), to_string(d.mode));
+      const Analysis a = analyze(d, [&](const std::string& s) {
+        if (!quiet) {
+          const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          std::fprintf(stderr, "[%6.1f s] %s\n", el, s.c_str());
+        }
+      });
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      write_report(a, d, out, seconds);
+      std::printf("%s\n", a.verdict.c_str());
+      std::printf("causes:");
+      for (Mechanism m : a.causes) std::printf(" %s", name(m));
+      std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
+                  a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
+      return 0;
+    }
+    if (positional[0] == "predict") {
+      if (positional.size() != 3) return usage_error("predict takes MODEL_JSON and DATASET_DIR");
+      const MaterialModel m = read_model(positional[1]);
+      const Dataset d = read_dataset(positional[2]);
+      write_prediction(m, positional[1], d, out);
+      std::printf("wrote %s/report.json\n", out.c_str());
+      return 0;
+    }
+    return usage_error("unknown command '" + positional[0] + "'");
+  } catch (const viscera::tissue::InputError& e) {
+    std::fprintf(stderr, "viscera-lab: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,113 @@
+#include "report.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common/svg_plot.hpp"
+#include "fit.hpp"
+#include "model_file.hpp"
+
+namespace viscera::lab {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+json figures(const ModelEvaluation& e) {
+  json j;
+  j["model"] = e.model.describe();
+  j["fit_rms_pa"] = e.fit_rms_pa;
+  j["heldout_rms_pa"] = e.heldout_rms_pa;
+  j["parameters"] = e.model.parameter_count();
+  j["tests"] = json::array();
+  for (const auto& t : e.tests)
+    j["tests"].push_back({{"file", t.file}, {"fit_rms_pa", t.fit_rms_pa}, {"heldout_rms_pa", t.heldout_rms_pa}, {"noise_pa", t.noise_pa}});
+  return j;
+}
+
+std::string stem(const std::string& file) { return fs::path(file).stem().string(); }
+
+}  // namespace
+
+void write_report(const Analysis& a, const Dataset& d, const std::string& out_dir, double seconds) {
+  fs::create_directories(out_dir);
+  json j;
+  j["dataset"] = a.dataset;
+  j["mode"] = to_string(d.mode);
+  j["noise_pa"] = a.noise_pa;
+  j["baseline"] = figures(a.baseline);
+  j["final"] = figures(a.final);
+  j["causes"] = json::array();
+  for (Mechanism m : a.causes) j["causes"].push_back(name(m));
+  j["gain"] = a.gain;
+  j["candidates"] = json::array();
+  for (const auto& c : a.candidates)
+    j["candidates"].push_back({{"mechanism", name(c.mechanism)}, {"round", c.round}, {"heldout_rms_before_pa", c.heldout_before_pa},
+                               {"heldout_rms_after_pa", c.heldout_after_pa}, {"accepted", c.accepted}, {"evidence", c.evidence}});
+  j["verdict"] = a.verdict;
+  j["seconds"] = seconds;
+  std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
+  write_model((fs::path(out_dir) / "model.json").string(), a.final.model, a.dataset);
+
+  std::ofstream md(fs::path(out_dir) / "report.md");
+  md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
+  md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences): " << a.noise_pa << " Pa. "
+     << "Analysis time: " << seconds << " s.\n\n";
+  md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out |\n|---|---|---|---|---|---|\n";
+  for (std::size_t k = 0; k < a.baseline.tests.size(); ++k)
+    md << "| " << a.baseline.tests[k].file << " | " << a.baseline.tests[k].noise_pa << " | " << a.baseline.tests[k].fit_rms_pa << " | "
+       << a.baseline.tests[k].heldout_rms_pa << " | " << a.final.tests[k].fit_rms_pa << " | " << a.final.tests[k].heldout_rms_pa << " |\n";
+  md << "| **all (RMS over tests)** | " << a.noise_pa << " | " << a.baseline.fit_rms_pa << " | " << a.baseline.heldout_rms_pa << " | "
+     << a.final.fit_rms_pa << " | " << a.final.heldout_rms_pa << " |\n\n";
+  md << "Held-out: the model is fitted to the other tests only and predicts this one.\n\n";
+  md << "## Candidate mechanisms\n\n| round | mechanism | held-out RMS before | after | accepted | evidence in the residuals |\n|---|---|---|---|---|---|\n";
+  for (const auto& c : a.candidates)
+    md << "| " << c.round << " | " << name(c.mechanism) << " | " << c.heldout_before_pa << " | " << c.heldout_after_pa << " | "
+       << (c.accepted ? "yes" : "no") << " | " << c.evidence << " |\n";
+  md << "\nA mechanism is accepted when it lowers the held-out mean square error by more than half the noise variance and the "
+        "held-out RMS by at least 5%; rounds add the best accepted mechanism and try the rest on top.\n\n";
+  md << "## Models\n\n- baseline: `" << a.baseline.model.describe() << "`, E = " << a.baseline.model.modulus_pa << " Pa, eta = "
+     << a.baseline.model.viscosity_pa_s << " Pa s\n- final: `" << a.final.model.describe() << "` (parameters in `model.json`)\n\n";
+  md << "## Data, baseline and final model\n\n";
+  for (std::size_t k = 0; k < d.tests.size(); ++k) {
+    const TestData& t = d.tests[k];
+    const auto yb = predict_stress(a.baseline.model, t), yf = predict_stress(a.final.model, t);
+    std::vector<double> rb, rf;
+    for (std::size_t i = 0; i < yb.size(); ++i) {
+      rb.push_back(t.stress_pa[i] - yb[i]);
+      rf.push_back(t.stress_pa[i] - yf[i]);
+    }
+    const std::string name_fit = stem(t.file) + "_fit.svg", name_res = stem(t.file) + "_residual.svg";
+    plot::write_svg((fs::path(out_dir) / name_fit).string(),
+                    {t.file + ": stress, data and models (fitted to all tests)", "time [s]", "stress [Pa]",
+                     {{"data", t.time_s, t.stress_pa, "#000000", "", 2.0},
+                      {"baseline " + a.baseline.model.describe(), t.time_s, yb, "#1f77b4", "8 4", 1.6},
+                      {"final " + a.final.model.describe(), t.time_s, yf, "#d62728", "", 1.6}}});
+    plot::write_svg((fs::path(out_dir) / name_res).string(),
+                    {t.file + ": residual (data - model)", "time [s]", "residual [Pa]",
+                     {{"baseline", t.time_s, rb, "#1f77b4", "8 4", 1.6}, {"final", t.time_s, rf, "#d62728", "", 1.6}}});
+    md << "### " << t.file << " (" << to_string(t.control) << " control)\n\n![" << t.file << "](" << name_fit << ")\n\n![residual](" << name_res << ")\n\n";
+  }
+}
+
+void write_prediction(const MaterialModel& m, const std::string& model_path, const Dataset& d, const std::string& out_dir) {
+  fs::create_directories(out_dir);
+  json j;
+  j["model"] = m.describe();
+  j["model_file"] = model_path;
+  j["dataset"] = d.name;
+  j["tests"] = json::array();
+  double s = 0;
+  for (const auto& t : d.tests) {
+    const double r = rms_error_pa(m, t);
+    s += r * r;
+    j["tests"].push_back({{"file", t.file}, {"rms_pa", r}});
+  }
+  j["rms_pa"] = std::sqrt(s / static_cast<double>(d.tests.size()));
+  std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
+}
+
+}  // namespace viscera::lab
