@@ -13,6 +13,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools   # DDS C API, idlc, ddsperf
   libflatbuffers-dev flatbuffers-compiler  # wire schemas, flatc
   nlohmann-json3-dev       # JSON for scene, material and data-set files
+  python3                  # bench summary and test scripts that read JSON
   libpugixml-dev           # XML parsing of VTU meshes
 )
 

@@ -34,7 +34,7 @@ std::string MaterialModel::describe() const {
 }
 
 int MaterialModel::parameter_count() const {
-  int n = 2 + static_cast<int>(relaxation_time_s.size());
+  int n = 2 + (has(Mechanism::broadband_relaxation) ? static_cast<int>(relaxation_time_s.size()) : 0);
   for (Mechanism m : kMechanisms)
     if (has(m) && m != Mechanism::broadband_relaxation) ++n;
   return n;

@@ -3,7 +3,7 @@
 # stderr and a non-zero exit. Usage: command_line_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
-sim="$build/tools/viscera-sim/viscera-sim"; fig="$build/tools/viscera-figure2/viscera-figure2"
+sim="$build/tools/viscera-sim/viscera-sim"; fig="$build/tools/viscera-figure2/viscera-figure2"; lab="$build/tools/viscera-lab/viscera-lab"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
 failures=0; passed=0
 expect() {  # expect NAME EXIT_CODE PATTERN -- command...
@@ -30,5 +30,16 @@ expect sim-bad-model 2 "'fem' is not one of" -- "$sim" --mesh "$src/data/meshes/
 expect sim-bad-slab 2 "fix-slab: axis 'w'" -- "$sim" --mesh "$src/data/meshes/liver.msh" --fix-slab w,max,0.1
 expect sim-runs 0 "wrote" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale 0.035 --fix-slab z,max,0.2 --duration 0.05 --out "$tmp/frames"
 expect fig-bad-mechanisms 2 "mechanisms" -- "$fig" --mechanisms 9 --csv "$tmp/f.csv" --svg "$tmp/f.svg"
+expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
+expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
+expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"
+expect lab-no-dataset 2 "nowhere/dataset.json: cannot open file" -- "$lab" analyze "$tmp/nowhere" --out "$tmp/o"
+expect lab-analyze 0 "causes: broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet
+expect lab-predict 0 "wrote" -- "$lab" predict "$tmp/titin/model.json" "$src/data/titin-passive-muscle" --out "$tmp/predicted"
+grep -q '"rms_pa"' "$tmp/predicted/report.json" || { echo "FAIL lab-predict: no rms_pa"; failures=$((failures+1)); }
+for key in baseline.model baseline.heldout_rms_pa causes final.model final.heldout_rms_pa gain; do
+  python3 -c "import json,sys; r=json.load(open('$tmp/titin/report.json')); v=r
+for k in '$key'.split('.'): v=v[k]" || { echo "FAIL report.json lacks $key"; failures=$((failures+1)); }
+done
 echo "command_line_test: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

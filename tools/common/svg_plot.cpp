@@ -30,7 +30,20 @@ std::string escape(const std::string& s) {
 }
 }  // namespace
 
-void write_svg(const std::string& path, const Figure& f) {
+void write_svg(const std::string& path, const Figure& input) {
+  Figure f = input;
+  if (f.log_x)
+    for (auto& s : f.series) {
+      Series kept = s;
+      kept.x.clear();
+      kept.y.clear();
+      for (std::size_t k = 0; k < s.x.size(); ++k)
+        if (s.x[k] > 0) {
+          kept.x.push_back(std::log10(s.x[k]));
+          kept.y.push_back(s.y[k]);
+        }
+      s = kept;
+    }
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
   for (const auto& s : f.series)
     for (std::size_t k = 0; k < s.x.size(); ++k) {
@@ -53,10 +66,10 @@ void write_svg(const std::string& path, const Figure& f) {
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << f.width_px << "\" height=\"" << f.height_px
     << "\" font-family=\"sans-serif\" font-size=\"13\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   o << "<text x=\"" << f.width_px / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << escape(f.title) << "</text>\n";
-  const double xs = tick_step(x1 - x0), ys = tick_step(y1 - y0);
+  const double xs = f.log_x ? 1.0 : tick_step(x1 - x0), ys = tick_step(y1 - y0);
   for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs)
     o << "<line x1=\"" << px(x) << "\" y1=\"" << T << "\" x2=\"" << px(x) << "\" y2=\"" << T + H
-      << "\" stroke=\"#e5e5e5\"/><text x=\"" << px(x) << "\" y=\"" << T + H + 18 << "\" text-anchor=\"middle\">" << fmt(x) << "</text>\n";
+      << "\" stroke=\"#e5e5e5\"/><text x=\"" << px(x) << "\" y=\"" << T + H + 18 << "\" text-anchor=\"middle\">" << fmt(f.log_x ? std::pow(10.0, x) : x) << "</text>\n";
   for (double y = std::ceil(y0 / ys) * ys; y <= y1 + 1e-9 * ys; y += ys)
     o << "<line x1=\"" << L << "\" y1=\"" << py(y) << "\" x2=\"" << L + W << "\" y2=\"" << py(y)
       << "\" stroke=\"#e5e5e5\"/><text x=\"" << L - 6 << "\" y=\"" << py(y) + 4 << "\" text-anchor=\"end\">" << fmt(y) << "</text>\n";

@@ -17,6 +17,7 @@ struct Figure {
   std::string title, x_label, y_label;
   std::vector<Series> series;
   int width_px = 900, height_px = 520;
+  bool log_x = false;  ///< logarithmic x axis (points with x <= 0 are dropped)
 };
 
 /// Writes the figure; throws std::runtime_error naming the path if it cannot be written.

@@ -81,14 +81,21 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
       rf.push_back(t.stress_pa[i] - yf[i]);
     }
     const std::string name_fit = stem(t.file) + "_fit.svg", name_res = stem(t.file) + "_residual.svg";
-    plot::write_svg((fs::path(out_dir) / name_fit).string(),
-                    {t.file + ": stress, data and models (fitted to all tests)", "time [s]", "stress [Pa]",
-                     {{"data", t.time_s, t.stress_pa, "#000000", "", 2.0},
-                      {"baseline " + a.baseline.model.describe(), t.time_s, yb, "#1f77b4", "8 4", 1.6},
-                      {"final " + a.final.model.describe(), t.time_s, yf, "#d62728", "", 1.6}}});
-    plot::write_svg((fs::path(out_dir) / name_res).string(),
-                    {t.file + ": residual (data - model)", "time [s]", "residual [Pa]",
-                     {{"baseline", t.time_s, rb, "#1f77b4", "8 4", 1.6}, {"final", t.time_s, rf, "#d62728", "", 1.6}}});
+    // Time since the first sample (plus one sampling interval), on a log axis: ramps and holds
+    // that last from 0.1 s to minutes are all visible.
+    std::vector<double> since;
+    const double offset = t.time_s[1] - t.time_s[0];
+    for (double x : t.time_s) since.push_back(x - t.time_s[0] + offset);
+    plot::Figure fit{t.file + ": stress, data and models (fitted to all tests)", "time since the first sample [s] (log)", "stress [Pa]",
+                     {{"data", since, t.stress_pa, "#000000", "", 2.0},
+                      {"baseline (" + std::to_string(a.baseline.model.parameter_count()) + " parameters)", since, yb, "#1f77b4", "8 4", 1.6},
+                      {"final (" + std::to_string(a.final.model.parameter_count()) + " parameters)", since, yf, "#d62728", "", 1.6}}};
+    fit.log_x = true;
+    plot::write_svg((fs::path(out_dir) / name_fit).string(), fit);
+    plot::Figure res{t.file + ": residual (data - model)", "time since the first sample [s] (log)", "residual [Pa]",
+                     {{"baseline", since, rb, "#1f77b4", "8 4", 1.6}, {"final", since, rf, "#d62728", "", 1.6}}};
+    res.log_x = true;
+    plot::write_svg((fs::path(out_dir) / name_res).string(), res);
     md << "### " << t.file << " (" << to_string(t.control) << " control)\n\n![" << t.file << "](" << name_fit << ")\n\n![residual](" << name_res << ")\n\n";
   }
 }
