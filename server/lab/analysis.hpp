@@ -32,6 +32,21 @@ struct Candidate {
   std::string evidence;          ///< the residual signature that points at it
 };
 
+/// A model run on the tetrahedral specimen (viscera's GPS, implicit, inertia) next to its
+/// material-point law.
+struct SpecimenCheck {
+  std::string model;
+  bool ran = false;
+  std::string note;
+  std::vector<std::string> files;
+  std::vector<double> specimen_rms_pa, law_rms_pa;
+  long steps = 0, newton_iterations = 0;
+};
+
+struct AnalyzeOptions {
+  bool specimen = true;  ///< also simulate baseline and final on the tetrahedral specimen
+};
+
 struct Analysis {
   std::string dataset;
   double noise_pa = 0.0;
@@ -40,6 +55,7 @@ struct Analysis {
   std::vector<Mechanism> causes;  ///< accepted, strongest first
   double gain = 1.0;              ///< baseline held-out RMS / final held-out RMS
   std::string verdict;            ///< one paragraph: what is wrong, why, what still does not fit
+  std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen
 };
 
 /// Noise of one test [Pa]: RMS of stress_sd_pa if given, else from second differences (MAD).
@@ -49,6 +65,7 @@ double noise_level_pa(const TestData& t);
 ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d);
 
 /// The whole analysis; `progress` receives one line per stage.
-Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {});
+Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {},
+                 const AnalyzeOptions& options = {});
 
 }  // namespace viscera::lab

@@ -34,6 +34,12 @@ std::vector<char> BoundaryConditions::constrained_mask(std::size_t node_count) c
   for (auto i : fixed_nodes) node(i);
   for (const auto& p : prescribed)
     for (auto i : p.nodes) node(i);
+  for (const auto& p : prescribed_axes)
+    for (auto i : p.nodes) {
+      if (i < 0 || static_cast<std::size_t>(i) >= node_count || p.axis < 0 || p.axis > 2)
+        throw std::invalid_argument("BoundaryConditions: bad prescribed axis motion");
+      mask[3 * static_cast<std::size_t>(i) + p.axis] = 1;
+    }
   for (const auto& c : fixed_axes) {
     if (c.node < 0 || static_cast<std::size_t>(c.node) >= node_count || c.axis < 0 || c.axis > 2)
       throw std::invalid_argument("BoundaryConditions: bad axis constraint");

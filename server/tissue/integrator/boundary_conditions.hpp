@@ -25,11 +25,20 @@ struct AxisConstraint {
   int axis;  ///< 0 = x, 1 = y, 2 = z
 };
 
+/// One coordinate of a set of nodes moved as prescribed, the others free (a frictionless grip).
+struct PrescribedAxisMotion {
+  std::vector<std::int32_t> nodes;
+  int axis = 0;
+  /// Coordinate [m] of a node with rest position X at time t [s].
+  std::function<double(const Vec3& rest, double t)> coordinate;
+};
+
 struct BoundaryConditions {
   Vec3 gravity_m_s2 = Vec3::Zero();
   std::vector<std::int32_t> fixed_nodes;        ///< held at their rest positions
   std::vector<AxisConstraint> fixed_axes;       ///< single coordinates held at rest
   std::vector<PrescribedMotion> prescribed;     ///< moved as prescribed
+  std::vector<PrescribedAxisMotion> prescribed_axes;  ///< one coordinate moved as prescribed
   /// External forces [N] per node (empty = none), scaled by force_amplitude(t) if given.
   std::vector<Vec3> nodal_forces;
   std::function<double(double t)> force_amplitude;

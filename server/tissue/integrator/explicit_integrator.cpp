@@ -75,6 +75,12 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
       state.v[i] = (target - x_prev_[i]) / dt;
       state.x[i] = target;
     }
+  for (const auto& p : bc_.prescribed_axes)
+    for (auto i : p.nodes) {
+      const double target = p.coordinate(rest[i], t1);
+      state.v[i][p.axis] = (target - x_prev_[i][p.axis]) / dt;
+      state.x[i][p.axis] = target;
+    }
   state.time_s = t1;
 }
 

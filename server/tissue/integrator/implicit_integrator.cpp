@@ -76,6 +76,8 @@ void ImplicitIntegrator::apply_constraints(State& state, double t) {
   for (const auto& c : bc_.fixed_axes) state.x[c.node][c.axis] = rest[c.node][c.axis];
   for (const auto& p : bc_.prescribed)
     for (auto i : p.nodes) state.x[i] = p.position(rest[i], t);
+  for (const auto& p : bc_.prescribed_axes)
+    for (auto i : p.nodes) state.x[i][p.axis] = p.coordinate(rest[i], t);
 }
 
 double ImplicitIntegrator::residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n,

@@ -45,6 +45,9 @@ class ImplicitIntegrator {
   NewtonReport solve_static(State& state);
 
   const std::vector<double>& masses() const { return mass_; }
+  /// Internal forces [N] at the state the last step or solve ended in (reactions at constrained
+  /// coordinates are their negatives).
+  const std::vector<Vec3>& last_internal_forces() const { return force_; }
   const ImplicitOptions& options() const { return options_; }
   void set_dt(double dt_s) { options_.dt_s = dt_s; }
 
