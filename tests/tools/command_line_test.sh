@@ -30,6 +30,14 @@ expect sim-bad-model 2 "'fem' is not one of" -- "$sim" --mesh "$src/data/meshes/
 expect sim-bad-slab 2 "fix-slab: axis 'w'" -- "$sim" --mesh "$src/data/meshes/liver.msh" --fix-slab w,max,0.1
 expect sim-runs 0 "wrote" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale 0.035 --fix-slab z,max,0.2 --duration 0.05 --out "$tmp/frames"
 expect fig-bad-mechanisms 2 "mechanisms" -- "$fig" --mechanisms 9 --csv "$tmp/f.csv" --svg "$tmp/f.svg"
+server="$build/server/runtime/viscera-server"; hc="$build/tools/haptic-client/haptic-client"
+echo '{"organ": {"mesh": "x.msh"}}' >"$tmp/bad_scene.json"
+expect server-help 0 "Usage: viscera-server" -- "$server" --help
+expect server-no-scene 2 "--scene FILE is required" -- "$server"
+expect server-bad-scene 2 "bad_scene.json: organ.material: missing" -- "$server" --scene "$tmp/bad_scene.json"
+expect server-bad-duration 2 "'soon' is not a non-negative number" -- "$server" --scene x --duration soon
+expect hc-help 0 "Usage: haptic-client" -- "$hc" --help
+expect hc-bad-rate 2 "--rate: 0 is outside" -- "$hc" --rate 0
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
 expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"

@@ -43,6 +43,10 @@ struct BoundaryConditions {
   std::vector<Vec3> nodal_forces;
   std::function<double(double t)> force_amplitude;
 
+  /// A position-dependent force field added at every explicit force evaluation (contact with an
+  /// instrument): f += field(x). Explicit integrator only.
+  std::function<void(std::span<const Vec3> x, std::span<Vec3> f)> force_field;
+
   /// 1 for each coordinate (3 per node) that is fixed or prescribed, else 0.
   std::vector<char> constrained_mask(std::size_t node_count) const;
   /// External force on node i at time t (gravity excluded).

@@ -42,6 +42,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   const std::size_t nm = model_.memory_size();
   if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
   const ForceStats stats = model_.add_forces(state.x, force_, {state.memory, state.memory, state.time_s - state.memory_time_s});
+  if (bc_.force_field) bc_.force_field(state.x, force_);
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
     std::ostringstream msg;

@@ -34,6 +34,8 @@ class ExplicitIntegrator {
   /// Returns the number of sub-steps.
   long advance(State& state, double duration_s);
 
+  /// The boundary conditions (their force field may be changed between steps).
+  BoundaryConditions& boundary_conditions() { return bc_; }
   /// Kinetic energy [J] of a state.
   double kinetic_energy(const State& state) const;
 

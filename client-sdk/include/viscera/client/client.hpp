@@ -1,0 +1,53 @@
+#pragma once
+// viscera's client SDK: find a server's scene, claim an instrument, stream poses, receive forces,
+// measure the command-to-force round trip. Built on protocol/ (the only DDS wrapper).
+//
+//   viscera::client::Client c(domain, client_id);
+//   auto scene = c.wait_for_scene(std::chrono::seconds(5));
+//   if (c.claim(1, std::chrono::seconds(2))) { c.send_tip(1, {x, y, z}); auto f = c.poll_force(1); }
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "viscera/protocol/messages.hpp"
+
+namespace viscera::client {
+
+struct LatencyStats {
+  std::size_t samples = 0;
+  double p50_us = 0, p99_us = 0, max_us = 0;
+};
+
+class Client {
+ public:
+  Client(std::uint32_t domain_id, std::uint32_t client_id);
+  ~Client();
+
+  /// Waits for the server's scene state (published reliably, transient local).
+  std::optional<protocol::Scene> wait_for_scene(std::chrono::milliseconds timeout);
+  /// Claims an instrument; true once the scene state shows this client as its owner.
+  bool claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
+  void release(std::uint32_t instrument_id);
+  /// Sends the instrument's tip position [m] (next sequence number, current stamp).
+  void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip);
+  /// Takes the forces that arrived; returns the newest for the instrument, if any. Each one
+  /// whose echoed stamp is this client's adds a round-trip sample.
+  std::optional<protocol::Force> poll_force(std::uint32_t instrument_id);
+  LatencyStats round_trip() const;
+  std::uint32_t id() const { return client_id_; }
+  /// Payloads that failed verification and were dropped.
+  std::uint64_t rejected() const { return rejected_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::uint32_t client_id_;
+  std::uint64_t seq_ = 0, rejected_ = 0;
+  std::vector<double> rtt_us_;
+  std::map<std::uint32_t, protocol::Force> latest_;
+};
+
+}  // namespace viscera::client

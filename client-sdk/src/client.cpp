@@ -1,0 +1,105 @@
+#include "viscera/client/client.hpp"
+
+#include <algorithm>
+#include <thread>
+
+#include "viscera/protocol/dds.hpp"
+
+namespace viscera::client {
+
+namespace proto = viscera::protocol;
+
+struct Client::Impl {
+  proto::Participant participant;
+  proto::Writer commands, sessions;
+  proto::Reader forces, scene;
+  std::optional<proto::Scene> last_scene;
+  explicit Impl(std::uint32_t domain)
+      : participant(domain),
+        commands(participant, proto::Stream::instrument_command),
+        sessions(participant, proto::Stream::session_request),
+        forces(participant, proto::Stream::force_feedback),
+        scene(participant, proto::Stream::scene_state) {}
+  void take_scene(std::uint64_t& rejected) {
+    scene.take([&](const proto::Received& r) {
+      std::string why;
+      if (auto s = proto::decode_scene(r.payload, &why)) last_scene = *s;
+      else ++rejected;
+    });
+  }
+};
+
+Client::Client(std::uint32_t domain_id, std::uint32_t client_id) : impl_(std::make_unique<Impl>(domain_id)), client_id_(client_id) {}
+Client::~Client() = default;
+
+std::optional<proto::Scene> Client::wait_for_scene(std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < end) {
+    impl_->scene.wait(std::chrono::milliseconds(50));
+    impl_->take_scene(rejected_);
+    if (impl_->last_scene) return impl_->last_scene;
+  }
+  return std::nullopt;
+}
+
+bool Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < end) {
+    impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, proto::Action::claim_instrument, instrument_id}));
+    impl_->scene.wait(std::chrono::milliseconds(100));
+    impl_->take_scene(rejected_);
+    if (impl_->last_scene)
+      for (const auto& i : impl_->last_scene->instruments)
+        if (i.instrument_id == instrument_id && i.owner_client_id == client_id_) return true;
+  }
+  return false;
+}
+
+void Client::release(std::uint32_t instrument_id) {
+  impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, proto::Action::release_instrument, instrument_id}));
+}
+
+void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip) {
+  proto::Command c;
+  c.instrument_id = instrument_id;
+  c.client_id = client_id_;
+  c.seq = ++seq_;
+  c.client_stamp_ns = proto::now_ns();
+  c.tip_position = tip;
+  impl_->commands.write(instrument_id, proto::encode(c));
+}
+
+std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
+  const std::int64_t now = proto::now_ns();
+  impl_->forces.take([&](const proto::Received& r) {
+    std::string why;
+    const auto f = proto::decode_force(r.payload, &why);
+    if (!f) {
+      ++rejected_;
+      return;
+    }
+    if (f->client_id != client_id_) return;
+    auto& slot = latest_[f->instrument_id];
+    if (f->command_seq >= slot.command_seq) {
+      if (f->command_seq > slot.command_seq) rtt_us_.push_back(1e-3 * static_cast<double>(now - f->command_client_stamp_ns));
+      slot = *f;
+    }
+  });
+  const auto it = latest_.find(instrument_id);
+  if (it == latest_.end()) return std::nullopt;
+  return it->second;
+}
+
+LatencyStats Client::round_trip() const {
+  LatencyStats s;
+  s.samples = rtt_us_.size();
+  if (rtt_us_.empty()) return s;
+  std::vector<double> v = rtt_us_;
+  std::sort(v.begin(), v.end());
+  s.p50_us = v[v.size() / 2];
+  s.p99_us = v[static_cast<std::size_t>(0.99 * static_cast<double>(v.size() - 1))];
+  s.max_us = v.back();
+  return s;
+}
+
+}  // namespace viscera::client

@@ -1,0 +1,86 @@
+#pragma once
+// The one wrapper of Cyclone DDS's C API in viscera: RAII entities, the envelope topic per
+// stream with its QoS (TRANSPORT.md), and typed writes/takes of FlatBuffer payloads. No other
+// code calls dds_* directly.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+namespace viscera::protocol {
+
+class DdsError : public std::runtime_error {
+ public:
+  DdsError(const std::string& what, int32_t code);
+};
+
+/// The streams of the protocol; each is one topic of Envelope with its own QoS.
+enum class Stream {
+  instrument_command,  ///< best effort, keep last 1 per key, volatile
+  force_feedback,      ///< best effort, keep last 1 per key, volatile
+  session_request,     ///< reliable, keep last 16, volatile
+  scene_state,         ///< reliable, keep last 1, transient local (late joiners get it)
+  telemetry,           ///< best effort, keep last 1, volatile
+};
+const char* topic_name(Stream s);
+
+class Participant {
+ public:
+  explicit Participant(std::uint32_t domain_id);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+  int32_t handle() const { return handle_; }
+  /// The envelope topic of a stream (created once per participant).
+  int32_t topic(Stream s);
+
+ private:
+  int32_t handle_;
+  int32_t topics_[5] = {0, 0, 0, 0, 0};
+};
+
+struct Received {
+  std::uint32_t source_id;
+  std::uint64_t seq;
+  std::int64_t stamp_ns;
+  std::span<const std::uint8_t> payload;  ///< valid during the callback only
+};
+
+class Writer {
+ public:
+  Writer(Participant& p, Stream s);
+  ~Writer();
+  Writer(const Writer&) = delete;
+  Writer& operator=(const Writer&) = delete;
+  void write(std::uint32_t source_id, std::span<const std::uint8_t> payload);
+  /// Number of matched readers.
+  int matched() const;
+
+ private:
+  int32_t handle_;
+  std::uint64_t seq_ = 0;
+};
+
+class Reader {
+ public:
+  Reader(Participant& p, Stream s);
+  ~Reader();
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+  /// Takes every available sample, calling f for each; returns how many.
+  int take(const std::function<void(const Received&)>& f);
+  /// Blocks until data are available or the timeout passes; true if data.
+  bool wait(std::chrono::nanoseconds timeout);
+
+ private:
+  int32_t handle_;
+  int32_t waitset_;
+  int32_t condition_;
+};
+
+/// Monotonic clock in nanoseconds (the stamps of the protocol).
+std::int64_t now_ns();
+
+}  // namespace viscera::protocol

@@ -1,0 +1,77 @@
+#pragma once
+// Plain C++ views of the protocol's messages, and their encoding and verified decoding. Every
+// received payload goes through decode_*: the FlatBuffers Verifier, then ranges and finiteness;
+// a payload that fails returns nullopt and says why (the receiver counts and drops it).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace viscera::protocol {
+
+using Vector3 = std::array<double, 3>;
+
+struct Command {
+  std::uint32_t instrument_id = 0, client_id = 0;
+  std::uint64_t seq = 0;
+  std::int64_t client_stamp_ns = 0;
+  Vector3 tip_position{};
+  std::array<double, 4> orientation{1, 0, 0, 0};
+  double jaw_opening = 0;
+  std::uint32_t buttons = 0;
+};
+
+struct Force {
+  std::uint32_t instrument_id = 0, client_id = 0;
+  std::uint64_t command_seq = 0;
+  std::int64_t command_client_stamp_ns = 0, server_stamp_ns = 0, step_time_ns = 0;
+  Vector3 force{}, torque{};
+  bool in_contact = false;
+  Vector3 contact_point{}, contact_normal{};
+  std::array<double, 9> stiffness{};  ///< row-major [N/m]
+};
+
+enum class Action : std::int8_t { claim_instrument = 0, release_instrument = 1, pause = 2, resume = 3, reset = 4 };
+
+struct SessionRequest {
+  std::uint32_t client_id = 0;
+  Action action = Action::claim_instrument;
+  std::uint32_t instrument_id = 0;
+};
+
+struct InstrumentInfo {
+  std::uint32_t instrument_id = 0;
+  bool grasper = false;
+  double tip_radius_m = 0;
+  std::uint32_t owner_client_id = 0;
+};
+
+struct Scene {
+  std::string name;
+  double physics_rate_hz = 0;
+  bool paused = false;
+  std::vector<InstrumentInfo> instruments;
+  Vector3 bounds_min{}, bounds_max{};
+};
+
+struct TelemetryReport {
+  std::int64_t server_stamp_ns = 0;
+  std::uint64_t steps = 0, overruns = 0, rejected_messages = 0;
+  double physics_rate_hz = 0, step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0;
+};
+
+std::vector<std::uint8_t> encode(const Command& c);
+std::vector<std::uint8_t> encode(const Force& f);
+std::vector<std::uint8_t> encode(const SessionRequest& r);
+std::vector<std::uint8_t> encode(const Scene& s);
+std::vector<std::uint8_t> encode(const TelemetryReport& t);
+
+std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> bytes, std::string* why);
+
+}  // namespace viscera::protocol

@@ -1,0 +1,137 @@
+#include "viscera/protocol/dds.hpp"
+
+#include <dds/dds.h>
+
+#include "envelope.h"
+
+namespace viscera::protocol {
+
+namespace {
+int32_t check(int32_t rc, const char* what) {
+  if (rc < 0) throw DdsError(what, rc);
+  return rc;
+}
+
+dds_qos_t* qos_for(Stream s) {
+  dds_qos_t* q = dds_create_qos();
+  switch (s) {
+    case Stream::instrument_command:
+    case Stream::force_feedback:
+    case Stream::telemetry:
+      dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
+      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+      break;
+    case Stream::session_request:
+      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
+      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+      break;
+    case Stream::scene_state:
+      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+      break;
+  }
+  // A client that dies or goes silent loses its liveliness within this lease.
+  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(500));
+  return q;
+}
+}  // namespace
+
+DdsError::DdsError(const std::string& what, int32_t code)
+    : std::runtime_error("DDS: " + what + ": " + dds_strretcode(code)) {}
+
+const char* topic_name(Stream s) {
+  switch (s) {
+    case Stream::instrument_command: return "viscera_instrument_command";
+    case Stream::force_feedback: return "viscera_force_feedback";
+    case Stream::session_request: return "viscera_session_request";
+    case Stream::scene_state: return "viscera_scene_state";
+    case Stream::telemetry: return "viscera_telemetry";
+  }
+  return "?";
+}
+
+Participant::Participant(std::uint32_t domain_id)
+    : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")) {}
+
+Participant::~Participant() { dds_delete(handle_); }
+
+int32_t Participant::topic(Stream s) {
+  int32_t& t = topics_[static_cast<int>(s)];
+  if (t == 0) t = check(dds_create_topic(handle_, &viscera_Envelope_desc, topic_name(s), nullptr, nullptr), topic_name(s));
+  return t;
+}
+
+Writer::Writer(Participant& p, Stream s) {
+  dds_qos_t* q = qos_for(s);
+  handle_ = dds_create_writer(p.handle(), p.topic(s), q, nullptr);
+  dds_delete_qos(q);
+  check(handle_, "create writer");
+}
+
+Writer::~Writer() { dds_delete(handle_); }
+
+void Writer::write(std::uint32_t source_id, std::span<const std::uint8_t> payload) {
+  viscera_Envelope e{};
+  e.source_id = source_id;
+  e.seq = ++seq_;
+  e.stamp_ns = now_ns();
+  // One copy, by dds_write: the envelope points at the caller's buffer.
+  e.payload._buffer = const_cast<std::uint8_t*>(payload.data());
+  e.payload._length = e.payload._maximum = static_cast<std::uint32_t>(payload.size());
+  e.payload._release = false;
+  check(dds_write(handle_, &e), "write");
+}
+
+int Writer::matched() const {
+  dds_publication_matched_status_t st{};
+  dds_get_publication_matched_status(handle_, &st);
+  return static_cast<int>(st.current_count);
+}
+
+Reader::Reader(Participant& p, Stream s) {
+  dds_qos_t* q = qos_for(s);
+  handle_ = dds_create_reader(p.handle(), p.topic(s), q, nullptr);
+  dds_delete_qos(q);
+  check(handle_, "create reader");
+  waitset_ = check(dds_create_waitset(p.handle()), "create waitset");
+  condition_ = check(dds_create_readcondition(handle_, DDS_ANY_STATE), "create read condition");
+  check(dds_waitset_attach(waitset_, condition_, handle_), "attach");
+}
+
+Reader::~Reader() {
+  dds_waitset_detach(waitset_, condition_);
+  dds_delete(condition_);
+  dds_delete(waitset_);
+  dds_delete(handle_);
+}
+
+int Reader::take(const std::function<void(const Received&)>& f) {
+  constexpr int kMax = 64;
+  void* samples[kMax] = {nullptr};
+  dds_sample_info_t infos[kMax];
+  int total = 0;
+  for (;;) {
+    const int32_t n = dds_take(handle_, samples, infos, kMax, kMax);  // loaned samples
+    if (n <= 0) break;
+    for (int32_t k = 0; k < n; ++k) {
+      if (!infos[k].valid_data) continue;
+      const auto* e = static_cast<const viscera_Envelope*>(samples[k]);
+      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}});
+      ++total;
+    }
+    dds_return_loan(handle_, samples, n);
+    if (n < kMax) break;
+  }
+  return total;
+}
+
+bool Reader::wait(std::chrono::nanoseconds timeout) {
+  return dds_waitset_wait(waitset_, nullptr, 0, timeout.count()) > 0;
+}
+
+std::int64_t now_ns() { return dds_time(); }
+
+}  // namespace viscera::protocol

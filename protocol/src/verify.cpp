@@ -1,0 +1,195 @@
+#include <cmath>
+
+#include "force_feedback_generated.h"
+#include "instrument_command_generated.h"
+#include "session_generated.h"
+#include "telemetry_generated.h"
+#include "viscera/protocol/messages.hpp"
+
+namespace viscera::protocol {
+
+namespace fb = viscera::wire;  // the flatc-generated types
+
+namespace {
+
+constexpr double kMaxPositionM = 10.0;      // a scene is metres across, not kilometres
+constexpr double kMaxForceN = 1e4;
+
+fb::Vec3 to_fb(const Vector3& v) { return fb::Vec3(v[0], v[1], v[2]); }
+Vector3 from_fb(const fb::Vec3* v) { return v ? Vector3{v->x(), v->y(), v->z()} : Vector3{0, 0, 0}; }
+
+bool finite(const Vector3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+bool within(const Vector3& v, double limit) { return std::abs(v[0]) <= limit && std::abs(v[1]) <= limit && std::abs(v[2]) <= limit; }
+
+template <typename T>
+const T* verified_root(std::span<const std::uint8_t> bytes, std::string* why) {
+  if (bytes.size() < 8) {
+    *why = "payload of " + std::to_string(bytes.size()) + " bytes is too short";
+    return nullptr;
+  }
+  flatbuffers::Verifier v(bytes.data(), bytes.size(), 64, 10000);
+  if (!v.VerifyBuffer<T>(nullptr)) {
+    *why = "FlatBuffers verification failed (truncated, garbage or another schema)";
+    return nullptr;
+  }
+  return flatbuffers::GetRoot<T>(bytes.data());
+}
+
+template <typename B>
+std::vector<std::uint8_t> finish(flatbuffers::FlatBufferBuilder& b, flatbuffers::Offset<B> root) {
+  b.Finish(root);
+  return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode(const Command& c) {
+  flatbuffers::FlatBufferBuilder b(128);
+  const fb::Vec3 tip = to_fb(c.tip_position);
+  const fb::Quat q(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]);
+  return finish(b, fb::CreateInstrumentCommand(b, c.instrument_id, c.client_id, c.seq, c.client_stamp_ns, &tip, &q, c.jaw_opening, c.buttons));
+}
+
+std::vector<std::uint8_t> encode(const Force& f) {
+  flatbuffers::FlatBufferBuilder b(256);
+  const fb::Vec3 point = to_fb(f.contact_point), normal = to_fb(f.contact_normal), force = to_fb(f.force), torque = to_fb(f.torque);
+  const auto& k = f.stiffness;
+  const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
+  const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
+  return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns,
+                                           &force, &torque, model, f.step_time_ns));
+}
+
+std::vector<std::uint8_t> encode(const SessionRequest& r) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id));
+}
+
+std::vector<std::uint8_t> encode(const Scene& s) {
+  flatbuffers::FlatBufferBuilder b(512);
+  std::vector<flatbuffers::Offset<fb::InstrumentState>> inst;
+  for (const auto& i : s.instruments)
+    inst.push_back(fb::CreateInstrumentState(b, i.instrument_id, i.grasper ? fb::InstrumentKind::grasper : fb::InstrumentKind::probe,
+                                             i.tip_radius_m, i.owner_client_id));
+  const auto name = b.CreateString(s.name);
+  const auto list = b.CreateVector(inst);
+  const fb::Vec3 lo = to_fb(s.bounds_min), hi = to_fb(s.bounds_max);
+  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi));
+}
+
+std::vector<std::uint8_t> encode(const TelemetryReport& t) {
+  flatbuffers::FlatBufferBuilder b(128);
+  return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us,
+                                       t.jitter_p99_us, t.overruns, t.rejected_messages));
+}
+
+std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::InstrumentCommand>(bytes, why);
+  if (!m) return std::nullopt;
+  Command c;
+  c.instrument_id = m->instrument_id();
+  c.client_id = m->client_id();
+  c.seq = m->seq();
+  c.client_stamp_ns = m->client_stamp_ns();
+  if (!m->tip_position()) {
+    *why = "tip_position missing";
+    return std::nullopt;
+  }
+  c.tip_position = from_fb(m->tip_position());
+  if (m->orientation()) c.orientation = {m->orientation()->w(), m->orientation()->x(), m->orientation()->y(), m->orientation()->z()};
+  c.jaw_opening = m->jaw_opening();
+  c.buttons = m->buttons();
+  if (!finite(c.tip_position) || !within(c.tip_position, kMaxPositionM)) {
+    *why = "tip_position is not finite or beyond 10 m";
+    return std::nullopt;
+  }
+  double qn = 0;
+  for (double q : c.orientation) qn += q * q;
+  if (!std::isfinite(qn) || std::abs(qn - 1.0) > 1e-3) {
+    *why = "orientation is not a unit quaternion";
+    return std::nullopt;
+  }
+  if (!std::isfinite(c.jaw_opening) || c.jaw_opening < 0 || c.jaw_opening > M_PI) {
+    *why = "jaw_opening outside [0, pi] rad";
+    return std::nullopt;
+  }
+  if (c.client_id == 0) {
+    *why = "client_id 0 is reserved";
+    return std::nullopt;
+  }
+  return c;
+}
+
+std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::ForceFeedback>(bytes, why);
+  if (!m) return std::nullopt;
+  Force f;
+  f.instrument_id = m->instrument_id();
+  f.client_id = m->client_id();
+  f.command_seq = m->command_seq();
+  f.command_client_stamp_ns = m->command_client_stamp_ns();
+  f.server_stamp_ns = m->server_stamp_ns();
+  f.step_time_ns = m->step_time_ns();
+  f.force = from_fb(m->force());
+  f.torque = from_fb(m->torque());
+  if (const auto* lm = m->local_model()) {
+    f.in_contact = lm->in_contact();
+    f.contact_point = from_fb(lm->point());
+    f.contact_normal = from_fb(lm->normal());
+    if (const auto* k = lm->stiffness())
+      f.stiffness = {k->m00(), k->m01(), k->m02(), k->m10(), k->m11(), k->m12(), k->m20(), k->m21(), k->m22()};
+  }
+  if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point)) {
+    *why = "force, torque or contact point not finite or out of range";
+    return std::nullopt;
+  }
+  for (double k : f.stiffness)
+    if (!std::isfinite(k)) {
+      *why = "stiffness not finite";
+      return std::nullopt;
+    }
+  return f;
+}
+
+std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::SessionRequest>(bytes, why);
+  if (!m) return std::nullopt;
+  const auto a = static_cast<int>(m->action());
+  if (a < 0 || a > 4) {
+    *why = "unknown action " + std::to_string(a);
+    return std::nullopt;
+  }
+  if (m->client_id() == 0) {
+    *why = "client_id 0 is reserved";
+    return std::nullopt;
+  }
+  return SessionRequest{m->client_id(), static_cast<Action>(a), m->instrument_id()};
+}
+
+std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::SceneState>(bytes, why);
+  if (!m) return std::nullopt;
+  Scene s;
+  s.name = m->scene_name() ? m->scene_name()->str() : "";
+  s.physics_rate_hz = m->physics_rate_hz();
+  s.paused = m->paused();
+  if (m->instruments())
+    for (const auto* i : *m->instruments())
+      s.instruments.push_back({i->instrument_id(), i->kind() == fb::InstrumentKind::grasper, i->tip_radius_m(), i->owner_client_id()});
+  s.bounds_min = from_fb(m->organ_bounds_min());
+  s.bounds_max = from_fb(m->organ_bounds_max());
+  if (!finite(s.bounds_min) || !finite(s.bounds_max) || !std::isfinite(s.physics_rate_hz)) {
+    *why = "scene numbers not finite";
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::Telemetry>(bytes, why);
+  if (!m) return std::nullopt;
+  return TelemetryReport{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
+                         m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us()};
+}
+
+}  // namespace viscera::protocol

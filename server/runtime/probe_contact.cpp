@@ -1,0 +1,75 @@
+#include "probe_contact.hpp"
+
+namespace viscera::runtime {
+
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3* w) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return *w = Vec3(1, 0, 0), a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return *w = Vec3(0, 1, 0), b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return *w = Vec3(1 - v, v, 0), a + v * ab;
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return *w = Vec3(0, 0, 1), c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double v = d2 / (d2 - d6);
+    return *w = Vec3(1 - v, 0, v), a + v * ac;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return *w = Vec3(0, 1 - v, v), b + v * (c - b);
+  }
+  const double denom = 1.0 / (va + vb + vc), v = vb * denom, u = vc * denom;
+  return *w = Vec3(1 - v - u, v, u), a + v * ab + u * ac;
+}
+
+ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m)
+    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m) {}
+
+ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f) const {
+  ContactResult r;
+  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
+  Vec3 weighted_point = Vec3::Zero();
+  double total = 0.0;
+  for (const auto& t : surface_) {
+    const Vec3 &a = x[t[0]], &b = x[t[1]], &c = x[t[2]];
+    Vec3 n = (b - a).cross(c - a);
+    const double area2 = n.norm();
+    if (area2 <= 0) continue;
+    n /= area2;
+    Vec3 w;
+    const Vec3 q = closest_point_on_triangle(centre, a, b, c, &w);
+    const double s = (centre - q).dot(n);
+    if (s >= radius_ || s < -max_depth_) continue;
+    // Off the triangle's interior, only a tip outside the surface touches its edge or corner.
+    const bool interior = w.minCoeff() > 0;
+    if (!interior && (s < 0 || (centre - q).norm() >= radius_)) continue;
+    const double depth = radius_ - s;
+    const Vec3 push = stiffness_ * depth * n;  // on the tool, out of the tissue
+    for (int k = 0; k < 3; ++k) f[t[k]] -= w[k] * push;
+    r.force_on_tool += push;
+    K += stiffness_ * n * n.transpose();
+    weighted_point += depth * q;
+    total += depth;
+    ++r.triangles_in_contact;
+  }
+  if (r.triangles_in_contact > 0) {
+    r.in_contact = true;
+    r.point = weighted_point / total;
+    const double fn = r.force_on_tool.norm();
+    if (fn > 0) r.normal = r.force_on_tool / fn;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r.stiffness[3 * i + j] = K(i, j);
+  }
+  return r;
+}
+
+}  // namespace viscera::runtime

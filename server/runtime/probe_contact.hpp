@@ -1,0 +1,42 @@
+#pragma once
+// Contact of a sphere-tipped probe with the organ's boundary triangles (HAPTICS.md, "Probe").
+// For every triangle, the closest point q to the tip centre c and the signed distance
+// s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r.
+// Because s keeps decreasing (and goes negative) when the centre passes below the surface, a tip
+// that moved deeper than its radius within one step is still pushed out along the normal: it does
+// not tunnel (triangles whose plane is more than `max_depth` behind the tip are ignored, so the
+// far side of the organ does not pull). The penalty force k (r - s) n acts on the triangle's
+// vertices with barycentric weights; the tool feels the opposite.
+#include <array>
+#include <span>
+#include <vector>
+
+#include "mesh/boundary_surface.hpp"
+
+namespace viscera::runtime {
+
+using tissue::Vec3;
+
+struct ContactResult {
+  Vec3 force_on_tool = Vec3::Zero();  ///< [N]
+  bool in_contact = false;
+  Vec3 point = Vec3::Zero(), normal = Vec3::UnitZ();
+  std::array<double, 9> stiffness{};  ///< penalty part of -dF/dx [N/m], row-major
+  int triangles_in_contact = 0;
+};
+
+class ProbeContact {
+ public:
+  ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m = 0.03);
+  /// Adds the penalty forces on the organ to f for the tip at `centre`; returns the reaction.
+  ContactResult apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f) const;
+
+ private:
+  std::vector<tissue::Triangle> surface_;
+  double radius_, stiffness_, max_depth_;
+};
+
+/// Closest point on triangle (a, b, c) to p, with its barycentric coordinates (Ericson 2005, 5.1.5).
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3* barycentric);
+
+}  // namespace viscera::runtime

@@ -1,0 +1,31 @@
+#pragma once
+// Scene files (JSON, docs/SCENE.md): the organ (mesh, scale, material, model, fixed region),
+// the instruments, rates and the DDS domain. Paths are relative to the scene file. Errors name
+// the file and the field.
+#include <array>
+#include <string>
+#include <vector>
+
+namespace viscera::runtime {
+
+struct InstrumentSpec {
+  std::uint32_t id = 0;
+  std::string kind = "probe";  ///< probe | grasper
+  double tip_radius_m = 0.005;
+};
+
+struct SceneSpec {
+  std::string name, source;
+  std::uint32_t domain_id = 0;
+  double physics_rate_hz = 1000.0;
+  std::string mesh, material, model = "gps_energy";
+  double scale_m_per_unit = 1.0, damping_per_s = 0.0, volume_term = 0.5;
+  double contact_stiffness_n_per_m = 200.0;
+  std::string fix_axis = "z", fix_side = "max";
+  double fix_fraction = 0.2;
+  std::vector<InstrumentSpec> instruments;
+};
+
+SceneSpec read_scene_file(const std::string& path);
+
+}  // namespace viscera::runtime

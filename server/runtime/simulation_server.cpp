@@ -1,0 +1,262 @@
+#include "simulation_server.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <thread>
+
+#include "common/input_error.hpp"
+#include "integrator/explicit_integrator.hpp"
+#include "material/material_file.hpp"
+#include "mesh/boundary_surface.hpp"
+#include "mesh/mesh_reader.hpp"
+#include "model/model_factory.hpp"
+#include "probe_contact.hpp"
+#include "viscera/protocol/dds.hpp"
+#include "viscera/protocol/messages.hpp"
+#include "viscoelastic/viscoelastic_material.hpp"
+
+namespace viscera::runtime {
+
+namespace proto = viscera::protocol;
+using namespace viscera::tissue;
+
+namespace {
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+}  // namespace
+
+struct SimulationServer::Impl {
+  SceneSpec scene;
+  std::shared_ptr<TetMesh> mesh;
+  std::unique_ptr<ForceModel> model;
+  std::unique_ptr<ExplicitIntegrator> integrator;
+  State state;
+  Box bounds;
+
+  struct Instrument {
+    InstrumentSpec spec;
+    std::unique_ptr<ProbeContact> contact;
+    std::uint32_t owner = 0;
+    bool has_command = false;
+    proto::Command last;
+    ContactResult result;
+  };
+  std::map<std::uint32_t, Instrument> instruments;
+
+  proto::Participant participant;
+  proto::Reader commands, sessions;
+  proto::Writer forces, scene_state, telemetry;
+  std::uint64_t rejected = 0;
+
+  explicit Impl(const SceneSpec& s)
+      : scene(s),
+        participant(s.domain_id),
+        commands(participant, proto::Stream::instrument_command),
+        sessions(participant, proto::Stream::session_request),
+        forces(participant, proto::Stream::force_feedback),
+        scene_state(participant, proto::Stream::scene_state),
+        telemetry(participant, proto::Stream::telemetry) {
+    mesh = std::make_shared<TetMesh>(read_tet_mesh(s.mesh));
+    scale_mesh(*mesh, s.scale_m_per_unit);
+    const Material material = read_material_file(s.material);
+    Mat6 D = material.elasticity;
+    GpsViscoelasticity ve;
+    if (material.viscoelasticity) {
+      const ViscoelasticSetup setup = make_viscoelastic(material.elasticity, *material.viscoelasticity, s.material);
+      D = setup.unrelaxed_elasticity;
+      ve = setup.gps;
+    }
+    model = make_force_model(s.model, mesh, {D}, s.volume_term, ve);
+    bounds = bounding_box(*mesh);
+    BoundaryConditions bc;
+    bc.gravity_m_s2 = Vec3(0, 0, -9.81);
+    const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
+    Box slab = bounds;
+    const double extent = bounds.hi[a] - bounds.lo[a];
+    if (s.fix_side == "min") slab.hi[a] = bounds.lo[a] + s.fix_fraction * extent;
+    else slab.lo[a] = bounds.hi[a] - s.fix_fraction * extent;
+    bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
+    bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f) {
+      for (auto& [id, inst] : instruments)
+        if (inst.owner != 0 && inst.has_command) {
+          const auto& p = inst.last.tip_position;
+          inst.result = inst.contact->apply(Vec3(p[0], p[1], p[2]), x, f);
+        } else {
+          inst.result = {};
+        }
+    };
+    integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
+                                                      ExplicitOptions{0.9, 0.0, s.damping_per_s, 2.0});
+    state = State::at_rest(*mesh);
+    const auto surface = extract_boundary(*mesh).triangles;
+    for (const auto& spec : s.instruments)
+      instruments[spec.id] = Instrument{spec, std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m)};
+    publish_scene();
+  }
+
+  void publish_scene() {
+    proto::Scene sc;
+    sc.name = scene.name;
+    sc.physics_rate_hz = scene.physics_rate_hz;
+    for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, false, inst.spec.tip_radius_m, inst.owner});
+    sc.bounds_min = {bounds.lo.x(), bounds.lo.y(), bounds.lo.z()};
+    sc.bounds_max = {bounds.hi.x(), bounds.hi.y(), bounds.hi.z()};
+    scene_state.write(0, proto::encode(sc));
+  }
+
+  void take_sessions() {
+    bool changed = false;
+    sessions.take([&](const proto::Received& r) {
+      std::string why;
+      const auto req = proto::decode_session_request(r.payload, &why);
+      if (!req) {
+        ++rejected;
+        return;
+      }
+      const auto it = instruments.find(req->instrument_id);
+      if (it == instruments.end()) {
+        ++rejected;
+        return;
+      }
+      Instrument& inst = it->second;
+      if (req->action == proto::Action::claim_instrument && inst.owner == 0) {
+        inst.owner = req->client_id;
+        inst.has_command = false;
+        changed = true;
+      } else if (req->action == proto::Action::release_instrument && inst.owner == req->client_id) {
+        inst.owner = 0;
+        inst.has_command = false;
+        changed = true;
+      }
+    });
+    if (changed) publish_scene();
+  }
+
+  void take_commands() {
+    commands.take([&](const proto::Received& r) {
+      std::string why;
+      const auto c = proto::decode_command(r.payload, &why);
+      if (!c) {
+        ++rejected;
+        return;
+      }
+      const auto it = instruments.find(c->instrument_id);
+      if (it == instruments.end() || it->second.owner != c->client_id) {
+        ++rejected;  // not this client's instrument
+        return;
+      }
+      if (!it->second.has_command || c->seq > it->second.last.seq) {
+        it->second.last = *c;
+        it->second.has_command = true;
+      }
+    });
+  }
+
+  void publish_forces(std::int64_t step_time_ns, ServerStats& stats) {
+    for (const auto& [id, inst] : instruments) {
+      if (inst.owner == 0 || !inst.has_command) continue;
+      proto::Force f;
+      f.instrument_id = id;
+      f.client_id = inst.owner;
+      f.command_seq = inst.last.seq;
+      f.command_client_stamp_ns = inst.last.client_stamp_ns;
+      f.server_stamp_ns = proto::now_ns();
+      f.step_time_ns = step_time_ns;
+      f.force = {inst.result.force_on_tool.x(), inst.result.force_on_tool.y(), inst.result.force_on_tool.z()};
+      f.in_contact = inst.result.in_contact;
+      f.contact_point = {inst.result.point.x(), inst.result.point.y(), inst.result.point.z()};
+      f.contact_normal = {inst.result.normal.x(), inst.result.normal.y(), inst.result.normal.z()};
+      f.stiffness = inst.result.stiffness;
+      forces.write(id, proto::encode(f));
+      ++stats.forces_sent;
+    }
+  }
+};
+
+SimulationServer::SimulationServer(const SceneSpec& scene) : impl_(std::make_unique<Impl>(scene)) {}
+SimulationServer::~SimulationServer() = default;
+
+std::string SimulationServer::describe() const {
+  char b[400];
+  std::snprintf(b, sizeof b, "scene %s: %zu nodes, %zu tets, model %s, explicit step %.3g s, %zu instruments, %.0f Hz, DDS domain %u",
+                impl_->scene.name.c_str(), impl_->mesh->node_count(), impl_->mesh->tet_count(), std::string(impl_->model->name()).c_str(),
+                impl_->integrator->dt_s(), impl_->instruments.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
+  return b;
+}
+
+ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration_s, const std::function<void(const std::string&)>& status) {
+  Impl& s = *impl_;
+  ServerStats stats;
+  using clock = std::chrono::steady_clock;
+  const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / s.scene.physics_rate_hz));
+  const auto start = clock::now();
+  auto next = start;
+  auto last_report = start;
+  std::vector<double> step_us, jitter_us;
+  std::uint64_t ticks_at_report = 0;
+  while (!stop.load()) {
+    const auto tick_start = clock::now();
+    jitter_us.push_back(std::chrono::duration<double, std::micro>(tick_start - next).count());
+    s.take_sessions();
+    s.take_commands();
+    const auto t0 = clock::now();
+    try {
+      s.integrator->advance(s.state, 1.0 / s.scene.physics_rate_hz);
+    } catch (const SimulationError& e) {
+      // Keep serving: the state was rolled back to the last good step; report it.
+      if (status) status(std::string("physics: ") + e.what());
+    }
+    const auto t1 = clock::now();
+    step_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    s.publish_forces(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), stats);
+    ++stats.ticks;
+    if (t1 - last_report >= std::chrono::seconds(1)) {
+      const double seconds = std::chrono::duration<double>(t1 - last_report).count();
+      stats.rate_hz = static_cast<double>(stats.ticks - ticks_at_report) / seconds;
+      stats.step_p50_us = percentile(step_us, 0.5);
+      stats.step_p99_us = percentile(step_us, 0.99);
+      stats.step_max_us = *std::max_element(step_us.begin(), step_us.end());
+      stats.jitter_p99_us = percentile(jitter_us, 0.99);
+      stats.rejected = s.rejected;
+      s.telemetry.write(0, proto::encode(proto::TelemetryReport{proto::now_ns(), stats.ticks, stats.overruns, stats.rejected, stats.rate_hz,
+                                                                stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us}));
+      if (status) {
+        char line[300];
+        int owned = 0;
+        double fmax = 0;
+        for (const auto& [id, inst] : s.instruments) {
+          owned += inst.owner != 0;
+          fmax = std::max(fmax, inst.result.force_on_tool.norm());
+        }
+        std::snprintf(line, sizeof line, "%.0f Hz physics, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, overruns %llu, "
+                      "%d instruments claimed, |F| %.3f N, rejected %llu",
+                      stats.rate_hz, stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
+                      static_cast<unsigned long long>(stats.overruns), owned, fmax, static_cast<unsigned long long>(stats.rejected));
+        status(line);
+      }
+      step_us.clear();
+      jitter_us.clear();
+      last_report = t1;
+      ticks_at_report = stats.ticks;
+    }
+    if (duration_s > 0 && std::chrono::duration<double>(t1 - start).count() >= duration_s) break;
+    next += period;
+    const auto now = clock::now();
+    if (now > next) {
+      ++stats.overruns;  // missed the deadline: do not try to catch up with a burst
+      next = now;
+    } else {
+      std::this_thread::sleep_until(next);
+    }
+  }
+  stats.rejected = s.rejected;
+  return stats;
+}
+
+}  // namespace viscera::runtime

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Integration, as separate processes over a real DDS domain on loopback with the project's Cyclone
+# configuration: viscera-server runs the liver scene; haptic-client claims a probe and presses it
+# into the liver and back at 1 kHz. The force must oppose the motion and grow with depth; the
+# server must stop cleanly on SIGINT. Usage: probe_press_test.sh BUILD_DIR SOURCE_DIR
+set -u
+build="$1"; src="$2"
+tmp="$(mktemp -d)"; trap 'kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
+export CYCLONEDDS_URI="file://$src/deploy/cyclonedds.xml"
+# A domain of its own, so that parallel runs on one machine do not meet.
+domain=$(( (RANDOM % 200) + 1 ))
+sed "s/\"domain_id\": 0/\"domain_id\": $domain/" "$src/data/scenes/liver.json" > "$tmp/scene.json"
+sed -i "s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" "$tmp/scene.json"
+"$build/server/runtime/viscera-server" --scene "$tmp/scene.json" > "$tmp/server.log" 2>&1 &
+server=$!
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --duration 4 --depth 0.03 --report "$tmp/report.json" > "$tmp/client.log" 2>&1
+client_rc=$?
+kill -INT "$server"
+wait "$server"; server_rc=$?
+cat "$tmp/client.log" "$tmp/server.log"
+failures=0; passed=0
+check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
+check "client exit code 0 (got $client_rc)" "[ $client_rc -eq 0 ]"
+check "server exit code 0 after SIGINT (got $server_rc)" "[ $server_rc -eq 0 ]"
+check "server reports a clean stop" "grep -q 'stopped after' '$tmp/server.log'"
+python3 - "$tmp/report.json" <<'PY' || failures=$((failures+1))
+import json, sys
+r = json.load(open(sys.argv[1]))
+s = [x for x in r["samples"] if x["in_contact"]]
+half = r["duration_s"] / 2
+down = [x for x in s if x["t_s"] < half]
+assert len(down) > 200, f"only {len(down)} contact samples while pressing"
+# Opposes the motion: the tool moves down (-z), the tissue pushes it up (+z).
+up = sum(1 for x in down if x["force_n"][2] > 0) / len(down)
+assert up > 0.95, f"force opposes the press in only {100*up:.0f}% of samples"
+# Grows with depth: mean vertical force in the deepest third above that of the shallowest third.
+down.sort(key=lambda x: -x["tip_z_m"])
+n = len(down) // 3
+shallow = sum(x["force_n"][2] for x in down[:n]) / n
+deep = sum(x["force_n"][2] for x in down[-n:]) / n
+assert deep > 1.5 * shallow, f"force does not grow with depth: {shallow:.3f} N shallow, {deep:.3f} N deep"
+rt = r["round_trip_us"]
+print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% opposing, mean F_z {shallow:.2f} N shallow, {deep:.2f} N deep; "
+      f"round trip p50 {rt['p50']:.0f} us, p99 {rt['p99']:.0f} us, max {rt['max']:.0f} us over {rt['samples']} commands")
+PY
+[ $? -eq 0 ] && passed=$((passed+1))
+echo "probe_press_test: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,88 @@
+// Every decoder against good, truncated, garbage, wrong-schema and out-of-range payloads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "viscera/protocol/messages.hpp"
+
+using namespace viscera::protocol;
+
+namespace {
+Command good_command() {
+  Command c;
+  c.instrument_id = 1;
+  c.client_id = 7;
+  c.seq = 42;
+  c.client_stamp_ns = 123456789;
+  c.tip_position = {0.01, -0.02, 0.03};
+  return c;
+}
+}  // namespace
+
+TEST(Messages, RoundTripsEveryMessage) {
+  std::string why;
+  const auto c = decode_command(encode(good_command()), &why);
+  ASSERT_TRUE(c) << why;
+  EXPECT_EQ(c->seq, 42u);
+  EXPECT_EQ(c->tip_position[1], -0.02);
+  Force f;
+  f.instrument_id = 1;
+  f.client_id = 7;
+  f.command_seq = 42;
+  f.force = {0.1, 0.2, 3.0};
+  f.in_contact = true;
+  f.stiffness[4] = 200;
+  const auto fd = decode_force(encode(f), &why);
+  ASSERT_TRUE(fd) << why;
+  EXPECT_EQ(fd->force[2], 3.0);
+  EXPECT_TRUE(fd->in_contact);
+  EXPECT_EQ(fd->stiffness[4], 200);
+  const auto s = decode_session_request(encode(SessionRequest{7, Action::release_instrument, 2}), &why);
+  ASSERT_TRUE(s) << why;
+  EXPECT_EQ(s->action, Action::release_instrument);
+  Scene sc;
+  sc.name = "liver";
+  sc.physics_rate_hz = 1000;
+  sc.instruments.push_back({1, false, 0.006, 7});
+  const auto sd = decode_scene(encode(sc), &why);
+  ASSERT_TRUE(sd) << why;
+  EXPECT_EQ(sd->instruments.at(0).owner_client_id, 7u);
+  EXPECT_TRUE(decode_telemetry(encode(TelemetryReport{1, 2, 3, 4, 999.0, 1, 2, 3, 4}), &why));
+}
+
+TEST(Messages, RejectsTruncatedGarbageWrongSchemaAndBadNumbers) {
+  std::string why;
+  auto bytes = encode(good_command());
+  for (std::size_t n : {0ul, 4ul, bytes.size() / 2, bytes.size() - 4}) {
+    const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<long>(n));
+    EXPECT_FALSE(decode_command(cut, &why)) << "truncated to " << n;
+  }
+  std::mt19937_64 rng(1);
+  int accepted = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<std::uint8_t> g(8 + rng() % 200);
+    for (auto& b : g) b = static_cast<std::uint8_t>(rng());
+    accepted += decode_command(g, &why).has_value();
+  }
+  EXPECT_EQ(accepted, 0);
+  Scene sc;
+  sc.name = "a scene, not a command";
+  EXPECT_FALSE(decode_command(encode(sc), &why));  // wrong schema
+  Command c = good_command();
+  c.tip_position[0] = std::nan("");
+  EXPECT_FALSE(decode_command(encode(c), &why));
+  EXPECT_NE(why.find("tip_position"), std::string::npos);
+  c = good_command();
+  c.tip_position[2] = 1e6;
+  EXPECT_FALSE(decode_command(encode(c), &why));
+  c = good_command();
+  c.orientation = {2, 0, 0, 0};
+  EXPECT_FALSE(decode_command(encode(c), &why));
+  c = good_command();
+  c.client_id = 0;
+  EXPECT_FALSE(decode_command(encode(c), &why));
+  Force f;
+  f.force = {std::numeric_limits<double>::infinity(), 0, 0};
+  EXPECT_FALSE(decode_force(encode(f), &why));
+}
