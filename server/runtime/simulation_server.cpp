@@ -44,6 +44,7 @@ struct SimulationServer::Impl {
     std::unique_ptr<ProbeContact> contact;
     std::uint32_t owner = 0;
     bool has_command = false;
+    std::int64_t last_heard_ns = 0;  // owner's last command or claim
     proto::Command last;
     ContactResult result;
   };
@@ -128,6 +129,7 @@ struct SimulationServer::Impl {
       if (req->action == proto::Action::claim_instrument && inst.owner == 0) {
         inst.owner = req->client_id;
         inst.has_command = false;
+        inst.last_heard_ns = proto::now_ns();
         changed = true;
       } else if (req->action == proto::Action::release_instrument && inst.owner == req->client_id) {
         inst.owner = 0;
@@ -151,11 +153,27 @@ struct SimulationServer::Impl {
         ++rejected;  // not this client's instrument
         return;
       }
+      it->second.last_heard_ns = proto::now_ns();
       if (!it->second.has_command || c->seq > it->second.last.seq) {
         it->second.last = *c;
         it->second.has_command = true;
       }
     });
+  }
+
+  /// A client that died or went silent for longer than the lease loses its instrument, which is
+  /// released safely (no force on the tissue from it any more).
+  void release_silent(std::int64_t lease_ns, const std::function<void(const std::string&)>& status) {
+    const std::int64_t now = proto::now_ns();
+    bool changed = false;
+    for (auto& [id, inst] : instruments)
+      if (inst.owner != 0 && now - inst.last_heard_ns > lease_ns) {
+        if (status) status("instrument " + std::to_string(id) + " released: client " + std::to_string(inst.owner) + " silent for more than the lease");
+        inst.owner = 0;
+        inst.has_command = false;
+        changed = true;
+      }
+    if (changed) publish_scene();
   }
 
   void publish_forces(std::int64_t step_time_ns, ServerStats& stats) {
@@ -205,6 +223,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     jitter_us.push_back(std::chrono::duration<double, std::micro>(tick_start - next).count());
     s.take_sessions();
     s.take_commands();
+    s.release_silent(500'000'000, status);  // the DDS liveliness lease of the command stream
     const auto t0 = clock::now();
     try {
       s.integrator->advance(s.state, 1.0 / s.scene.physics_rate_hz);

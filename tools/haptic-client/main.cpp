@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
     const double top = scene->bounds_max[2];
     std::printf("haptic-client: scene %s, instrument %u claimed; pressing at (%.3f, %.3f) from z = %.3f m to %.3f m\n", scene->name.c_str(),
                 instrument, cx, cy, top + 0.01, top - depth);
+    std::fflush(stdout);
     nlohmann::json samples = nlohmann::json::array();
     const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / rate));
     const auto start = std::chrono::steady_clock::now();
@@ -62,6 +63,7 @@ int main(int argc, char** argv) {
           std::printf("t = %5.2f s  tip z %.4f m  force (%.3f, %.3f, %.3f) N%s\n", t, z, f->force[0], f->force[1], f->force[2],
                       f->in_contact ? "  contact" : "");
           last_print = t;
+          std::fflush(stdout);
         }
       }
       next += period;

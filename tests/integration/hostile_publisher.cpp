@@ -1,0 +1,49 @@
+// Writes hostile payloads on the command and session topics: garbage, truncated commands,
+// another schema, NaN positions, and commands for an instrument the sender does not own.
+// Usage: hostile_publisher DOMAIN SECONDS
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <thread>
+
+#include "viscera/protocol/dds.hpp"
+#include "viscera/protocol/messages.hpp"
+
+using namespace viscera::protocol;
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: hostile_publisher DOMAIN SECONDS\n");
+    return 2;
+  }
+  Participant p(static_cast<std::uint32_t>(std::atoi(argv[1])));
+  Writer commands(p, Stream::instrument_command), sessions(p, Stream::session_request);
+  std::mt19937_64 rng(99);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[2]));
+  long sent = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    std::vector<std::uint8_t> garbage(8 + rng() % 100);
+    for (auto& b : garbage) b = static_cast<std::uint8_t>(rng());
+    Command c;
+    c.instrument_id = 1;
+    c.client_id = 66;  // not the owner
+    c.tip_position = {0, 0, 0};
+    std::vector<std::uint8_t> good = encode(c);
+    std::vector<std::uint8_t> truncated(good.begin(), good.begin() + static_cast<long>(good.size() / 2));
+    c.tip_position = {std::nan(""), 0, 0};
+    Scene wrong;
+    wrong.name = "not a command";
+    commands.write(900, garbage);
+    commands.write(901, truncated);
+    commands.write(902, encode(c));
+    commands.write(903, encode(wrong));
+    commands.write(904, good);  // valid, but for an instrument owned by someone else
+    sessions.write(905, garbage);
+    sent += 6;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  std::printf("hostile_publisher: sent %ld hostile payloads\n", sent);
+  return 0;
+}
