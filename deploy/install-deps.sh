@@ -15,6 +15,7 @@ packages=(
   nlohmann-json3-dev       # JSON for scene, material and data-set files
   python3                  # bench summary and test scripts that read JSON
   libpugixml-dev           # XML parsing of VTU meshes
+  clang libclang-rt-14-dev # libFuzzer for the message-decoder fuzz target
 )
 
 missing=()

@@ -11,6 +11,9 @@
 
 #include "common/command_line.hpp"
 #include "viscera/client/client.hpp"
+#include "viscera/client/local_force_model.hpp"
+
+#include <map>
 
 int main(int argc, char** argv) {
   viscera::cli::CommandLine cl("haptic-client",
@@ -24,12 +27,16 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "length of the run [s]", "4");
   cl.flag("rate", "HZ", "device rate [Hz]", "1000");
   cl.flag("depth", "M", "press depth below the top of the organ's bounding box [m]", "0.03");
+  cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
   cl.flag("report", "FILE.json", "write samples and statistics here");
   try {
     if (!cl.parse(argc, argv)) return 0;
     const auto client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
     const auto instrument = static_cast<std::uint32_t>(cl.number_in("instrument", 1, 1e6));
     const double duration = cl.number_in("duration", 0.1, 3600), rate = cl.number_in("rate", 1, 20000), depth = cl.number_in("depth", 0, 0.2);
+    const double max_force = cl.number_in("max-force", 0.1, 1000);
+    std::map<std::uint64_t, viscera::protocol::Vector3> sent;  // tip of each recent command, for the local model
+    std::uint64_t seq = 0, clamps = 0;
     viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)), client_id);
     const auto scene = client.wait_for_scene(std::chrono::seconds(10));
     if (!scene) {
@@ -56,9 +63,17 @@ int main(int argc, char** argv) {
       const double phase = t / duration;  // 0..1: down then up
       const double z = (top + 0.01) - (0.01 + depth) * (phase < 0.5 ? 2 * phase : 2 * (1 - phase));
       client.send_tip(instrument, {cx, cy, z});
+      sent[++seq] = {cx, cy, z};
+      if (sent.size() > 4096) sent.erase(sent.begin());
       if (const auto f = client.poll_force(instrument)) {
+        // The force rendered now, from the server's latest local model at the current tip.
+        const auto it = sent.find(f->command_seq);
+        const auto rendered = it != sent.end() ? viscera::client::render_local_model(*f, it->second, {cx, cy, z}, max_force)
+                                               : viscera::client::RenderedForce{};
+        clamps += rendered.clamped;
         samples.push_back({{"t_s", t}, {"tip_z_m", z}, {"force_n", {f->force[0], f->force[1], f->force[2]}}, {"in_contact", f->in_contact},
-                           {"command_seq", f->command_seq}});
+                           {"rendered_force_n", {rendered.force[0], rendered.force[1], rendered.force[2]}},
+                           {"model_age_commands", seq - f->command_seq}, {"command_seq", f->command_seq}});
         if (t - last_print >= 0.25) {
           std::printf("t = %5.2f s  tip z %.4f m  force (%.3f, %.3f, %.3f) N%s\n", t, z, f->force[0], f->force[1], f->force[2],
                       f->in_contact ? "  contact" : "");
@@ -71,8 +86,9 @@ int main(int argc, char** argv) {
     }
     client.release(instrument);
     const auto rtt = client.round_trip();
-    std::printf("haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected\n", rtt.samples, rtt.p50_us,
-                rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()));
+    std::printf("haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
+                rtt.samples, rtt.p50_us, rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()),
+                static_cast<unsigned long long>(clamps), max_force);
     if (cl.has("report")) {
       nlohmann::json r{{"scene", scene->name}, {"instrument", instrument}, {"client_id", client_id}, {"rate_hz", rate},
                        {"duration_s", duration}, {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
