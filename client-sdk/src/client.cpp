@@ -59,13 +59,14 @@ void Client::release(std::uint32_t instrument_id) {
   impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, proto::Action::release_instrument, instrument_id}));
 }
 
-void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip) {
+void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad) {
   proto::Command c;
   c.instrument_id = instrument_id;
   c.client_id = client_id_;
   c.seq = ++seq_;
   c.client_stamp_ns = proto::now_ns();
   c.tip_position = tip;
+  c.jaw_opening = jaw_opening_rad;
   impl_->commands.write(instrument_id, proto::encode(c));
 }
 

@@ -47,6 +47,7 @@ SceneSpec read_scene_file(const std::string& path) {
   s.damping_per_s = number(o, "damping_per_s", "organ.", 0, 1e4, 0.0);
   s.volume_term = number(o, "volume_term", "organ.", 0, 0.99, 0.5);
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
+  s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
   if (o.contains("fix_slab")) {
     const json& f = o["fix_slab"];
     if (!f.is_array() || f.size() != 3 || !f[0].is_string() || !f[1].is_string() || !f[2].is_number())
@@ -69,7 +70,9 @@ SceneSpec read_scene_file(const std::string& path) {
     if (spec.id == 0) throw InputError(path, 0, prefix + "id", "missing");
     if (!ids.insert(spec.id).second) throw InputError(path, 0, prefix + "id", std::to_string(spec.id) + " is used twice");
     spec.kind = i.value("kind", "probe");
-    if (spec.kind != "probe") throw InputError(path, 0, prefix + "kind", "'" + spec.kind + "' is not supported yet (probe)");
+    if (spec.kind != "probe" && spec.kind != "grasper")
+      throw InputError(path, 0, prefix + "kind", "'" + spec.kind + "' is not probe or grasper");
+    spec.grasp_radius_m = number(i, "grasp_radius_m", prefix, 1e-4, 0.05, 0.01);
     spec.tip_radius_m = number(i, "tip_radius_m", prefix, 1e-4, 0.05, 0.005);
     s.instruments.push_back(spec);
   }

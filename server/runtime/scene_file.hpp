@@ -12,6 +12,7 @@ struct InstrumentSpec {
   std::uint32_t id = 0;
   std::string kind = "probe";  ///< probe | grasper
   double tip_radius_m = 0.005;
+  double grasp_radius_m = 0.01;  ///< grasper: surface nodes this close to the tip are grasped
 };
 
 struct SceneSpec {
@@ -21,6 +22,7 @@ struct SceneSpec {
   std::string mesh, material, model = "gps_energy";
   double scale_m_per_unit = 1.0, damping_per_s = 0.0, volume_term = 0.5;
   double contact_stiffness_n_per_m = 200.0;
+  double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
   std::string fix_axis = "z", fix_side = "max";
   double fix_fraction = 0.2;
   std::vector<InstrumentSpec> instruments;

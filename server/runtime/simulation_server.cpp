@@ -45,10 +45,13 @@ struct SimulationServer::Impl {
     std::uint32_t owner = 0;
     bool has_command = false;
     std::int64_t last_heard_ns = 0;  // owner's last command or claim
+    // Grasper: nodes held by the closed jaws, with their offsets from the tip when grasped.
+    std::vector<std::pair<std::int32_t, Vec3>> grasped;
     proto::Command last;
     ContactResult result;
   };
   std::map<std::uint32_t, Instrument> instruments;
+  std::vector<std::int32_t> surface_nodes;
 
   proto::Participant participant;
   proto::Reader commands, sessions;
@@ -84,18 +87,29 @@ struct SimulationServer::Impl {
     else slab.lo[a] = bounds.hi[a] - s.fix_fraction * extent;
     bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
     bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f) {
-      for (auto& [id, inst] : instruments)
-        if (inst.owner != 0 && inst.has_command) {
-          const auto& p = inst.last.tip_position;
-          inst.result = inst.contact->apply(Vec3(p[0], p[1], p[2]), x, f);
-        } else {
+      for (auto& [id, inst] : instruments) {
+        if (inst.owner == 0 || !inst.has_command) {
           inst.result = {};
+          continue;
         }
+        const auto& p = inst.last.tip_position;
+        const Vec3 tip(p[0], p[1], p[2]);
+        inst.result = inst.contact->apply(tip, x, f);
+        // Grasped nodes follow the jaws through stiff springs; the tool feels their reaction.
+        for (const auto& [node, offset] : inst.grasped) {
+          const Vec3 pull = scene.grasp_stiffness_n_per_m * (tip + offset - x[node]);
+          f[node] += pull;
+          inst.result.force_on_tool -= pull;
+        }
+        if (!inst.grasped.empty()) inst.result.in_contact = true;
+      }
     };
     integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
                                                       ExplicitOptions{0.9, 0.0, s.damping_per_s, 2.0});
     state = State::at_rest(*mesh);
-    const auto surface = extract_boundary(*mesh).triangles;
+    const BoundarySurface boundary = extract_boundary(*mesh);
+    const auto& surface = boundary.triangles;
+    surface_nodes = boundary.nodes;
     for (const auto& spec : s.instruments)
       instruments[spec.id] = Instrument{spec, std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m)};
     publish_scene();
@@ -105,7 +119,7 @@ struct SimulationServer::Impl {
     proto::Scene sc;
     sc.name = scene.name;
     sc.physics_rate_hz = scene.physics_rate_hz;
-    for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, false, inst.spec.tip_radius_m, inst.owner});
+    for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, inst.spec.kind == "grasper", inst.spec.tip_radius_m, inst.owner});
     sc.bounds_min = {bounds.lo.x(), bounds.lo.y(), bounds.lo.z()};
     sc.bounds_max = {bounds.hi.x(), bounds.hi.y(), bounds.hi.z()};
     scene_state.write(0, proto::encode(sc));
@@ -134,6 +148,7 @@ struct SimulationServer::Impl {
       } else if (req->action == proto::Action::release_instrument && inst.owner == req->client_id) {
         inst.owner = 0;
         inst.has_command = false;
+        inst.grasped.clear();
         changed = true;
       }
     });
@@ -157,8 +172,23 @@ struct SimulationServer::Impl {
       if (!it->second.has_command || c->seq > it->second.last.seq) {
         it->second.last = *c;
         it->second.has_command = true;
+        update_grasp(it->second);
       }
     });
+  }
+
+  /// Graspers: jaws closing (opening below 0.1 rad) grasp the surface nodes within the grasp
+  /// radius of the tip; opening them (above 0.2 rad, hysteresis) releases them.
+  void update_grasp(Instrument& inst) {
+    if (inst.spec.kind != "grasper") return;
+    const auto& p = inst.last.tip_position;
+    const Vec3 tip(p[0], p[1], p[2]);
+    if (inst.grasped.empty() && inst.last.jaw_opening < 0.1) {
+      for (auto n : surface_nodes)
+        if ((state.x[n] - tip).norm() < inst.spec.grasp_radius_m) inst.grasped.emplace_back(n, state.x[n] - tip);
+    } else if (!inst.grasped.empty() && inst.last.jaw_opening > 0.2) {
+      inst.grasped.clear();
+    }
   }
 
   /// A client that died or went silent for longer than the lease loses its instrument, which is
@@ -171,6 +201,7 @@ struct SimulationServer::Impl {
         if (status) status("instrument " + std::to_string(id) + " released: client " + std::to_string(inst.owner) + " silent for more than the lease");
         inst.owner = 0;
         inst.has_command = false;
+        inst.grasped.clear();  // a dead client's grasper lets go
         changed = true;
       }
     if (changed) publish_scene();

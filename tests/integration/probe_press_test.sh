@@ -15,14 +15,37 @@ sed -i "s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/mater
 server=$!
 "$build/tools/haptic-client/haptic-client" --domain "$domain" --duration 4 --depth 0.03 --report "$tmp/report.json" > "$tmp/client.log" 2>&1
 client_rc=$?
+# Grasp and pull: the grasper (instrument 3) closes its jaws on the top surface, pulls up 2 cm, opens.
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 2 --instrument 3 --script grasp --depth 0 --pull 0.02 \
+  --duration 4 --report "$tmp/grasp.json" >> "$tmp/client.log" 2>&1
+grasp_rc=$?
 kill -INT "$server"
 wait "$server"; server_rc=$?
 cat "$tmp/client.log" "$tmp/server.log"
 failures=0; passed=0
 check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
 check "client exit code 0 (got $client_rc)" "[ $client_rc -eq 0 ]"
+check "grasp client exit code 0 (got $grasp_rc)" "[ $grasp_rc -eq 0 ]"
 check "server exit code 0 after SIGINT (got $server_rc)" "[ $server_rc -eq 0 ]"
 check "server reports a clean stop" "grep -q 'stopped after' '$tmp/server.log'"
+python3 - "$tmp/grasp.json" <<'PY' || failures=$((failures+1))
+import json, sys
+r = json.load(open(sys.argv[1]))
+d = r["duration_s"]
+pulling = [x for x in r["samples"] if 0.35 * d < x["t_s"] < 0.72 * d]
+released = [x for x in r["samples"] if x["t_s"] > 0.85 * d]
+assert pulling and released, "no samples in the pull or release phases"
+down = sum(1 for x in pulling if x["force_n"][2] < 0) / len(pulling)
+assert down > 0.95, f"the grasped tissue pulls back in only {100*down:.0f}% of the pull"
+pulling.sort(key=lambda x: x["tip_z_m"])
+n = len(pulling) // 3
+early = sum(-x["force_n"][2] for x in pulling[:n]) / n
+late = sum(-x["force_n"][2] for x in pulling[-n:]) / n
+assert late > 1.5 * early, f"restoring force does not grow with the pull: {early:.2f} N then {late:.2f} N"
+after = max(abs(x["force_n"][2]) for x in released)
+assert after < 0.05, f"opened jaws still hold the tissue: {after:.3f} N"
+print(f"[ figure ] grasp and pull 2 cm: restoring force {early:.2f} N early, {late:.2f} N late in the pull; {after:.3f} N after opening")
+PY
 python3 - "$tmp/report.json" <<'PY' || failures=$((failures+1))
 import json, sys
 r = json.load(open(sys.argv[1]))

@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "length of the run [s]", "4");
   cl.flag("rate", "HZ", "device rate [Hz]", "1000");
   cl.flag("depth", "M", "press depth below the top of the organ's bounding box [m]", "0.03");
+  cl.flag("script", "NAME", "press (probe) | grasp (grasper: touch the top, close the jaws, pull up PULL, open)", "press");
+  cl.flag("pull", "M", "grasp script: how far to pull up after grasping [m]", "0.02");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
   cl.flag("report", "FILE.json", "write samples and statistics here");
   try {
@@ -34,7 +36,9 @@ int main(int argc, char** argv) {
     const auto client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
     const auto instrument = static_cast<std::uint32_t>(cl.number_in("instrument", 1, 1e6));
     const double duration = cl.number_in("duration", 0.1, 3600), rate = cl.number_in("rate", 1, 20000), depth = cl.number_in("depth", 0, 0.2);
-    const double max_force = cl.number_in("max-force", 0.1, 1000);
+    const double max_force = cl.number_in("max-force", 0.1, 1000), pull = cl.number_in("pull", 0, 0.2);
+    const std::string script = cl.text("script");
+    if (script != "press" && script != "grasp") throw viscera::cli::UsageError("--script: '" + script + "' is not press or grasp");
     std::map<std::uint64_t, viscera::protocol::Vector3> sent;  // tip of each recent command, for the local model
     std::uint64_t seq = 0, clamps = 0;
     viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)), client_id);
@@ -49,8 +53,8 @@ int main(int argc, char** argv) {
     }
     const double cx = 0.5 * (scene->bounds_min[0] + scene->bounds_max[0]), cy = 0.5 * (scene->bounds_min[1] + scene->bounds_max[1]);
     const double top = scene->bounds_max[2];
-    std::printf("haptic-client: scene %s, instrument %u claimed; pressing at (%.3f, %.3f) from z = %.3f m to %.3f m\n", scene->name.c_str(),
-                instrument, cx, cy, top + 0.01, top - depth);
+    std::printf("haptic-client: scene %s, instrument %u claimed; script %s at (%.3f, %.3f), from z = %.3f m down to %.3f m\n",
+                scene->name.c_str(), instrument, script.c_str(), cx, cy, top + 0.01, top - depth);
     std::fflush(stdout);
     nlohmann::json samples = nlohmann::json::array();
     const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / rate));
@@ -60,9 +64,18 @@ int main(int argc, char** argv) {
     for (;;) {
       const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (t >= duration) break;
-      const double phase = t / duration;  // 0..1: down then up
-      const double z = (top + 0.01) - (0.01 + depth) * (phase < 0.5 ? 2 * phase : 2 * (1 - phase));
-      client.send_tip(instrument, {cx, cy, z});
+      const double phase = t / duration;  // 0..1
+      double z = 0, jaw = 0.5;
+      if (script == "press") {  // down then up
+        z = (top + 0.01) - (0.01 + depth) * (phase < 0.5 ? 2 * phase : 2 * (1 - phase));
+      } else {  // grasp: 0-0.25 descend to the surface, close; 0.25-0.75 pull up; 0.75-1 open and hold
+        const double surface = top - depth;
+        if (phase < 0.25) z = (top + 0.01) - (top + 0.01 - surface) * (phase / 0.25);
+        else if (phase < 0.75) z = surface + pull * (phase - 0.25) / 0.5;
+        else z = surface + pull;
+        jaw = (phase >= 0.2 && phase < 0.75) ? 0.0 : 0.5;
+      }
+      client.send_tip(instrument, {cx, cy, z}, jaw);
       sent[++seq] = {cx, cy, z};
       if (sent.size() > 4096) sent.erase(sent.begin());
       if (const auto f = client.poll_force(instrument)) {
@@ -71,7 +84,7 @@ int main(int argc, char** argv) {
         const auto rendered = it != sent.end() ? viscera::client::render_local_model(*f, it->second, {cx, cy, z}, max_force)
                                                : viscera::client::RenderedForce{};
         clamps += rendered.clamped;
-        samples.push_back({{"t_s", t}, {"tip_z_m", z}, {"force_n", {f->force[0], f->force[1], f->force[2]}}, {"in_contact", f->in_contact},
+        samples.push_back({{"t_s", t}, {"tip_z_m", z}, {"jaw_rad", jaw}, {"force_n", {f->force[0], f->force[1], f->force[2]}}, {"in_contact", f->in_contact},
                            {"rendered_force_n", {rendered.force[0], rendered.force[1], rendered.force[2]}},
                            {"model_age_commands", seq - f->command_seq}, {"command_seq", f->command_seq}});
         if (t - last_print >= 0.25) {

@@ -31,8 +31,9 @@ class Client {
   /// Claims an instrument; true once the scene state shows this client as its owner.
   bool claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
   void release(std::uint32_t instrument_id);
-  /// Sends the instrument's tip position [m] (next sequence number, current stamp).
-  void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip);
+  /// Sends the instrument's tip position [m] and jaw opening [rad] (next sequence number,
+  /// current stamp).
+  void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip, double jaw_opening_rad = 0.5);
   /// Takes the forces that arrived; returns the newest for the instrument, if any. Each one
   /// whose echoed stamp is this client's adds a round-trip sample.
   std::optional<protocol::Force> poll_force(std::uint32_t instrument_id);
