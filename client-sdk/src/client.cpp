@@ -91,6 +91,16 @@ std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
   return it->second;
 }
 
+std::optional<proto::Force> Client::wait_force(std::uint32_t instrument_id, std::chrono::steady_clock::time_point deadline) {
+  for (;;) {
+    auto f = poll_force(instrument_id);
+    if (f && f->command_seq == seq_) return f;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) return f;
+    impl_->forces.wait(deadline - now);
+  }
+}
+
 LatencyStats Client::round_trip() const {
   LatencyStats s;
   s.samples = rtt_us_.size();

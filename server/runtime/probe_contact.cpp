@@ -54,7 +54,8 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
     if (!interior && (s < 0 || (centre - q).norm() >= radius_)) continue;
     const double depth = radius_ - s;
     const Vec3 push = stiffness_ * depth * n;  // on the tool, out of the tissue
-    for (int k = 0; k < 3; ++k) f[t[k]] -= w[k] * push;
+    if (!f.empty())
+      for (int k = 0; k < 3; ++k) f[t[k]] -= w[k] * push;
     r.force_on_tool += push;
     K += stiffness_ * n * n.transpose();
     weighted_point += depth * q;

@@ -155,28 +155,6 @@ struct SimulationServer::Impl {
     if (changed) publish_scene();
   }
 
-  void take_commands() {
-    commands.take([&](const proto::Received& r) {
-      std::string why;
-      const auto c = proto::decode_command(r.payload, &why);
-      if (!c) {
-        ++rejected;
-        return;
-      }
-      const auto it = instruments.find(c->instrument_id);
-      if (it == instruments.end() || it->second.owner != c->client_id) {
-        ++rejected;  // not this client's instrument
-        return;
-      }
-      it->second.last_heard_ns = proto::now_ns();
-      if (!it->second.has_command || c->seq > it->second.last.seq) {
-        it->second.last = *c;
-        it->second.has_command = true;
-        update_grasp(it->second);
-      }
-    });
-  }
-
   /// Graspers: jaws closing (opening below 0.1 rad) grasp the surface nodes within the grasp
   /// radius of the tip; opening them (above 0.2 rad, hysteresis) releases them.
   void update_grasp(Instrument& inst) {
@@ -207,24 +185,63 @@ struct SimulationServer::Impl {
     if (changed) publish_scene();
   }
 
-  void publish_forces(std::int64_t step_time_ns, ServerStats& stats) {
-    for (const auto& [id, inst] : instruments) {
-      if (inst.owner == 0 || !inst.has_command) continue;
-      proto::Force f;
-      f.instrument_id = id;
-      f.client_id = inst.owner;
-      f.command_seq = inst.last.seq;
-      f.command_client_stamp_ns = inst.last.client_stamp_ns;
-      f.server_stamp_ns = proto::now_ns();
-      f.step_time_ns = step_time_ns;
-      f.force = {inst.result.force_on_tool.x(), inst.result.force_on_tool.y(), inst.result.force_on_tool.z()};
-      f.in_contact = inst.result.in_contact;
-      f.contact_point = {inst.result.point.x(), inst.result.point.y(), inst.result.point.z()};
-      f.contact_normal = {inst.result.normal.x(), inst.result.normal.y(), inst.result.normal.z()};
-      f.stiffness = inst.result.stiffness;
-      forces.write(id, proto::encode(f));
-      ++stats.forces_sent;
+  /// Commands that arrive between ticks are answered at once: the reaction at the commanded pose
+  /// on the current tissue state (contact query, no step), so the round trip does not wait for
+  /// the next tick. The tick then steps the tissue with the newest pose.
+  void answer_new_commands(ServerStats& stats) {
+    std::vector<std::uint32_t> updated;
+    commands.take([&](const proto::Received& r) {
+      std::string why;
+      const auto c = proto::decode_command(r.payload, &why);
+      if (!c) {
+        ++rejected;
+        return;
+      }
+      const auto it = instruments.find(c->instrument_id);
+      if (it == instruments.end() || it->second.owner != c->client_id) {
+        ++rejected;
+        return;
+      }
+      Instrument& inst = it->second;
+      inst.last_heard_ns = proto::now_ns();
+      if (!inst.has_command || c->seq > inst.last.seq) {
+        inst.last = *c;
+        inst.has_command = true;
+        update_grasp(inst);
+        updated.push_back(c->instrument_id);
+      }
+    });
+    for (auto id : updated) {
+      Instrument& inst = instruments[id];
+      const auto& p = inst.last.tip_position;
+      const Vec3 tip(p[0], p[1], p[2]);
+      inst.result = inst.contact->apply(tip, state.x, {});
+      for (const auto& [node, offset] : inst.grasped) inst.result.force_on_tool -= scene.grasp_stiffness_n_per_m * (tip + offset - state.x[node]);
+      if (!inst.grasped.empty()) inst.result.in_contact = true;
+      publish_force(id, inst, 0, stats);
     }
+  }
+
+  void publish_force(std::uint32_t id, const Instrument& inst, std::int64_t step_time_ns, ServerStats& stats) {
+    proto::Force f;
+    f.instrument_id = id;
+    f.client_id = inst.owner;
+    f.command_seq = inst.last.seq;
+    f.command_client_stamp_ns = inst.last.client_stamp_ns;
+    f.server_stamp_ns = proto::now_ns();
+    f.step_time_ns = step_time_ns;
+    f.force = {inst.result.force_on_tool.x(), inst.result.force_on_tool.y(), inst.result.force_on_tool.z()};
+    f.in_contact = inst.result.in_contact;
+    f.contact_point = {inst.result.point.x(), inst.result.point.y(), inst.result.point.z()};
+    f.contact_normal = {inst.result.normal.x(), inst.result.normal.y(), inst.result.normal.z()};
+    f.stiffness = inst.result.stiffness;
+    forces.write(id, proto::encode(f));
+    ++stats.forces_sent;
+  }
+
+  void publish_forces(std::int64_t step_time_ns, ServerStats& stats) {
+    for (const auto& [id, inst] : instruments)
+      if (inst.owner != 0 && inst.has_command) publish_force(id, inst, step_time_ns, stats);
   }
 };
 
@@ -253,7 +270,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     const auto tick_start = clock::now();
     jitter_us.push_back(std::chrono::duration<double, std::micro>(tick_start - next).count());
     s.take_sessions();
-    s.take_commands();
+    s.answer_new_commands(stats);
     s.release_silent(500'000'000, status);  // the DDS liveliness lease of the command stream
     const auto t0 = clock::now();
     try {
@@ -302,7 +319,10 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       ++stats.overruns;  // missed the deadline: do not try to catch up with a burst
       next = now;
     } else {
-      std::this_thread::sleep_until(next);
+      // Until the next tick: answer commands as they arrive.
+      while (clock::now() < next) {
+        if (s.commands.wait(next - clock::now())) s.answer_new_commands(stats);
+      }
     }
   }
   stats.rejected = s.rejected;

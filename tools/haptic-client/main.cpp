@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
       client.send_tip(instrument, {cx, cy, z}, jaw);
       sent[++seq] = {cx, cy, z};
       if (sent.size() > 4096) sent.erase(sent.begin());
-      if (const auto f = client.poll_force(instrument)) {
+      // Wait for the answer to this command until shortly before the next device period.
+      if (const auto f = client.wait_force(instrument, next + period - std::chrono::microseconds(100))) {
         // The force rendered now, from the server's latest local model at the current tip.
         const auto it = sent.find(f->command_seq);
         const auto rendered = it != sent.end() ? viscera::client::render_local_model(*f, it->second, {cx, cy, z}, max_force)

@@ -37,6 +37,9 @@ class Client {
   /// Takes the forces that arrived; returns the newest for the instrument, if any. Each one
   /// whose echoed stamp is this client's adds a round-trip sample.
   std::optional<protocol::Force> poll_force(std::uint32_t instrument_id);
+  /// Waits (at most until `deadline`) for a force answering the newest command of the
+  /// instrument; returns the newest force seen either way.
+  std::optional<protocol::Force> wait_force(std::uint32_t instrument_id, std::chrono::steady_clock::time_point deadline);
   LatencyStats round_trip() const;
   std::uint32_t id() const { return client_id_; }
   /// Payloads that failed verification and were dropped.
