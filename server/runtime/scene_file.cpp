@@ -46,6 +46,7 @@ SceneSpec read_scene_file(const std::string& path) {
   s.scale_m_per_unit = number(o, "scale_m_per_unit", "organ.", 1e-6, 1e3, 1.0);
   s.damping_per_s = number(o, "damping_per_s", "organ.", 0, 1e4, 0.0);
   s.volume_term = number(o, "volume_term", "organ.", 0, 0.99, 0.5);
+  s.refine = static_cast<int>(number(o, "refine", "organ.", 0, 2, 0));
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
   if (o.contains("fix_slab")) {

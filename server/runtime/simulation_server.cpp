@@ -11,6 +11,7 @@
 #include "material/material_file.hpp"
 #include "mesh/boundary_surface.hpp"
 #include "mesh/mesh_reader.hpp"
+#include "mesh/refinement.hpp"
 #include "model/model_factory.hpp"
 #include "probe_contact.hpp"
 #include "viscera/protocol/dds.hpp"
@@ -67,6 +68,7 @@ struct SimulationServer::Impl {
         scene_state(participant, proto::Stream::scene_state),
         telemetry(participant, proto::Stream::telemetry) {
     mesh = std::make_shared<TetMesh>(read_tet_mesh(s.mesh));
+    for (int k = 0; k < s.refine; ++k) *mesh = refine_uniform(*mesh);
     scale_mesh(*mesh, s.scale_m_per_unit);
     const Material material = read_material_file(s.material);
     Mat6 D = material.elasticity;
