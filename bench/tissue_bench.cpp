@@ -58,6 +58,14 @@ std::unique_ptr<ForceModel> make_model(const std::string& name, const Level* lev
   return make_force_model(name, level->mesh, {material()});
 }
 
+void count_tets(benchmark::State& st, const Level* level) {
+  const double tets = static_cast<double>(level->mesh->tet_count());
+  st.counters["tets"] = tets;
+  st.counters["tet_updates_per_s"] = benchmark::Counter(tets * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
+  st.counters["ns_per_tet"] = benchmark::Counter(tets * static_cast<double>(st.iterations()),
+                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 void force(benchmark::State& st, std::string model_name, const Level* level) {
   const auto model = make_model(model_name, level);
   const auto x = deformed(*level->mesh);
@@ -67,12 +75,7 @@ void force(benchmark::State& st, std::string model_name, const Level* level) {
     benchmark::DoNotOptimize(model->add_forces(x, f));
     benchmark::ClobberMemory();
   }
-  const double tets = static_cast<double>(level->mesh->tet_count());
-  st.counters["tets"] = tets;
-  st.counters["tet_updates_per_s"] = benchmark::Counter(tets * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
-  st.counters["ns_per_tet"] = benchmark::Counter(tets * static_cast<double>(st.iterations()),
-                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  st.counters["ns_per_tet"] = st.counters["ns_per_tet"];
+  count_tets(st, level);
 }
 
 void step(benchmark::State& st, std::string model_name, const Level* level) {
@@ -88,11 +91,7 @@ void step(benchmark::State& st, std::string model_name, const Level* level) {
     integrator.step(s);
     benchmark::ClobberMemory();
   }
-  const double tets = static_cast<double>(level->mesh->tet_count());
-  st.counters["tets"] = tets;
-  st.counters["tet_updates_per_s"] = benchmark::Counter(tets * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
-  st.counters["ns_per_tet"] = benchmark::Counter(tets * static_cast<double>(st.iterations()),
-                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  count_tets(st, level);
   st.counters["dt_s"] = integrator.dt_s();
 }
 

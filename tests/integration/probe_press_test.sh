@@ -5,13 +5,9 @@
 # server must stop cleanly on SIGINT. Usage: probe_press_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
-tmp="$(mktemp -d)"; trap 'kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
-export CYCLONEDDS_URI="file://$src/deploy/cyclonedds.xml"
-# A domain of its own, so that parallel runs on one machine do not meet.
-domain=$(( (RANDOM % 200) + 1 ))
-sed "s/\"domain_id\": 0/\"domain_id\": $domain/" "$src/data/scenes/liver.json" > "$tmp/scene.json"
-sed -i "s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" "$tmp/scene.json"
-"$build/server/runtime/viscera-server" --scene "$tmp/scene.json" > "$tmp/server.log" 2>&1 &
+. "$(dirname "$0")/common.sh"
+trap 'kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
+"$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
 "$build/tools/haptic-client/haptic-client" --domain "$domain" --duration 4 --depth 0.03 --report "$tmp/report.json" > "$tmp/client.log" 2>&1
 client_rc=$?
@@ -22,8 +18,6 @@ grasp_rc=$?
 kill -INT "$server"
 wait "$server"; server_rc=$?
 cat "$tmp/client.log" "$tmp/server.log"
-failures=0; passed=0
-check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
 check "client exit code 0 (got $client_rc)" "[ $client_rc -eq 0 ]"
 check "grasp client exit code 0 (got $grasp_rc)" "[ $grasp_rc -eq 0 ]"
 check "server exit code 0 after SIGINT (got $server_rc)" "[ $server_rc -eq 0 ]"

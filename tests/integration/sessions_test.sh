@@ -6,13 +6,10 @@
 # Usage: sessions_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
-tmp="$(mktemp -d)"; trap 'kill "$server" "$victim" 2>/dev/null; rm -rf "$tmp"' EXIT
-export CYCLONEDDS_URI="file://$src/deploy/cyclonedds.xml"
-domain=$(( (RANDOM % 200) + 1 ))
-sed "s/\"domain_id\": 0/\"domain_id\": $domain/" "$src/data/scenes/liver.json" > "$tmp/scene.json"
-sed -i "s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" "$tmp/scene.json"
+. "$(dirname "$0")/common.sh"
+trap 'kill "$server" "$victim" 2>/dev/null; rm -rf "$tmp"' EXIT
 hc="$build/tools/haptic-client/haptic-client"
-"$build/server/runtime/viscera-server" --scene "$tmp/scene.json" > "$tmp/server.log" 2>&1 &
+"$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
 # Two clients, two instruments, plus hostile traffic, all at once.
 "$hc" --domain "$domain" --client-id 11 --instrument 1 --duration 3 --report "$tmp/a.json" > "$tmp/a.log" 2>&1 &
@@ -32,8 +29,6 @@ kill -KILL "$victim"; killed_at=$(date +%s.%N)
 rc_heir=$?; claimed_at=$(date +%s.%N)
 kill -INT "$server"; wait "$server"; rc_server=$?
 cat "$tmp/a.log" "$tmp/b.log" "$tmp/hostile.log" "$tmp/victim.log" "$tmp/heir.log" "$tmp/server.log"
-failures=0; passed=0
-check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
 check "client A ran (rc $rc_a)" "[ $rc_a -eq 0 ]"
 check "client B ran (rc $rc_b)" "[ $rc_b -eq 0 ]"
 check "victim had claimed instrument 1" "grep -q claimed '$tmp/victim.log'"

@@ -282,29 +282,11 @@ TEST(GpsMemoryVariables, ImplicitIntegratorCarriesTheMemoryAsTheExplicitOneDoes)
   // with the exact CQ response it must stay within the same 10% as the explicit run.
   Figure2Options o;
   const Figure2 reference = compute_figure2(o);
-  const double h = o.thickness_m / o.block_layers;
-  auto mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(h, h, o.thickness_m), 1, 1, o.block_layers));
-  ViscoelasticSpec spec;
-  const ViscoelasticSetup ve = make_viscoelastic(elasticity_matrix(IsotropicElasticity{2 * o.modulus_pa * 1.3, 0.3}), spec);
-  GpsOptions go;
-  go.viscoelasticity = ve.gps;
-  const GpsModel model(mesh, {ve.unrelaxed_elasticity}, {}, go);
-  BoundaryConditions bc;
-  bc.nodal_forces.assign(mesh->node_count(), Vec3::Zero());
-  std::vector<std::int32_t> top;
-  for (std::size_t i = 0; i < mesh->node_count(); ++i) {
-    const auto n = static_cast<std::int32_t>(i);
-    if (mesh->nodes[i].z() < 1e-12) {
-      bc.fixed_nodes.push_back(n);
-      continue;
-    }
-    bc.fixed_axes.push_back({n, 1});
-    bc.fixed_axes.push_back({n, 2});
-    if (mesh->nodes[i].z() > o.thickness_m - 1e-12) top.push_back(n);
-  }
-  for (auto i : top) bc.nodal_forces[i].x() = h * h / static_cast<double>(top.size());  // 1 Pa, uniform
-  bc.force_amplitude = [](double t) { return t < 1.0 - 1e-12 ? 1.0 : 0.0; };
-  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), o.density_kg_m3), bc, {0.002, 0.0, 1e-10, 20});
+  ShearBlock block = make_shear_block(o, [](double t) { return t < 1.0 - 1e-12 ? 1.0 : 0.0; });
+  const auto& mesh = block.mesh;
+  const auto& top = block.top;
+  const GpsModel& model = *block.model;
+  ImplicitIntegrator integrator(model, block.density, block.bc, {0.002, 0.0, 1e-10, 20});
   State s = State::at_rest(*mesh);
   double err = 0;
   for (std::size_t k = 0; k < reference.time_s.size(); ++k) {

@@ -15,56 +15,18 @@ namespace viscera::tissue {
 
 namespace {
 
-// The 3D GPS block: one column of cells, every node restricted to motion along x (y and z held),
-// base fixed, top loaded by the traction (consistent nodal forces of the top triangles).
 std::vector<double> simulate_gps_block(const Figure2Options& o, const std::function<double(double)>& traction,
                                        std::size_t samples, double* dt_out) {
-  const double h = o.thickness_m / o.block_layers;
-  auto mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(h, h, o.thickness_m), 1, 1, o.block_layers));
-  const double nu = 0.3;
-  const Mat6 D_ref = elasticity_matrix(IsotropicElasticity{2 * o.modulus_pa * (1 + nu), nu});
-  ViscoelasticSpec spec;
-  spec.shear_q = o.q;
-  spec.band_low_hz = o.band_low_hz;
-  spec.band_high_hz = o.band_high_hz;
-  spec.mechanisms = o.mechanisms;
-  spec.reference_frequency_hz = o.reference_frequency_hz;
-  const ViscoelasticSetup ve = make_viscoelastic(D_ref, spec, "figure 2");
-  GpsOptions gps_options;
-  gps_options.viscoelasticity = ve.gps;
-  const GpsModel model(mesh, {ve.unrelaxed_elasticity}, {}, gps_options);
-
-  BoundaryConditions bc;
-  bc.nodal_forces.assign(mesh->node_count(), Vec3::Zero());
-  for (std::size_t i = 0; i < mesh->node_count(); ++i) {
-    const auto n = static_cast<std::int32_t>(i);
-    if (mesh->nodes[i].z() < 1e-12) {
-      bc.fixed_nodes.push_back(n);
-      continue;
-    }
-    bc.fixed_axes.push_back({n, 1});
-    bc.fixed_axes.push_back({n, 2});
-  }
-  for (const auto& tri : extract_boundary(*mesh).triangles) {
-    const Vec3 &a = mesh->nodes[tri[0]], &b = mesh->nodes[tri[1]], &c = mesh->nodes[tri[2]];
-    if (a.z() < o.thickness_m - 1e-12 || b.z() < o.thickness_m - 1e-12 || c.z() < o.thickness_m - 1e-12) continue;
-    const double area = 0.5 * (b - a).cross(c - a).norm();
-    for (auto v : tri) bc.nodal_forces[v].x() += area / 3.0;  // per pascal of traction
-  }
-  bc.force_amplitude = traction;
-  ExplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), o.density_kg_m3), bc);
+  ShearBlock block = make_shear_block(o, traction);
+  ExplicitIntegrator integrator(*block.model, block.density, block.bc);
   *dt_out = integrator.dt_s();
-  State s = State::at_rest(*mesh);
-  std::vector<std::int32_t> top;
-  for (std::size_t i = 0; i < mesh->node_count(); ++i)
-    if (mesh->nodes[i].z() > o.thickness_m - 1e-12) top.push_back(static_cast<std::int32_t>(i));
+  State s = State::at_rest(*block.mesh);
   std::vector<double> out;
-  const double dt_out_s = 1.0 / o.sample_rate_hz;
   for (std::size_t k = 0; k < samples; ++k) {
     double u = 0.0;
-    for (auto i : top) u += s.x[i].x() - mesh->nodes[i].x();
-    out.push_back(u / static_cast<double>(top.size()));
-    integrator.advance(s, dt_out_s);
+    for (auto i : block.top) u += s.x[i].x() - block.mesh->nodes[i].x();
+    out.push_back(u / static_cast<double>(block.top.size()));
+    integrator.advance(s, 1.0 / o.sample_rate_hz);
   }
   return out;
 }
@@ -76,6 +38,43 @@ double rms_relative(const std::vector<double>& a, const std::vector<double>& ref
 }
 
 }  // namespace
+
+ShearBlock make_shear_block(const Figure2Options& o, const std::function<double(double)>& traction) {
+  ShearBlock b;
+  const double h = o.thickness_m / o.block_layers;
+  b.mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(h, h, o.thickness_m), 1, 1, o.block_layers));
+  const double nu = 0.3;
+  ViscoelasticSpec spec;
+  spec.shear_q = o.q;
+  spec.band_low_hz = o.band_low_hz;
+  spec.band_high_hz = o.band_high_hz;
+  spec.mechanisms = o.mechanisms;
+  spec.reference_frequency_hz = o.reference_frequency_hz;
+  const ViscoelasticSetup ve = make_viscoelastic(elasticity_matrix(IsotropicElasticity{2 * o.modulus_pa * (1 + nu), nu}), spec, "figure 2");
+  GpsOptions gps_options;
+  gps_options.viscoelasticity = ve.gps;
+  b.model = std::make_unique<GpsModel>(b.mesh, std::vector<Mat6>{ve.unrelaxed_elasticity}, std::vector<std::uint16_t>{}, gps_options);
+  b.bc.nodal_forces.assign(b.mesh->node_count(), Vec3::Zero());
+  for (std::size_t i = 0; i < b.mesh->node_count(); ++i) {
+    const auto n = static_cast<std::int32_t>(i);
+    if (b.mesh->nodes[i].z() < 1e-12) {
+      b.bc.fixed_nodes.push_back(n);
+      continue;
+    }
+    b.bc.fixed_axes.push_back({n, 1});
+    b.bc.fixed_axes.push_back({n, 2});
+    if (b.mesh->nodes[i].z() > o.thickness_m - 1e-12) b.top.push_back(n);
+  }
+  for (const auto& tri : extract_boundary(*b.mesh).triangles) {
+    const Vec3 &p0 = b.mesh->nodes[tri[0]], &p1 = b.mesh->nodes[tri[1]], &p2 = b.mesh->nodes[tri[2]];
+    if (p0.z() < o.thickness_m - 1e-12 || p1.z() < o.thickness_m - 1e-12 || p2.z() < o.thickness_m - 1e-12) continue;
+    const double area = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    for (auto v : tri) b.bc.nodal_forces[v].x() += area / 3.0;  // per pascal of traction
+  }
+  b.bc.force_amplitude = traction;
+  b.density.assign(b.mesh->tet_count(), o.density_kg_m3);
+  return b;
+}
 
 Figure2 compute_figure2(const Figure2Options& o) {
   Figure2 r;

@@ -6,8 +6,12 @@
 //  2. viscera's memory variables: a 1D column of linear elements and the 3D GPS on a tetrahedral
 //     block (laterally constrained to simple shear), both explicit at the computed stable step;
 //  3. a Kelvin-Voigt solid with one relaxation time matched at 2 Hz (exact, frequency domain).
+#include <functional>
+#include <memory>
 #include <vector>
 
+#include "gps/gps_model.hpp"
+#include "integrator/boundary_conditions.hpp"
 #include "viscoelastic/constant_q_fit.hpp"
 
 namespace viscera::tissue {
@@ -31,5 +35,17 @@ struct Figure2 {
 };
 
 Figure2 compute_figure2(const Figure2Options& options = {});
+
+/// The 3D block of Figure 2 ready to integrate: one column of cells, every node restricted to
+/// motion along x, base fixed, the top loaded by 1 Pa times `traction(t)` (consistent nodal forces
+/// of the top triangles); the GPS with the memory variables of `options`.
+struct ShearBlock {
+  std::shared_ptr<TetMesh> mesh;
+  std::unique_ptr<GpsModel> model;
+  BoundaryConditions bc;
+  std::vector<std::int32_t> top;  ///< nodes whose mean x displacement is the output
+  std::vector<double> density;
+};
+ShearBlock make_shear_block(const Figure2Options& options, const std::function<double(double)>& traction);
 
 }  // namespace viscera::tissue
