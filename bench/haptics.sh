@@ -19,7 +19,7 @@ for line in open(sys.argv[1]):
     m = re.search(r"50% ([0-9.]+)us 90% [0-9.]+us 99% ([0-9.]+)us max ([0-9.]+)us", line)
     if m:
         p50.append(float(m.group(1))); p99.append(float(m.group(2))); mx.append(float(m.group(3)))
-print(f"| ddsperf ping-pong, 64 B at 1 kHz (as ddsperf prints it) | {statistics.median(p50):.0f} | {statistics.median(p99):.0f} | {max(mx):.0f} | - | - | - | - |")
+print(f"| ddsperf ping-pong, 64 B at 1 kHz (as ddsperf prints it) | {statistics.median(p50):.0f} | {statistics.median(p99):.0f} | {max(mx):.0f} | - | - | - | - | - |")
 PY
 for scene in liver liver-12k; do
   domain=$(( (RANDOM % 200) + 1 ))
@@ -36,6 +36,7 @@ r = json.load(open(report))["round_trip_us"]
 p50, p99, mx, jit, rate = [], [], [], [], []
 tets = ""
 overruns = 0
+resets = 0
 for line in open(log):
     m = re.search(r"([0-9]+) Hz physics, step p50 ([0-9]+) us p99 ([0-9]+) us max ([0-9]+) us, jitter p99 ([0-9]+) us, overruns ([0-9]+)", line)
     if m:
@@ -43,10 +44,12 @@ for line in open(log):
         jit.append(float(m.group(5))); overruns = int(m.group(6))
     m = re.search(r"([0-9]+) tets", line)
     if m: tets = m.group(1)
+    m = re.search(r"([0-9]+) physics resets", line)
+    if m: resets = int(m.group(1))
 print(f"| viscera {scene} ({tets} tets): pose -> force round trip | {r['p50']:.0f} | {r['p99']:.0f} | {r['max']:.0f} | "
-      f"{statistics.median(rate):.0f} | {statistics.median(p50):.0f} / {max(p99):.0f} | {max(jit):.0f} | {overruns} |")
+      f"{statistics.median(rate):.0f} | {statistics.median(p50):.0f} / {max(p99):.0f} | {max(jit):.0f} | {overruns} | {resets} |")
 PY
 done
-echo "| measurement | p50 [us] | p99 [us] | max [us] | physics rate [Hz] | step p50 / worst p99 [us] | tick jitter p99 [us] | overruns |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| measurement | p50 [us] | p99 [us] | max [us] | physics rate [Hz] | step p50 / worst p99 [us] | tick jitter p99 [us] | overruns | physics resets |"
+echo "|---|---|---|---|---|---|---|---|---|"
 cat "$tmp/ping.txt"

@@ -1,5 +1,7 @@
 #include "probe_contact.hpp"
 
+#include <cmath>
+
 namespace viscera::runtime {
 
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3* w) {
@@ -34,7 +36,8 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m)
     : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m) {}
 
-ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f) const {
+ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f,
+                                  std::span<double> node_stiffness) const {
   ContactResult r;
   Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
   Vec3 weighted_point = Vec3::Zero();
@@ -56,6 +59,8 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
     const Vec3 push = stiffness_ * depth * n;  // on the tool, out of the tissue
     if (!f.empty())
       for (int k = 0; k < 3; ++k) f[t[k]] -= w[k] * push;
+    if (!node_stiffness.empty())
+      for (int k = 0; k < 3; ++k) node_stiffness[t[k]] += std::sqrt(3.0) * stiffness_ * w[k];
     r.force_on_tool += push;
     K += stiffness_ * n * n.transpose();
     weighted_point += depth * q;

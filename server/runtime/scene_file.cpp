@@ -47,6 +47,10 @@ SceneSpec read_scene_file(const std::string& path) {
   s.damping_per_s = number(o, "damping_per_s", "organ.", 0, 1e4, 0.0);
   s.volume_term = number(o, "volume_term", "organ.", 0, 0.99, 0.5);
   s.refine = static_cast<int>(number(o, "refine", "organ.", 0, 2, 0));
+  const std::string step = o.value("stable_step", "element");
+  if (step != "element" && step != "global")
+    throw InputError(path, 0, "organ.stable_step", "'" + step + "' is not element or global");
+  s.global_stable_step = step == "global";
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
   if (o.contains("fix_slab")) {

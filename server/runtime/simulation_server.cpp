@@ -88,7 +88,8 @@ struct SimulationServer::Impl {
     if (s.fix_side == "min") slab.hi[a] = bounds.lo[a] + s.fix_fraction * extent;
     else slab.lo[a] = bounds.hi[a] - s.fix_fraction * extent;
     bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
-    bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f) {
+    // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
+    bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
       for (auto& [id, inst] : instruments) {
         if (inst.owner == 0 || !inst.has_command) {
           inst.result = {};
@@ -96,21 +97,22 @@ struct SimulationServer::Impl {
         }
         const auto& p = inst.last.tip_position;
         const Vec3 tip(p[0], p[1], p[2]);
-        inst.result = inst.contact->apply(tip, x, f);
+        inst.result = inst.contact->apply(tip, x, f, stiffness);
         // Grasped nodes follow the jaws through stiff springs; the tool feels their reaction.
         for (const auto& [node, offset] : inst.grasped) {
           const Vec3 pull = scene.grasp_stiffness_n_per_m * (tip + offset - x[node]);
           f[node] += pull;
+          stiffness[node] += scene.grasp_stiffness_n_per_m;
           inst.result.force_on_tool -= pull;
         }
         if (!inst.grasped.empty()) inst.result.in_contact = true;
       }
     };
-    integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
-                                                      ExplicitOptions{0.9, 0.0, s.damping_per_s, 2.0});
-    state = State::at_rest(*mesh);
     const BoundarySurface boundary = extract_boundary(*mesh);
     const auto& surface = boundary.triangles;
+    integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
+                                                      ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step});
+    state = State::at_rest(*mesh);
     surface_nodes = boundary.nodes;
     for (const auto& spec : s.instruments)
       instruments[spec.id] = Instrument{spec, std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m)};
@@ -278,8 +280,12 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     try {
       s.integrator->advance(s.state, 1.0 / s.scene.physics_rate_hz);
     } catch (const SimulationError& e) {
-      // Keep serving: the state was rolled back to the last good step; report it.
-      if (status) status(std::string("physics: ") + e.what());
+      // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
+      // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.
+      s.state = State::at_rest(*s.mesh);
+      for (auto& [id, inst] : s.instruments) inst.grasped.clear();
+      ++stats.physics_resets;
+      if (status) status(std::string("physics: ") + e.what() + "; organ reset to rest");
     }
     const auto t1 = clock::now();
     step_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
@@ -304,9 +310,10 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
           fmax = std::max(fmax, inst.result.force_on_tool.norm());
         }
         std::snprintf(line, sizeof line, "%.0f Hz physics, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, overruns %llu, "
-                      "%d instruments claimed, |F| %.3f N, rejected %llu",
+                      "%d instruments claimed, |F| %.3f N, rejected %llu, physics resets %llu",
                       stats.rate_hz, stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
-                      static_cast<unsigned long long>(stats.overruns), owned, fmax, static_cast<unsigned long long>(stats.rejected));
+                      static_cast<unsigned long long>(stats.overruns), owned, fmax, static_cast<unsigned long long>(stats.rejected),
+                      static_cast<unsigned long long>(stats.physics_resets));
         status(line);
       }
       step_us.clear();

@@ -44,8 +44,10 @@ struct BoundaryConditions {
   std::function<double(double t)> force_amplitude;
 
   /// A position-dependent force field added at every explicit force evaluation (contact with an
-  /// instrument): f += field(x). Explicit integrator only.
-  std::function<void(std::span<const Vec3> x, std::span<Vec3> f)> force_field;
+  /// instrument): f += field(x). It also adds to `stiffness` [N/m] per node a bound on its own
+  /// stiffness there (at least the Gershgorin row sum of -df/dx); the explicit integrator treats
+  /// that part implicitly, so the field never limits the step. Explicit integrator only.
+  std::function<void(std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness)> force_field;
 
   /// 1 for each coordinate (3 per node) that is fixed or prescribed, else 0.
   std::vector<char> constrained_mask(std::size_t node_count) const;

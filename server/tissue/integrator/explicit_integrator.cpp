@@ -1,5 +1,6 @@
 #include "integrator/explicit_integrator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -16,9 +17,9 @@ ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<doub
   if (!(options_.mass_damping_per_s >= 0))
     throw std::invalid_argument("ExplicitOptions.mass_damping_per_s must be >= 0");
   mass_ = lumped_masses(model.rest_mesh(), density_kg_m3);
-  critical_ = critical_time_step(model, density_kg_m3);
-  dt_ = options_.dt_s > 0 ? options_.dt_s : options_.safety_factor * critical_.dt_s;
   const auto mask = bc_.constrained_mask(mass_.size());
+  critical_ = options_.global_stable_step ? global_time_step(model, mass_, mask) : critical_time_step(model, density_kg_m3);
+  dt_ = options_.dt_s > 0 ? options_.dt_s : options_.safety_factor * critical_.dt_s;
   inv_mass_.resize(mass_.size());
   gravity_.resize(mass_.size());
   for (std::size_t i = 0; i < mass_.size(); ++i) {
@@ -28,6 +29,7 @@ ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<doub
   if (!bc_.nodal_forces.empty() && bc_.nodal_forces.size() != mass_.size())
     throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");
   force_.resize(mass_.size());
+  field_stiffness_.resize(mass_.size());
 }
 
 void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
@@ -42,7 +44,12 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   const std::size_t nm = model_.memory_size();
   if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
   const ForceStats stats = model_.add_forces(state.x, force_, {state.memory, state.memory, state.time_s - state.memory_time_s});
-  if (bc_.force_field) bc_.force_field(state.x, force_);
+  bool stiff_field = false;
+  if (bc_.force_field) {
+    std::fill(field_stiffness_.begin(), field_stiffness_.end(), 0.0);
+    bc_.force_field(state.x, force_, field_stiffness_);
+    stiff_field = std::any_of(field_stiffness_.begin(), field_stiffness_.end(), [](double k) { return k > 0; });
+  }
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
     std::ostringstream msg;
@@ -63,7 +70,11 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   state.memory_time_s = state.time_s;
   const double damping = std::exp(-options_.mass_damping_per_s * dt);
   for (std::size_t i = 0; i < n; ++i) {
-    state.v[i] = (state.v[i] + dt * inv_mass_[i].cwiseProduct(force_[i])) * damping;
+    // A node under the field's springs moves with the mass m + dt^2 k (the springs taken
+    // implicitly): by Weyl's inequality dt^2 omega^2 <= dt^2 omega_model^2 + 1 <= 4 while
+    // dt <= sqrt(3) / omega_model, so stiff instrument springs on light nodes never destabilise.
+    const double scale = stiff_field ? mass_[i] / (mass_[i] + dt * dt * field_stiffness_[i]) : 1.0;
+    state.v[i] = (state.v[i] + (scale * dt) * inv_mass_[i].cwiseProduct(force_[i])) * damping;
     for (int k = 0; k < 3; ++k)
       if (inv_mass_[i][k] == 0.0) state.v[i][k] = 0.0;
     state.x[i] += dt * state.v[i];

@@ -12,10 +12,14 @@
 namespace viscera::tissue {
 
 struct ExplicitOptions {
-  double safety_factor = 0.9;         ///< dt = safety x critical step (0 < s <= 1)
+  /// dt = safety x critical step (0 < s <= 1); with a stiff force field, s <= sqrt(3)/2 keeps the
+  /// bound (BoundaryConditions::force_field)
+  double safety_factor = 0.9;
   double dt_s = 0.0;                  ///< if > 0, used instead (for studies; may be unstable)
   double mass_damping_per_s = 0.0;    ///< alpha >= 0 [1/s]
   double max_edge_strain = 2.0;       ///< |dL|/L0 above this means the run went unstable
+  /// Critical step from the global estimate (global_time_step) instead of the element bound.
+  bool global_stable_step = false;
 };
 
 class ExplicitIntegrator {
@@ -51,6 +55,7 @@ class ExplicitIntegrator {
   StableStep critical_;
   double dt_;
   std::vector<Vec3> force_, x_prev_, v_prev_;
+  std::vector<double> field_stiffness_;
   double t_prev_ = 0.0;
 };
 

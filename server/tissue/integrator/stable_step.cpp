@@ -1,6 +1,8 @@
 #include "integrator/stable_step.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -31,6 +33,62 @@ StableStep critical_time_step(const ForceModel& model, std::span<const double> d
   // differences to (2 / omega) (sqrt(1 + xi^2) - xi), xi = tau omega / 2 (Belytschko et al.).
   const double xi = 0.5 * model.stiffness_damping_time_s() * omega;
   return {2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi), omega, worst_element};
+}
+
+StableStep global_time_step(const ForceModel& model, std::span<const double> masses, std::span<const char> constrained,
+                            int iterations, double margin) {
+  const auto& X = model.rest_mesh().nodes;
+  const std::size_t n = X.size();
+  std::vector<double> inv_sqrt_m(n);
+  for (std::size_t i = 0; i < n; ++i) inv_sqrt_m[i] = 1.0 / std::sqrt(masses[i]);
+  double h = 0.0;  // mean edge length: sets the finite-difference step
+  for (std::size_t e = 0; e < model.element_count(); ++e) {
+    const auto p = model.gather(X, e);
+    h += (p[1] - p[0]).norm();
+  }
+  h /= static_cast<double>(model.element_count());
+  std::vector<Vec3> v(n), xp(n), xm(n), fp(n), fm(n), w(n);
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;  // deterministic start vector
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      v[i][k] = constrained[3 * i + k] ? 0.0 : static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
+    }
+  const auto normalize = [&](std::vector<Vec3>& a) {
+    double s = 0;
+    for (const auto& x : a) s += x.squaredNorm();
+    s = std::sqrt(s);
+    for (auto& x : a) x /= s;
+  };
+  normalize(v);
+  double lambda = 0.0;
+  for (int it = 0; it < iterations; ++it) {
+    // w = M^-1/2 K M^-1/2 v, with K u = -(f(X + eps u) - f(X - eps u)) / (2 eps).
+    double umax = 0;
+    for (std::size_t i = 0; i < n; ++i) umax = std::max(umax, (inv_sqrt_m[i] * v[i]).cwiseAbs().maxCoeff());
+    const double eps = 1e-6 * h / umax;
+    for (std::size_t i = 0; i < n; ++i) {
+      xp[i] = X[i] + eps * inv_sqrt_m[i] * v[i];
+      xm[i] = X[i] - eps * inv_sqrt_m[i] * v[i];
+    }
+    std::fill(fp.begin(), fp.end(), Vec3::Zero());
+    std::fill(fm.begin(), fm.end(), Vec3::Zero());
+    model.add_forces(xp, fp);
+    model.add_forces(xm, fm);
+    double rq = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      w[i] = -(fp[i] - fm[i]) / (2 * eps) * inv_sqrt_m[i];
+      for (int k = 0; k < 3; ++k)
+        if (constrained[3 * i + k]) w[i][k] = 0.0;
+      rq += w[i].dot(v[i]);
+    }
+    lambda = rq;  // Rayleigh quotient with |v| = 1
+    v = w;
+    normalize(v);
+  }
+  const double omega = std::sqrt(margin * lambda);
+  const double xi = 0.5 * model.stiffness_damping_time_s() * omega;
+  return {2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi), omega, 0};
 }
 
 }  // namespace viscera::tissue
