@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Haptic loop over DDS in one run: ddsperf ping-pong (the floor) and viscera-server + haptic-client
 # at 1 kHz on the liver at 1.5k and 12k tetrahedra. Prints a markdown table (docs/PERFORMANCE.md).
-# Usage: bench/haptics.sh [SECONDS]   (default 30)
+# Usage: [DEPTH=0.02] bench/haptics.sh [SECONDS]   (default 30 s; DEPTH: press depth in metres)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-30}"
@@ -27,7 +27,7 @@ for scene in liver liver-12k; do
     "$root/data/scenes/$scene.json" > "$tmp/$scene.json"
   "$root/build/server/runtime/viscera-server" --scene "$tmp/$scene.json" --duration "$((seconds + 4))" > "$tmp/$scene.server.log" 2>&1 &
   server=$!
-  "$root/build/tools/haptic-client/haptic-client" --domain "$domain" --duration "$seconds" --depth 0.03 --report "$tmp/$scene.json.report" > /dev/null
+  "$root/build/tools/haptic-client/haptic-client" --domain "$domain" --duration "$seconds" --depth "${DEPTH:-0.02}" --report "$tmp/$scene.json.report" > /dev/null
   wait "$server"
   python3 - "$scene" "$tmp/$scene.json.report" "$tmp/$scene.server.log" >> "$tmp/ping.txt" <<'PY'
 import json, re, statistics, sys

@@ -34,7 +34,7 @@ class ExplicitIntegrator {
   /// One step. On instability (edge strain above the limit, or NaN) throws SimulationError naming
   /// the element and the time, and puts `state` back to the last step that passed the check.
   void step(State& state);
-  /// Sub-steps until state.time_s has advanced by `duration_s` (last sub-step shortened).
+  /// Equal sub-steps, each at most dt_s(), until state.time_s has advanced by `duration_s`.
   /// Returns the number of sub-steps.
   long advance(State& state, double duration_s);
 
