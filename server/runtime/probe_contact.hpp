@@ -27,7 +27,7 @@ struct ContactResult {
 
 class ProbeContact {
  public:
-  ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m = 0.03);
+  ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m = 0.02);
   /// Adds the penalty forces on the organ to f for the tip at `centre`, and to `node_stiffness`
   /// (if not empty) a bound on their stiffness per node, sqrt(3) k w (the Gershgorin row sum);
   /// returns the reaction. With an empty f it only queries the reaction (the state is not changed).

@@ -45,6 +45,7 @@ SceneSpec read_scene_file(const std::string& path) {
   s.model = o.value("model", "gps_energy");
   s.scale_m_per_unit = number(o, "scale_m_per_unit", "organ.", 1e-6, 1e3, 1.0);
   s.damping_per_s = number(o, "damping_per_s", "organ.", 0, 1e4, 0.0);
+  s.gravity_m_s2 = number(o, "gravity_m_s2", "organ.", 0, 100, 9.81);
   s.volume_term = number(o, "volume_term", "organ.", 0, 0.99, 0.5);
   s.refine = static_cast<int>(number(o, "refine", "organ.", 0, 2, 0));
   const std::string step = o.value("stable_step", "element");

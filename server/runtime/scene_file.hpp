@@ -21,6 +21,7 @@ struct SceneSpec {
   double physics_rate_hz = 1000.0;
   std::string mesh, material, model = "gps_energy";
   double scale_m_per_unit = 1.0, damping_per_s = 0.0, volume_term = 0.5;
+  double gravity_m_s2 = 9.81;  ///< along -z
   int refine = 0;
   bool global_stable_step = false;  ///< "stable_step": "global" | "element"  ///< uniform 1:8 refinements of the mesh (0-2)
   double contact_stiffness_n_per_m = 200.0;

@@ -81,7 +81,7 @@ struct SimulationServer::Impl {
     model = make_force_model(s.model, mesh, {D}, s.volume_term, ve);
     bounds = bounding_box(*mesh);
     BoundaryConditions bc;
-    bc.gravity_m_s2 = Vec3(0, 0, -9.81);
+    bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
     const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
     Box slab = bounds;
     const double extent = bounds.hi[a] - bounds.lo[a];

@@ -40,9 +40,10 @@ after = max(abs(x["force_n"][2]) for x in released)
 assert after < 0.05, f"opened jaws still hold the tissue: {after:.3f} N"
 print(f"[ figure ] grasp and pull 2 cm: restoring force {early:.2f} N early, {late:.2f} N late in the pull; {after:.3f} N after opening")
 PY
-python3 - "$tmp/report.json" <<'PY' || failures=$((failures+1))
+python3 - "$tmp/report.json" "$scene" <<'PY' || failures=$((failures+1))
 import json, sys
 r = json.load(open(sys.argv[1]))
+k = json.load(open(sys.argv[2]))["organ"]["contact_stiffness_n_per_m"]
 s = [x for x in r["samples"] if x["in_contact"]]
 half = r["duration_s"] / 2
 down = [x for x in s if x["t_s"] < half]
@@ -56,8 +57,13 @@ n = len(down) // 3
 shallow = sum(x["force_n"][2] for x in down[:n]) / n
 deep = sum(x["force_n"][2] for x in down[-n:]) / n
 assert deep > 1.5 * shallow, f"force does not grow with depth: {shallow:.3f} N shallow, {deep:.3f} N deep"
+# The tissue yields: pressing a rigid (or fixed) surface would give the penalty k x travel past
+# first contact; a soft organ in series with the penalty gives far less.
+travel = max(x["tip_z_m"] for x in down) - sum(x["tip_z_m"] for x in down[-n:]) / n
+assert deep < 0.3 * k * travel, f"the organ does not yield: {deep:.2f} N deep, penalty on a rigid surface {k * travel:.2f} N"
 rt = r["round_trip_us"]
-print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% opposing, mean F_z {shallow:.2f} N shallow, {deep:.2f} N deep; "
+print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% opposing, mean F_z {shallow:.2f} N shallow, {deep:.2f} N deep "
+      f"({100 * deep / (k * travel):.0f}% of the penalty on a rigid surface over {1000 * travel:.0f} mm); "
       f"round trip p50 {rt['p50']:.0f} us, p99 {rt['p99']:.0f} us, max {rt['max']:.0f} us over {rt['samples']} commands")
 PY
 [ $? -eq 0 ] && passed=$((passed+1))

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -13,20 +15,19 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/local_force_model.hpp"
 
-#include <map>
-
 int main(int argc, char** argv) {
   viscera::cli::CommandLine cl("haptic-client",
       "A virtual haptic device: claims an instrument of a running viscera-server and plays a scripted trajectory.\n"
-      "Script 'press': the probe starts 1 cm above the organ at the centre of its top, presses down to DEPTH below\n"
-      "the top of the bounding box in the first half of the run and comes back in the second half.\n"
+      "Script 'press': the probe starts 1 cm above the organ at the centre of its top and moves down until the\n"
+      "server reports contact, presses DEPTH further by mid-run and comes back to the contact height by the end.\n"
+      "Script 'grasp': the grasper moves down to contact (plus DEPTH), closes its jaws, pulls up PULL, opens.\n"
       "Prints force and command-to-force round trip; --report writes every sample as JSON.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");
   cl.flag("instrument", "ID", "instrument to claim", "1");
   cl.flag("duration", "S", "length of the run [s]", "4");
   cl.flag("rate", "HZ", "device rate [Hz]", "1000");
-  cl.flag("depth", "M", "press depth below the top of the organ's bounding box [m]", "0.03");
+  cl.flag("depth", "M", "how far to press beyond the first contact [m]", "0.03");
   cl.flag("script", "NAME", "press (probe) | grasp (grasper: touch the top, close the jaws, pull up PULL, open)", "press");
   cl.flag("pull", "M", "grasp script: how far to pull up after grasping [m]", "0.02");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
@@ -53,8 +54,11 @@ int main(int argc, char** argv) {
     }
     const double cx = 0.5 * (scene->bounds_min[0] + scene->bounds_max[0]), cy = 0.5 * (scene->bounds_min[1] + scene->bounds_max[1]);
     const double top = scene->bounds_max[2];
-    std::printf("haptic-client: scene %s, instrument %u claimed; script %s at (%.3f, %.3f), from z = %.3f m down to %.3f m\n",
-                scene->name.c_str(), instrument, script.c_str(), cx, cy, top + 0.01, top - depth);
+    // Search: down from 1 cm above the organ at a speed that reaches its bottom in 40% of the run.
+    const double search_speed = (top + 0.01 - scene->bounds_min[2]) / (0.4 * duration);
+    double contact_z = std::numeric_limits<double>::quiet_NaN(), contact_t = 0;
+    std::printf("haptic-client: scene %s, instrument %u claimed; script %s at (%.3f, %.3f), from z = %.3f m down to contact%s%.3f m\n",
+                scene->name.c_str(), instrument, script.c_str(), cx, cy, top + 0.01, " + ", depth);
     std::fflush(stdout);
     nlohmann::json samples = nlohmann::json::array();
     const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / rate));
@@ -64,22 +68,29 @@ int main(int argc, char** argv) {
     for (;;) {
       const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (t >= duration) break;
-      const double phase = t / duration;  // 0..1
       double z = 0, jaw = 0.5;
-      if (script == "press") {  // down then up
-        z = (top + 0.01) - (0.01 + depth) * (phase < 0.5 ? 2 * phase : 2 * (1 - phase));
-      } else {  // grasp: 0-0.25 descend to the surface, close; 0.25-0.75 pull up; 0.75-1 open and hold
-        const double surface = top - depth;
-        if (phase < 0.25) z = (top + 0.01) - (top + 0.01 - surface) * (phase / 0.25);
-        else if (phase < 0.75) z = surface + pull * (phase - 0.25) / 0.5;
-        else z = surface + pull;
-        jaw = (phase >= 0.2 && phase < 0.75) ? 0.0 : 0.5;
+      if (std::isnan(contact_z)) {  // searching for the surface (sags under gravity, moves under other tools)
+        z = std::max(scene->bounds_min[2], top + 0.01 - search_speed * t);
+      } else if (script == "press") {  // DEPTH beyond contact by mid-run, back to the contact height at the end
+        const double mid = std::max(0.5 * duration, contact_t + 1e-3);
+        z = t < mid ? contact_z - depth * (t - contact_t) / (mid - contact_t) : contact_z - depth * (duration - t) / (duration - mid);
+      } else {  // grasp: DEPTH beyond contact within 5% of the run, jaws closed; pull up PULL by 75%; open and hold
+        const double bite = contact_z - depth, t1 = contact_t + 0.05 * duration, t2 = std::max(0.75 * duration, t1 + 1e-3);
+        if (t < t1) z = contact_z - depth * (t - contact_t) / (t1 - contact_t);
+        else if (t < t2) z = bite + pull * (t - t1) / (t2 - t1);
+        else z = bite + pull;
+        jaw = t < t2 ? 0.0 : 0.5;
       }
       client.send_tip(instrument, {cx, cy, z}, jaw);
       sent[++seq] = {cx, cy, z};
       if (sent.size() > 4096) sent.erase(sent.begin());
       // Wait for the answer to this command until shortly before the next device period.
       if (const auto f = client.wait_force(instrument, next + period - std::chrono::microseconds(100))) {
+        if (std::isnan(contact_z) && f->in_contact) {
+          contact_z = z;
+          contact_t = t;
+          std::printf("t = %5.2f s  contact at tip z %.4f m\n", t, z);
+        }
         // The force rendered now, from the server's latest local model at the current tip.
         const auto it = sent.find(f->command_seq);
         const auto rendered = it != sent.end() ? viscera::client::render_local_model(*f, it->second, {cx, cy, z}, max_force)
