@@ -88,7 +88,6 @@ struct SimulationServer::Impl {
     if (s.fix_side == "min") slab.hi[a] = bounds.lo[a] + s.fix_fraction * extent;
     else slab.lo[a] = bounds.hi[a] - s.fix_fraction * extent;
     bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
-    // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
     bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
       for (auto& [id, inst] : instruments) {
         if (inst.owner == 0 || !inst.has_command) {
@@ -110,6 +109,7 @@ struct SimulationServer::Impl {
     };
     const BoundarySurface boundary = extract_boundary(*mesh);
     const auto& surface = boundary.triangles;
+    // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
     integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
                                                       ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step});
     state = State::at_rest(*mesh);
