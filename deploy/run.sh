@@ -1,13 +1,27 @@
 #!/usr/bin/env bash
-# The main job: installs and builds what is missing, then runs the liver demo: the bundled liver
-# (liver2.msh, 1,493 tetrahedra, scaled to 17 cm) hanging from its upper surface under gravity,
-# simulated with the generalized particle system and constant-Q viscoelasticity (Q = 4.8, three
-# memory variables, no artificial damping); frames go to out/liver-demo (ParaView).
+# The main job: installs and builds what is missing, then runs viscera as it is used: the
+# simulation server on the bundled liver (liver2, 1,493 tetrahedra, constant-Q viscoelastic GPS
+# at 1 kHz) and, as a separate process over Cyclone DDS, a scripted haptic client that presses a
+# probe into the liver and then grasps and pulls it. Both print live: the server its physics rate,
+# step times, jitter, overruns and the force on the tools; the client the force it feels, the
+# command-to-force round trip and the surface frames it receives.
+#   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene
+#   DURATION=20 ./deploy/run.sh                           a longer press (seconds)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/deploy/build.sh" "$root/build"
-exec "$root/build/tools/viscera-sim/viscera-sim" \
-  --mesh "$root/data/meshes/liver2.msh" --scale 0.08 \
-  --material "$root/data/materials/liver-viscoelastic.json" \
-  --model gps_energy --damping 0 --fix-slab z,max,0.2 --duration 2 \
-  --out "$root/out/liver-demo" "$@"
+scene="${SCENE:-$root/data/scenes/liver.json}"
+duration="${DURATION:-8}"
+export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$root/deploy/cyclonedds.xml}"
+domain=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('domain_id', 0))" "$scene")
+bin="$root/build"
+"$bin/server/runtime/viscera-server" --scene "$scene" > >(sed -u 's/^/[server] /') 2>&1 &
+server=$!
+trap 'kill -INT "$server" 2>/dev/null || true; wait "$server" 2>/dev/null || true; sleep 0.2' EXIT
+echo "[demo] probe 1 presses 3 cm into the liver and comes back (${duration} s)"
+"$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
+  --duration "$duration" --watch-mesh 2>&1 | sed -u 's/^/[haptic] /'
+echo "[demo] grasper 3 closes its jaws on the liver, pulls it up 2 cm, lets go (6 s)"
+"$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 2 --instrument 3 --script grasp --depth 0 --pull 0.02 \
+  --duration 6 2>&1 | sed -u 's/^/[haptic] /'
+echo "[demo] done; the server stops"

@@ -14,6 +14,8 @@ struct Client::Impl {
   proto::Writer commands, sessions;
   proto::Reader forces, scene;
   std::optional<proto::Scene> last_scene;
+  std::unique_ptr<proto::Reader> topology, frames;  // created on first use
+  std::optional<proto::SurfaceTopology> surface;
   explicit Impl(std::uint32_t domain)
       : participant(domain),
         commands(participant, proto::Stream::instrument_command),
@@ -99,6 +101,36 @@ std::optional<proto::Force> Client::wait_force(std::uint32_t instrument_id, std:
     if (now >= deadline) return f;
     impl_->forces.wait(deadline - now);
   }
+}
+
+std::optional<proto::SurfaceTopology> Client::surface() {
+  if (!impl_->topology) {
+    impl_->topology = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::surface_topology);
+    impl_->frames = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::mesh_frame);
+  }
+  impl_->topology->take([&](const proto::Received& r) {
+    std::string why;
+    if (auto t = proto::decode_surface_topology(r.payload, &why)) impl_->surface = std::move(*t);
+    else ++rejected_;
+  });
+  return impl_->surface;
+}
+
+std::optional<proto::MeshFrame> Client::poll_mesh_frame() {
+  const auto topology = surface();
+  std::optional<proto::MeshFrame> newest;
+  impl_->frames->take([&](const proto::Received& r) {
+    std::string why;
+    auto f = proto::decode_mesh_frame(r.payload, &why);
+    if (f && !topology) return;  // the topology (transient local) is still on its way
+    if (!f || !topology || f->mesh_id != topology->mesh_id || f->positions.size() != 3ull * topology->vertex_count) {
+      ++rejected_;
+      return;
+    }
+    ++mesh_frames_;
+    if (!newest || f->frame > newest->frame) newest = std::move(f);
+  });
+  return newest;
 }
 
 LatencyStats Client::round_trip() const {

@@ -27,7 +27,13 @@ dds_qos_t* qos_for(Stream s) {
       dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
       dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
       break;
+    case Stream::mesh_frame:
+      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+      break;
     case Stream::scene_state:
+    case Stream::surface_topology:
       dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
       dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
       dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
@@ -49,6 +55,8 @@ const char* topic_name(Stream s) {
     case Stream::session_request: return "viscera_session_request";
     case Stream::scene_state: return "viscera_scene_state";
     case Stream::telemetry: return "viscera_telemetry";
+    case Stream::surface_topology: return "viscera_surface_topology";
+    case Stream::mesh_frame: return "viscera_mesh_frame";
   }
   return "?";
 }

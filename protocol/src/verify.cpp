@@ -2,7 +2,9 @@
 
 #include "force_feedback_generated.h"
 #include "instrument_command_generated.h"
+#include "mesh_frame_generated.h"
 #include "session_generated.h"
+#include "surface_mesh_generated.h"
 #include "telemetry_generated.h"
 #include "viscera/protocol/messages.hpp"
 
@@ -57,7 +59,7 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
   return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns,
-                                           &force, &torque, model, f.step_time_ns));
+                                           &force, &torque, model, f.step_time_ns, f.penetration_m));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -81,6 +83,20 @@ std::vector<std::uint8_t> encode(const TelemetryReport& t) {
   flatbuffers::FlatBufferBuilder b(128);
   return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us,
                                        t.jitter_p99_us, t.overruns, t.rejected_messages));
+}
+
+std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
+  flatbuffers::FlatBufferBuilder b(64 + 4 * t.triangles.size() + 4 * t.rest_positions.size());
+  const auto name = b.CreateString(t.organ_name);
+  const auto tris = b.CreateVector(t.triangles);
+  const auto rest = b.CreateVector(t.rest_positions);
+  return finish(b, fb::CreateSurfaceTopology(b, t.mesh_id, name, t.vertex_count, tris, rest));
+}
+
+std::vector<std::uint8_t> encode(const MeshFrame& m) {
+  flatbuffers::FlatBufferBuilder b(64 + 4 * m.positions.size());
+  const auto positions = b.CreateVector(m.positions);
+  return finish(b, fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions));
 }
 
 std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why) {
@@ -132,6 +148,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   f.step_time_ns = m->step_time_ns();
   f.force = from_fb(m->force());
   f.torque = from_fb(m->torque());
+  f.penetration_m = m->penetration_m();
   if (const auto* lm = m->local_model()) {
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());
@@ -139,8 +156,9 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
     if (const auto* k = lm->stiffness())
       f.stiffness = {k->m00(), k->m01(), k->m02(), k->m10(), k->m11(), k->m12(), k->m20(), k->m21(), k->m22()};
   }
-  if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point)) {
-    *why = "force, torque or contact point not finite or out of range";
+  if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point) || !std::isfinite(f.penetration_m) ||
+      std::abs(f.penetration_m) > kMaxPositionM) {
+    *why = "force, torque, contact point or penetration not finite or out of range";
     return std::nullopt;
   }
   for (double k : f.stiffness)
@@ -190,6 +208,59 @@ std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> by
   if (!m) return std::nullopt;
   return TelemetryReport{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
                          m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us()};
+}
+
+namespace {
+/// Positions: whole vertices, finite, within the scene's extent.
+bool valid_positions(const flatbuffers::Vector<float>* p, std::string* why) {
+  if (!p || p->size() % 3 != 0) {
+    *why = "positions missing or not 3 per vertex";
+    return false;
+  }
+  for (const float v : *p)
+    if (!std::isfinite(v) || std::abs(v) > kMaxPositionM) {
+      *why = "a position is not finite or beyond 10 m";
+      return false;
+    }
+  return true;
+}
+}  // namespace
+
+std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::SurfaceTopology>(bytes, why);
+  if (!m) return std::nullopt;
+  if (!valid_positions(m->rest_positions(), why)) return std::nullopt;
+  SurfaceTopology t;
+  t.mesh_id = m->mesh_id();
+  t.organ_name = m->organ_name() ? m->organ_name()->str() : "";
+  t.vertex_count = m->vertex_count();
+  if (m->rest_positions()->size() != 3ull * t.vertex_count) {
+    *why = "rest_positions hold " + std::to_string(m->rest_positions()->size()) + " numbers for " + std::to_string(t.vertex_count) + " vertices";
+    return std::nullopt;
+  }
+  if (!m->triangles() || m->triangles()->size() % 3 != 0) {
+    *why = "triangles missing or not 3 indices each";
+    return std::nullopt;
+  }
+  for (const auto i : *m->triangles())
+    if (i >= t.vertex_count) {
+      *why = "triangle vertex " + std::to_string(i) + " beyond vertex_count " + std::to_string(t.vertex_count);
+      return std::nullopt;
+    }
+  t.triangles.assign(m->triangles()->begin(), m->triangles()->end());
+  t.rest_positions.assign(m->rest_positions()->begin(), m->rest_positions()->end());
+  return t;
+}
+
+std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::MeshFrame>(bytes, why);
+  if (!m) return std::nullopt;
+  if (!valid_positions(m->positions(), why)) return std::nullopt;
+  if (!std::isfinite(m->sim_time_s()) || m->sim_time_s() < 0) {
+    *why = "sim_time_s not finite or negative";
+    return std::nullopt;
+  }
+  return MeshFrame{m->mesh_id(), m->frame(), m->sim_time_s(), m->server_stamp_ns(), {m->positions()->begin(), m->positions()->end()}};
 }
 
 }  // namespace viscera::protocol

@@ -1,5 +1,6 @@
 #include "probe_contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace viscera::runtime {
@@ -65,6 +66,7 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
     K += stiffness_ * n * n.transpose();
     weighted_point += depth * q;
     total += depth;
+    r.depth_m = std::max(r.depth_m, depth);
     ++r.triangles_in_contact;
   }
   if (r.triangles_in_contact > 0) {

@@ -23,6 +23,7 @@ struct ContactResult {
   Vec3 point = Vec3::Zero(), normal = Vec3::UnitZ();
   std::array<double, 9> stiffness{};  ///< penalty part of -dF/dx [N/m], row-major
   int triangles_in_contact = 0;
+  double depth_m = 0;  ///< deepest penetration of the tip sphere [m]
 };
 
 class ProbeContact {

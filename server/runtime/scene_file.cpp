@@ -36,6 +36,7 @@ SceneSpec read_scene_file(const std::string& path) {
   s.name = j.value("name", std::filesystem::path(path).stem().string());
   s.domain_id = static_cast<std::uint32_t>(number(j, "domain_id", "", 0, 230, 0));
   s.physics_rate_hz = number(j, "physics_rate_hz", "", 10, 10000, 1000);
+  s.mesh_rate_hz = number(j, "mesh_rate_hz", "", 0, 240, 60);
   if (!j.contains("organ") || !j["organ"].is_object()) throw InputError(path, 0, "organ", "missing or not an object");
   const json& o = j["organ"];
   for (const char* key : {"mesh", "material"})

@@ -19,11 +19,12 @@ struct SceneSpec {
   std::string name, source;
   std::uint32_t domain_id = 0;
   double physics_rate_hz = 1000.0;
+  double mesh_rate_hz = 60.0;  ///< surface frames per second (0: none)
   std::string mesh, material, model = "gps_energy";
   double scale_m_per_unit = 1.0, damping_per_s = 0.0, volume_term = 0.5;
   double gravity_m_s2 = 9.81;  ///< along -z
-  int refine = 0;
-  bool global_stable_step = false;  ///< "stable_step": "global" | "element"  ///< uniform 1:8 refinements of the mesh (0-2)
+  int refine = 0;  ///< uniform 1:8 refinements of the mesh (0-2)
+  bool global_stable_step = false;  ///< "stable_step": "global" | "element"
   double contact_stiffness_n_per_m = 200.0;
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
   std::string fix_axis = "z", fix_side = "max";

@@ -12,6 +12,7 @@
 #include "mesh/boundary_surface.hpp"
 #include "mesh/mesh_reader.hpp"
 #include "mesh/refinement.hpp"
+#include "mesh_publisher.hpp"
 #include "model/model_factory.hpp"
 #include "probe_contact.hpp"
 #include "viscera/protocol/dds.hpp"
@@ -38,6 +39,7 @@ struct SimulationServer::Impl {
   std::unique_ptr<ForceModel> model;
   std::unique_ptr<ExplicitIntegrator> integrator;
   State state;
+  double sim_time_s = 0;
   Box bounds;
 
   struct Instrument {
@@ -57,6 +59,7 @@ struct SimulationServer::Impl {
   proto::Participant participant;
   proto::Reader commands, sessions;
   proto::Writer forces, scene_state, telemetry;
+  std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread; after the writers it uses
   std::uint64_t rejected = 0;
 
   explicit Impl(const SceneSpec& s)
@@ -116,7 +119,24 @@ struct SimulationServer::Impl {
     surface_nodes = boundary.nodes;
     for (const auto& spec : s.instruments)
       instruments[spec.id] = Instrument{spec, std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m)};
+    if (s.mesh_rate_hz > 0) mesh_publisher = std::make_unique<MeshPublisher>(participant, surface_topology(boundary), boundary.nodes, s.mesh_rate_hz);
     publish_scene();
+  }
+
+  /// The boundary surface with its vertices numbered in the order of boundary.nodes.
+  proto::SurfaceTopology surface_topology(const BoundarySurface& boundary) const {
+    proto::SurfaceTopology t;
+    t.mesh_id = 1;
+    t.organ_name = scene.name;
+    t.vertex_count = static_cast<std::uint32_t>(boundary.nodes.size());
+    std::vector<std::uint32_t> vertex_of(mesh->node_count(), 0);
+    for (std::size_t k = 0; k < boundary.nodes.size(); ++k) {
+      vertex_of[boundary.nodes[k]] = static_cast<std::uint32_t>(k);
+      for (int d = 0; d < 3; ++d) t.rest_positions.push_back(static_cast<float>(mesh->nodes[boundary.nodes[k]][d]));
+    }
+    for (const auto& tri : boundary.triangles)
+      for (const auto n : tri) t.triangles.push_back(vertex_of[n]);
+    return t;
   }
 
   void publish_scene() {
@@ -239,6 +259,7 @@ struct SimulationServer::Impl {
     f.contact_point = {inst.result.point.x(), inst.result.point.y(), inst.result.point.z()};
     f.contact_normal = {inst.result.normal.x(), inst.result.normal.y(), inst.result.normal.z()};
     f.stiffness = inst.result.stiffness;
+    f.penetration_m = inst.result.depth_m;
     forces.write(id, proto::encode(f));
     ++stats.forces_sent;
   }
@@ -279,6 +300,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     const auto t0 = clock::now();
     try {
       s.integrator->advance(s.state, 1.0 / s.scene.physics_rate_hz);
+      s.sim_time_s += 1.0 / s.scene.physics_rate_hz;
     } catch (const SimulationError& e) {
       // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
       // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.
@@ -290,6 +312,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     const auto t1 = clock::now();
     step_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
     s.publish_forces(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), stats);
+    if (s.mesh_publisher) s.mesh_publisher->offer(s.state.x, s.sim_time_s, proto::now_ns());
     ++stats.ticks;
     if (t1 - last_report >= std::chrono::seconds(1)) {
       const double seconds = std::chrono::duration<double>(t1 - last_report).count();
@@ -299,10 +322,14 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       stats.step_max_us = *std::max_element(step_us.begin(), step_us.end());
       stats.jitter_p99_us = percentile(jitter_us, 0.99);
       stats.rejected = s.rejected;
+      if (s.mesh_publisher) {
+        stats.mesh_frames = s.mesh_publisher->frames_published();
+        stats.mesh_frames_skipped = s.mesh_publisher->frames_skipped();
+      }
       s.telemetry.write(0, proto::encode(proto::TelemetryReport{proto::now_ns(), stats.ticks, stats.overruns, stats.rejected, stats.rate_hz,
                                                                 stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us}));
       if (status) {
-        char line[300];
+        char line[400];
         int owned = 0;
         double fmax = 0;
         for (const auto& [id, inst] : s.instruments) {
@@ -310,10 +337,11 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
           fmax = std::max(fmax, inst.result.force_on_tool.norm());
         }
         std::snprintf(line, sizeof line, "%.0f Hz physics, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, overruns %llu, "
-                      "%d instruments claimed, |F| %.3f N, rejected %llu, physics resets %llu",
+                      "%d instruments claimed, |F| %.3f N, rejected %llu, physics resets %llu, mesh frames %llu (%llu skipped)",
                       stats.rate_hz, stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
                       static_cast<unsigned long long>(stats.overruns), owned, fmax, static_cast<unsigned long long>(stats.rejected),
-                      static_cast<unsigned long long>(stats.physics_resets));
+                      static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.mesh_frames),
+                      static_cast<unsigned long long>(stats.mesh_frames_skipped));
         status(line);
       }
       step_us.clear();
@@ -335,6 +363,10 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     }
   }
   stats.rejected = s.rejected;
+  if (s.mesh_publisher) {
+    stats.mesh_frames = s.mesh_publisher->frames_published();
+    stats.mesh_frames_skipped = s.mesh_publisher->frames_skipped();
+  }
   return stats;
 }
 

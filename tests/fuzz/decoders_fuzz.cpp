@@ -17,5 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (auto r = decode_session_request(bytes, &why)) (void)encode(*r);
   if (auto s = decode_scene(bytes, &why)) (void)encode(*s);
   if (auto t = decode_telemetry(bytes, &why)) (void)encode(*t);
+  if (auto t = decode_surface_topology(bytes, &why)) (void)encode(*t);
+  if (auto m = decode_mesh_frame(bytes, &why)) (void)encode(*m);
   return 0;
 }

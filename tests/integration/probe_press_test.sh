@@ -9,17 +9,26 @@ build="$1"; src="$2"
 trap 'kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
-"$build/tools/haptic-client/haptic-client" --domain "$domain" --duration 4 --depth 0.03 --report "$tmp/report.json" > "$tmp/client.log" 2>&1
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --duration 4 --depth 0.03 --watch-mesh --report "$tmp/report.json" > "$tmp/client.log" 2>&1
 client_rc=$?
 # Grasp and pull: the grasper (instrument 3) closes its jaws on the top surface, pulls up 2 cm, opens.
 "$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 2 --instrument 3 --script grasp --depth 0 --pull 0.02 \
   --duration 4 --report "$tmp/grasp.json" >> "$tmp/client.log" 2>&1
 grasp_rc=$?
+# A client compiled against schema 1 (before ForceFeedback gained a field) still works.
+"$build/tests/integration/old_client" "$domain" 4 2 2 >> "$tmp/client.log" 2>&1
+old_rc=$?
+# A trajectory file, relative to the organ's top centre.
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 5 --instrument 2 --quiet \
+  --trajectory "$src/data/trajectories/press-and-slide.csv" --frame organ-top --report "$tmp/trajectory.json" >> "$tmp/client.log" 2>&1
+trajectory_rc=$?
 kill -INT "$server"
 wait "$server"; server_rc=$?
 cat "$tmp/client.log" "$tmp/server.log"
 check "client exit code 0 (got $client_rc)" "[ $client_rc -eq 0 ]"
 check "grasp client exit code 0 (got $grasp_rc)" "[ $grasp_rc -eq 0 ]"
+check "schema-1 client exit code 0 (got $old_rc)" "[ $old_rc -eq 0 ]"
+check "trajectory client exit code 0 (got $trajectory_rc)" "[ $trajectory_rc -eq 0 ]"
 check "server exit code 0 after SIGINT (got $server_rc)" "[ $server_rc -eq 0 ]"
 check "server reports a clean stop" "grep -q 'stopped after' '$tmp/server.log'"
 python3 - "$tmp/grasp.json" <<'PY' || failures=$((failures+1))
@@ -39,6 +48,34 @@ assert late > 1.5 * early, f"restoring force does not grow with the pull: {early
 after = max(abs(x["force_n"][2]) for x in released)
 assert after < 0.05, f"opened jaws still hold the tissue: {after:.3f} N"
 print(f"[ figure ] grasp and pull 2 cm: restoring force {early:.2f} N early, {late:.2f} N late in the pull; {after:.3f} N after opening")
+PY
+python3 - "$tmp/trajectory.json" "$src/data/trajectories/press-and-slide.csv" <<'PY' || failures=$((failures+1))
+import json, sys
+r = json.load(open(sys.argv[1]))
+end = max(float(l.split(",")[0]) for l in open(sys.argv[2]) if l[0].isdigit())
+s = r["samples"]
+assert abs(s[-1]["t_s"] - end) < 0.05 and len(s) > 0.9 * 1000 * end, f"trajectory of {end} s played as {len(s)} samples ending at {s[-1]['t_s']:.2f} s"
+pressed = [x for x in s if 2.0 < x["t_s"] < 3.5]
+up = sum(1 for x in pressed if x["in_contact"] and x["force_n"][2] > 0) / len(pressed)
+assert up > 0.95, f"the tissue pushes back in only {100*up:.0f}% of the pressed phase"
+lifted = [x for x in s if x["t_s"] > 4.4]
+assert lifted and not any(x["in_contact"] for x in lifted), "still in contact after lifting off 2 cm above the top"
+print(f"[ figure ] trajectory press-and-slide: {len(s)} samples over {end} s, pushed back in {100*up:.0f}% of the pressed phase, free after lift-off")
+PY
+python3 - "$tmp/report.json" 0.03 <<'PY' || failures=$((failures+1))
+import json, sys
+r = json.load(open(sys.argv[1]))
+depth = float(sys.argv[2])
+m = r["mesh"]
+assert 55 <= m["rate_hz"] <= 65, f"surface frames at {m['rate_hz']:.1f} Hz, the scene asks for 60"
+under = [x["under_tip_dz_m"] for x in m["samples"]]
+deepest = min(under)
+# The press goes `depth` beyond first contact; the soft organ yields nearly all of it.
+assert deepest < -0.5 * depth, f"the surface under the probe moved only {1000*deepest:.1f} mm for a {1000*depth:.0f} mm press"
+tail = [x["under_tip_dz_m"] for x in m["samples"] if x["t_s"] > 0.95 * r["duration_s"]]
+assert tail and min(tail) > 0.5 * deepest, f"the surface did not come back: {1000*min(tail):.1f} mm at the end, {1000*deepest:.1f} mm deepest"
+print(f"[ figure ] mesh stream: {m['frames']} frames at {m['rate_hz']:.1f} Hz; surface under the probe down {1000*-deepest:.1f} mm at the deepest "
+      f"({1000*depth:.0f} mm press), {1000*-min(tail):.1f} mm at the end")
 PY
 python3 - "$tmp/report.json" "$scene" <<'PY' || failures=$((failures+1))
 import json, sys

@@ -86,3 +86,53 @@ TEST(Messages, RejectsTruncatedGarbageWrongSchemaAndBadNumbers) {
   f.force = {std::numeric_limits<double>::infinity(), 0, 0};
   EXPECT_FALSE(decode_force(encode(f), &why));
 }
+
+namespace {
+SurfaceTopology good_topology() {
+  SurfaceTopology t;
+  t.mesh_id = 1;
+  t.organ_name = "tet";
+  t.vertex_count = 4;
+  t.triangles = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
+  t.rest_positions = {0, 0, 0, 0.1f, 0, 0, 0, 0.1f, 0, 0, 0, 0.1f};
+  return t;
+}
+}  // namespace
+
+TEST(Messages, SurfaceTopologyAndFramesRoundTripAndBadOnesAreRejected) {
+  std::string why;
+  const auto t = decode_surface_topology(encode(good_topology()), &why);
+  ASSERT_TRUE(t) << why;
+  EXPECT_EQ(t->triangles, good_topology().triangles);
+  EXPECT_EQ(t->rest_positions, good_topology().rest_positions);
+  EXPECT_EQ(t->organ_name, "tet");
+  MeshFrame m{1, 7, 0.25, 99, good_topology().rest_positions};
+  const auto md = decode_mesh_frame(encode(m), &why);
+  ASSERT_TRUE(md) << why;
+  EXPECT_EQ(md->frame, 7u);
+  EXPECT_EQ(md->positions, m.positions);
+
+  auto bad = good_topology();
+  bad.triangles[4] = 4;  // a vertex that does not exist
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  EXPECT_NE(why.find("beyond vertex_count"), std::string::npos) << why;
+  bad = good_topology();
+  bad.vertex_count = 5;  // positions for 4
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  bad = good_topology();
+  bad.triangles.pop_back();
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  bad = good_topology();
+  bad.rest_positions[5] = std::nanf("");
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  m.positions[2] = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(decode_mesh_frame(encode(m), &why));
+  m.positions = {0, 0};  // not whole vertices
+  EXPECT_FALSE(decode_mesh_frame(encode(m), &why));
+  m.positions = {0, 0, 0};
+  m.sim_time_s = -1;
+  EXPECT_FALSE(decode_mesh_frame(encode(m), &why));
+  EXPECT_FALSE(decode_mesh_frame(encode(good_command()), &why));  // wrong schema
+  const auto bytes = encode(good_topology());
+  EXPECT_FALSE(decode_surface_topology(std::span(bytes).first(bytes.size() / 2), &why));  // truncated
+}

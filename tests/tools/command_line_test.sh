@@ -38,6 +38,18 @@ expect server-bad-scene 2 "bad_scene.json: organ.material: missing" -- "$server"
 expect server-bad-duration 2 "'soon' is not a non-negative number" -- "$server" --scene x --duration soon
 expect hc-help 0 "Usage: haptic-client" -- "$hc" --help
 expect hc-bad-rate 2 "--rate: 0 is outside" -- "$hc" --rate 0
+printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n0.5,0,0,abc\n' >"$tmp/t1.csv"
+printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n0.5,0,0,0\n0.5,0,0,-0.01\n' >"$tmp/t2.csv"
+printf 'time_s,x_m,y_m\n0,0,0\n' >"$tmp/t3.csv"
+printf 'time_s,x_m,y_m,z_m\n0,0,0,0\n1,0,0,-20\n' >"$tmp/t4.csv"
+printf 'time_s,x_m,y_m,z_m,jaw_rad\n0,0,0,0,0.5\n1,0,0,0,7\n' >"$tmp/t5.csv"
+expect hc-traj-missing 2 "nowhere.csv: cannot open file" -- "$hc" --trajectory "$tmp/nowhere.csv"
+expect hc-traj-number 2 "t1.csv:3: column z_m: 'abc' is not a finite number" -- "$hc" --trajectory "$tmp/t1.csv"
+expect hc-traj-time 2 "t2.csv:4: column time_s" -- "$hc" --trajectory "$tmp/t2.csv"
+expect hc-traj-header 2 "t3.csv:1: column z_m: missing from the header" -- "$hc" --trajectory "$tmp/t3.csv"
+expect hc-traj-units 2 "t4.csv:3: column z_m: .* are the units metres" -- "$hc" --trajectory "$tmp/t4.csv"
+expect hc-traj-jaw 2 "t5.csv:3: column jaw_rad" -- "$hc" --trajectory "$tmp/t5.csv"
+expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
 expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"

@@ -41,6 +41,14 @@ class Client {
   /// instrument; returns the newest force seen either way.
   std::optional<protocol::Force> wait_force(std::uint32_t instrument_id, std::chrono::steady_clock::time_point deadline);
   LatencyStats round_trip() const;
+
+  /// The organ's boundary surface (triangles, rest positions), once it has arrived. The first
+  /// call subscribes this client to the mesh streams; clients that never call it receive none.
+  std::optional<protocol::SurfaceTopology> surface();
+  /// The newest surface frame that arrived since the last call, checked against the topology
+  /// (frames of another mesh_id or with another vertex count are dropped and counted).
+  std::optional<protocol::MeshFrame> poll_mesh_frame();
+  std::uint64_t mesh_frames_received() const { return mesh_frames_; }
   std::uint32_t id() const { return client_id_; }
   /// Payloads that failed verification and were dropped.
   std::uint64_t rejected() const { return rejected_; }
@@ -49,7 +57,7 @@ class Client {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::uint32_t client_id_;
-  std::uint64_t seq_ = 0, rejected_ = 0;
+  std::uint64_t seq_ = 0, rejected_ = 0, mesh_frames_ = 0;
   std::vector<double> rtt_us_;
   std::map<std::uint32_t, protocol::Force> latest_;
 };

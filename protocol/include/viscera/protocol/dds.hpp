@@ -23,7 +23,10 @@ enum class Stream {
   session_request,     ///< reliable, keep last 16, volatile
   scene_state,         ///< reliable, keep last 1, transient local (late joiners get it)
   telemetry,           ///< best effort, keep last 1, volatile
+  surface_topology,    ///< reliable, keep last 1 per key, transient local (late joiners get it)
+  mesh_frame,          ///< reliable, keep last 1 per key, volatile (slow readers skip frames)
 };
+constexpr int kStreamCount = 7;
 const char* topic_name(Stream s);
 
 class Participant {
@@ -38,7 +41,7 @@ class Participant {
 
  private:
   int32_t handle_;
-  int32_t topics_[5] = {0, 0, 0, 0, 0};
+  int32_t topics_[kStreamCount] = {};
 };
 
 struct Received {

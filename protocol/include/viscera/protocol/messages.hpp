@@ -31,6 +31,7 @@ struct Force {
   bool in_contact = false;
   Vector3 contact_point{}, contact_normal{};
   std::array<double, 9> stiffness{};  ///< row-major [N/m]
+  double penetration_m = 0;           ///< [m] tip depth in the tissue (added in schema 2)
 };
 
 enum class Action : std::int8_t { claim_instrument = 0, release_instrument = 1, pause = 2, resume = 3, reset = 4 };
@@ -62,16 +63,40 @@ struct TelemetryReport {
   double physics_rate_hz = 0, step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0;
 };
 
+/// An organ's boundary surface, sent once per mesh_id; frames list positions in its vertex order.
+struct SurfaceTopology {
+  std::uint32_t mesh_id = 0;
+  std::string organ_name;
+  std::uint32_t vertex_count = 0;
+  std::vector<std::uint32_t> triangles;  ///< 3 vertex indices per triangle
+  std::vector<float> rest_positions;     ///< [m] 3 per vertex
+};
+
+/// The deformed surface at one instant.
+struct MeshFrame {
+  std::uint32_t mesh_id = 0;
+  std::uint64_t frame = 0;
+  double sim_time_s = 0;
+  std::int64_t server_stamp_ns = 0;
+  std::vector<float> positions;  ///< [m] 3 per vertex
+};
+
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);
 std::vector<std::uint8_t> encode(const SessionRequest& r);
 std::vector<std::uint8_t> encode(const Scene& s);
 std::vector<std::uint8_t> encode(const TelemetryReport& t);
+std::vector<std::uint8_t> encode(const SurfaceTopology& t);
+std::vector<std::uint8_t> encode(const MeshFrame& m);
 
 std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint8_t> bytes, std::string* why);
+/// Checks the frame on its own (finite positions within 10 m, whole vertices); that its vertex
+/// count matches the topology of its mesh_id is the receiver's check (it holds the topology).
+std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, std::string* why);
 
 }  // namespace viscera::protocol

@@ -1,0 +1,76 @@
+#include "mesh_publisher.hpp"
+
+namespace viscera::runtime {
+
+namespace proto = viscera::protocol;
+
+MeshPublisher::MeshPublisher(proto::Participant& participant, proto::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
+                             double rate_hz)
+    : topology_writer_(participant, proto::Stream::surface_topology),
+      frame_writer_(participant, proto::Stream::mesh_frame),
+      nodes_(std::move(surface_nodes)),
+      mesh_id_(topology.mesh_id),
+      period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
+  topology_writer_.write(mesh_id_, proto::encode(topology));
+  pending_.mesh_id = mesh_id_;
+  pending_.positions.resize(3 * nodes_.size());
+  thread_ = std::thread([this] { publish_loop(); });
+}
+
+MeshPublisher::~MeshPublisher() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  ready_cv_.notify_one();
+  thread_.join();
+}
+
+void MeshPublisher::offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns) {
+  if (now_ns < next_due_ns_) return;
+  next_due_ns_ = std::max(next_due_ns_ + period_ns_, now_ns);  // steady cadence, no burst after a stall
+  std::unique_lock lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) {  // the publisher is swapping buffers this very moment
+    ++skipped_;
+    return;
+  }
+  if (ready_) ++skipped_;  // the previous snapshot was never taken: the newer one replaces it
+  float* p = pending_.positions.data();
+  for (const auto n : nodes_)
+    for (int d = 0; d < 3; ++d) *p++ = static_cast<float>(x[n][d]);
+  pending_.frame = ++offered_;
+  pending_.sim_time_s = sim_time_s;
+  pending_.server_stamp_ns = now_ns;
+  ready_ = true;
+  lock.unlock();
+  ready_cv_.notify_one();
+}
+
+std::uint64_t MeshPublisher::frames_published() const {
+  std::lock_guard lock(mutex_);
+  return published_;
+}
+
+void MeshPublisher::publish_loop() {
+  proto::MeshFrame frame;  // the buffer being written; swapped with pending_, so set up alike
+  frame.mesh_id = mesh_id_;
+  frame.positions.resize(pending_.positions.size());
+  for (;;) {
+    {
+      std::unique_lock lock(mutex_);
+      ready_cv_.wait(lock, [this] { return ready_ || stop_; });
+      if (stop_) return;
+      std::swap(frame, pending_);  // O(1): the physics thread fills the other buffer next time
+      ready_ = false;
+    }
+    try {
+      frame_writer_.write(mesh_id_, proto::encode(frame));
+    } catch (const proto::DdsError&) {
+      continue;  // a frame lost to the transport; the next one follows in 1/rate s
+    }
+    std::lock_guard lock(mutex_);
+    ++published_;
+  }
+}
+
+}  // namespace viscera::runtime

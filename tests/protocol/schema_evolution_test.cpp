@@ -1,0 +1,62 @@
+// Schema evolution: a field added at the end of a table (ForceFeedback.penetration_m, schema 2)
+// must not break clients compiled against schema 1, and messages of schema-1 writers must still
+// decode. Schema 1 is the frozen copy in tests/protocol/schema_v1 (namespace viscera::wire_v1).
+#include <gtest/gtest.h>
+
+#include "force_feedback_generated.h"  // schema 1, from tests/protocol/schema_v1
+#include "instrument_command_generated.h"
+#include "viscera/protocol/messages.hpp"  // schema 2 (current)
+
+namespace v1 = viscera::wire_v1;
+using namespace viscera::protocol;
+
+TEST(SchemaEvolution, OldReaderReadsNewForceFeedback) {
+  Force f;
+  f.instrument_id = 2;
+  f.client_id = 9;
+  f.command_seq = 1234;
+  f.command_client_stamp_ns = 555;
+  f.force = {0.1, -0.2, 1.5};
+  f.in_contact = true;
+  f.contact_normal = {0, 0, 1};
+  f.stiffness[8] = 800;
+  f.step_time_ns = 180000;
+  f.penetration_m = 0.0021;  // the field schema 1 does not know
+  const auto bytes = encode(f);
+  flatbuffers::Verifier verifier(bytes.data(), bytes.size());
+  ASSERT_TRUE(v1::VerifyForceFeedbackBuffer(verifier));
+  const auto* old = v1::GetForceFeedback(bytes.data());
+  EXPECT_EQ(old->instrument_id(), 2u);
+  EXPECT_EQ(old->client_id(), 9u);
+  EXPECT_EQ(old->command_seq(), 1234u);
+  EXPECT_EQ(old->command_client_stamp_ns(), 555);
+  EXPECT_EQ(old->force()->z(), 1.5);
+  EXPECT_EQ(old->step_time_ns(), 180000);
+  ASSERT_NE(old->local_model(), nullptr);
+  EXPECT_TRUE(old->local_model()->in_contact());
+  EXPECT_EQ(old->local_model()->stiffness()->m22(), 800);
+}
+
+TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
+  flatbuffers::FlatBufferBuilder b;
+  const v1::Vec3 force(0, 0, 2.5), point(0.01, 0.02, 0.03), normal(0, 0, 1);
+  const v1::Mat3 K(0, 0, 0, 0, 0, 0, 0, 0, 400);
+  const auto model = v1::CreateLocalForceModel(b, &point, &normal, &K, true);
+  b.Finish(v1::CreateForceFeedback(b, 3, 9, 77, 1000, 2000, &force, nullptr, model, 150000));
+  std::string why;
+  const auto f = decode_force({b.GetBufferPointer(), b.GetSize()}, &why);
+  ASSERT_TRUE(f) << why;
+  EXPECT_EQ(f->command_seq, 77u);
+  EXPECT_EQ(f->force[2], 2.5);
+  EXPECT_EQ(f->stiffness[8], 400);
+  EXPECT_EQ(f->penetration_m, 0.0);  // absent: the schema's default
+
+  flatbuffers::FlatBufferBuilder c;
+  const v1::Vec3 tip(0.0, 0.01, 0.05);
+  const v1::Quat q(1, 0, 0, 0);
+  c.Finish(v1::CreateInstrumentCommand(c, 1, 9, 5, 42, &tip, &q, 0.3, 0));
+  const auto cmd = decode_command({c.GetBufferPointer(), c.GetSize()}, &why);
+  ASSERT_TRUE(cmd) << why;
+  EXPECT_EQ(cmd->seq, 5u);
+  EXPECT_EQ(cmd->tip_position[2], 0.05);
+}

@@ -1,0 +1,47 @@
+#include "scripted_device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace viscera::haptic {
+
+ScriptedDevice::ScriptedDevice(std::string script, const protocol::Scene& scene, double duration_s, double depth_m, double pull_m)
+    : script_(std::move(script)),
+      cx_(0.5 * (scene.bounds_min[0] + scene.bounds_max[0])),
+      cy_(0.5 * (scene.bounds_min[1] + scene.bounds_max[1])),
+      top_(scene.bounds_max[2]),
+      bottom_(scene.bounds_min[2]),
+      duration_(duration_s),
+      depth_(depth_m),
+      pull_(pull_m),
+      // Search: down from 1 cm above the organ at a speed that reaches its bottom in 40% of the run.
+      search_speed_((top_ + 0.01 - bottom_) / (0.4 * duration_s)) {}
+
+client::DeviceSample ScriptedDevice::read(double t) {
+  t_ = t;
+  double jaw = 0.5;
+  if (std::isnan(contact_z_)) {  // searching for the surface (it sags under gravity, moves under other tools)
+    z_ = std::max(bottom_, top_ + 0.01 - search_speed_ * t);
+  } else if (script_ == "press") {
+    const double mid = std::max(0.5 * duration_, contact_t_ + 1e-3);
+    z_ = t < mid ? contact_z_ - depth_ * (t - contact_t_) / (mid - contact_t_) : contact_z_ - depth_ * (duration_ - t) / (duration_ - mid);
+  } else {  // grasp
+    const double bite = contact_z_ - depth_, t1 = contact_t_ + 0.05 * duration_, t2 = std::max(0.75 * duration_, t1 + 1e-3);
+    if (t < t1) z_ = contact_z_ - depth_ * (t - contact_t_) / (t1 - contact_t_);
+    else if (t < t2) z_ = bite + pull_ * (t - t1) / (t2 - t1);
+    else z_ = bite + pull_;
+    jaw = t < t2 ? 0.0 : 0.5;
+  }
+  return {{cx_, cy_, z_}, jaw, 0, t >= duration_};
+}
+
+void ScriptedDevice::render(const protocol::Vector3&, bool in_contact) {
+  if (std::isnan(contact_z_) && in_contact) {
+    contact_z_ = z_;
+    contact_t_ = t_;
+    std::printf("t = %5.2f s  contact at tip z %.4f m\n", t_, z_);
+  }
+}
+
+}  // namespace viscera::haptic
