@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Haptic loop over DDS in one run: ddsperf ping-pong (the floor) and viscera-server + haptic-client
-# at 1 kHz on the liver at 1.5k and 12k tetrahedra. Prints a markdown table (docs/PERFORMANCE.md).
-# Usage: [DEPTH=0.02] bench/haptics.sh [SECONDS]   (default 30 s; DEPTH: press depth in metres)
+# Haptic loop over DDS in one run: ddsperf ping-pong (the floor), then viscera-server + haptic-client
+# at 1 kHz on the liver at 1.5k, 12k (and with SCENES="... liver-96k" 96k) tetrahedra, each scene
+# twice: without mesh updates, and with surface frames at 60 Hz received by the haptic client.
+# Prints a markdown table (docs/PERFORMANCE.md).
+# Usage: [DEPTH=0.02] [SCENES="liver liver-12k"] bench/haptics.sh [SECONDS]   (default 30 s)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-30}"
@@ -12,31 +14,39 @@ ddsperf -D "$((seconds + 2))" pong >/dev/null 2>&1 &
 sleep 0.5
 ddsperf -D "$seconds" ping 1000Hz size 64 > "$tmp/ping.log" 2>&1 || true
 wait || true
-python3 - "$tmp/ping.log" > "$tmp/ping.txt" <<'PY'
+python3 - "$tmp/ping.log" > "$tmp/rows.txt" <<'PY'
 import re, statistics, sys
 p50, p99, mx = [], [], []
 for line in open(sys.argv[1]):
     m = re.search(r"50% ([0-9.]+)us 90% [0-9.]+us 99% ([0-9.]+)us max ([0-9.]+)us", line)
     if m:
         p50.append(float(m.group(1))); p99.append(float(m.group(2))); mx.append(float(m.group(3)))
-print(f"| ddsperf ping-pong, 64 B at 1 kHz (as ddsperf prints it) | {statistics.median(p50):.0f} | {statistics.median(p99):.0f} | {max(mx):.0f} | - | - | - | - | - |")
+print(f"| ddsperf ping-pong, 64 B at 1 kHz (as ddsperf prints it) | - | {statistics.median(p50):.0f} | {statistics.median(p99):.0f} | {max(mx):.0f} | - | - | - | - | - | - |")
 PY
-for scene in liver liver-12k; do
-  domain=$(( (RANDOM % 200) + 1 ))
-  sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$root/data/meshes/#; s#\"../materials/#\"$root/data/materials/#" \
-    "$root/data/scenes/$scene.json" > "$tmp/$scene.json"
-  "$root/build/server/runtime/viscera-server" --scene "$tmp/$scene.json" --duration "$((seconds + 4))" > "$tmp/$scene.server.log" 2>&1 &
-  server=$!
-  "$root/build/tools/haptic-client/haptic-client" --domain "$domain" --duration "$seconds" --depth "${DEPTH:-0.02}" --report "$tmp/$scene.json.report" > /dev/null
-  wait "$server"
-  python3 - "$scene" "$tmp/$scene.json.report" "$tmp/$scene.server.log" >> "$tmp/ping.txt" <<'PY'
+for scene in ${SCENES:-liver liver-12k}; do
+  for mesh_hz in 0 60; do
+    domain=$(( (RANDOM % 200) + 1 ))
+    sed "s/\"domain_id\": 0/\"domain_id\": $domain, \"mesh_rate_hz\": $mesh_hz/; s#\"../meshes/#\"$root/data/meshes/#; s#\"../materials/#\"$root/data/materials/#" \
+      "$root/data/scenes/$scene.json" > "$tmp/$scene.json"
+    "$root/build/server/runtime/viscera-server" --scene "$tmp/$scene.json" > "$tmp/server.log" 2>&1 &
+    server=$!
+    watch=""; [ "$mesh_hz" -gt 0 ] && watch="--watch-mesh"
+    # The client waits for the server (large meshes take seconds to load), then runs SECONDS.
+    "$root/build/tools/haptic-client/haptic-client" --domain "$domain" --duration "$seconds" --depth "${DEPTH:-0.02}" $watch \
+      --report "$tmp/report.json" > /dev/null
+    kill -INT "$server"; wait "$server"
+    python3 - "$scene" "$mesh_hz" "$tmp/report.json" "$tmp/server.log" >> "$tmp/rows.txt" <<'PY'
 import json, re, statistics, sys
-scene, report, log = sys.argv[1:]
-r = json.load(open(report))["round_trip_us"]
+scene, mesh_hz, report, log = sys.argv[1:]
+rep = json.load(open(report))
+r = rep["round_trip_us"]
+# The client's device loop: samples rendered per second from the local force model.
+s = rep["samples"]
+render_hz = (len(s) - 1) / (s[-1]["t_s"] - s[0]["t_s"]) if len(s) > 1 else 0
+frames = f"{rep['mesh']['rate_hz']:.0f}" if "mesh" in rep else "-"
 p50, p99, mx, jit, rate = [], [], [], [], []
 tets = ""
-overruns = 0
-resets = 0
+overruns = resets = 0
 for line in open(log):
     m = re.search(r"([0-9]+) Hz physics, step p50 ([0-9]+) us p99 ([0-9]+) us max ([0-9]+) us, jitter p99 ([0-9]+) us, overruns ([0-9]+)", line)
     if m:
@@ -46,10 +56,19 @@ for line in open(log):
     if m: tets = m.group(1)
     m = re.search(r"([0-9]+) physics resets", line)
     if m: resets = int(m.group(1))
-print(f"| viscera {scene} ({tets} tets): pose -> force round trip | {r['p50']:.0f} | {r['p99']:.0f} | {r['max']:.0f} | "
-      f"{statistics.median(rate):.0f} | {statistics.median(p50):.0f} / {max(p99):.0f} | {max(jit):.0f} | {overruns} | {resets} |")
+print(f"| viscera {scene} ({tets} tets): pose -> force round trip | {frames} | {r['p50']:.0f} | {r['p99']:.0f} | {r['max']:.0f} | "
+      f"{statistics.median(rate):.0f} | {statistics.median(p50):.0f} / {max(p99):.0f} | {max(jit):.0f} | {overruns} | {resets} | {render_hz:.0f} |")
 PY
+  done
 done
-echo "| measurement | p50 [us] | p99 [us] | max [us] | physics rate [Hz] | step p50 / worst p99 [us] | tick jitter p99 [us] | overruns | physics resets |"
-echo "|---|---|---|---|---|---|---|---|---|"
-cat "$tmp/ping.txt"
+echo "| measurement | mesh frames received [Hz] | p50 [us] | p99 [us] | max [us] | physics rate [Hz] | step p50 / worst p99 [us] | tick jitter p99 [us] | overruns | physics resets | client force rendering [Hz] |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+cat "$tmp/rows.txt"
+python3 - "$tmp/rows.txt" <<'PY'
+import sys
+rows = [l.split("|") for l in open(sys.argv[1]) if l.startswith("| viscera")]
+print()
+for off, on in zip(rows[0::2], rows[1::2]):
+    print(f"- {off[1].split(':')[0].strip()}: round-trip p99 with 60 Hz mesh updates / without = {float(on[4]) / float(off[4]):.2f}, "
+          f"p50 {float(on[3]) / float(off[3]):.2f}")
+PY

@@ -66,7 +66,11 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
     K += stiffness_ * n * n.transpose();
     weighted_point += depth * q;
     total += depth;
-    r.depth_m = std::max(r.depth_m, depth);
+    if (depth > r.depth_m) {
+      r.depth_m = depth;
+      r.deepest_triangle = t;
+      r.deepest_weights = w;
+    }
     ++r.triangles_in_contact;
   }
   if (r.triangles_in_contact > 0) {

@@ -12,6 +12,7 @@
 #include "mesh/boundary_surface.hpp"
 #include "mesh/mesh_reader.hpp"
 #include "mesh/refinement.hpp"
+#include "contact_compliance.hpp"
 #include "mesh_publisher.hpp"
 #include "model/model_factory.hpp"
 #include "probe_contact.hpp"
@@ -38,6 +39,7 @@ struct SimulationServer::Impl {
   std::shared_ptr<TetMesh> mesh;
   std::unique_ptr<ForceModel> model;
   std::unique_ptr<ExplicitIntegrator> integrator;
+  std::unique_ptr<ContactCompliance> compliance;  // worker thread; uses *model
   State state;
   double sim_time_s = 0;
   Box bounds;
@@ -116,6 +118,7 @@ struct SimulationServer::Impl {
     integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
                                                       ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step});
     state = State::at_rest(*mesh);
+    compliance = std::make_unique<ContactCompliance>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc);
     surface_nodes = boundary.nodes;
     for (const auto& spec : s.instruments)
       instruments[spec.id] = Instrument{spec, std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m)};
@@ -258,10 +261,30 @@ struct SimulationServer::Impl {
     f.in_contact = inst.result.in_contact;
     f.contact_point = {inst.result.point.x(), inst.result.point.y(), inst.result.point.z()};
     f.contact_normal = {inst.result.normal.x(), inst.result.normal.y(), inst.result.normal.z()};
-    f.stiffness = inst.result.stiffness;
+    f.stiffness = local_stiffness(inst.result);
     f.penetration_m = inst.result.depth_m;
     forces.write(id, proto::encode(f));
     ++stats.forces_sent;
+  }
+
+  /// The local force model's stiffness: the contact penalty in series with the tissue condensed
+  /// onto the contact, along the contact normal (the contact is frictionless); the penalty alone
+  /// (an upper bound) until the tissue's compliance at the contact is known.
+  std::array<double, 9> local_stiffness(const ContactResult& r) {
+    if (!r.in_contact || r.deepest_triangle[0] < 0) return r.stiffness;
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> penalty(r.stiffness.data());
+    const double k_penalty = r.normal.dot(penalty * r.normal);
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const auto block = compliance->node(r.deepest_triangle[k]);
+      if (!block) return r.stiffness;
+      C += r.deepest_weights[k] * *block;
+    }
+    const double k = 1.0 / (1.0 / k_penalty + r.normal.dot(C * r.normal));
+    std::array<double, 9> out;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out[3 * i + j] = k * r.normal[i] * r.normal[j];
+    return out;
   }
 
   void publish_forces(std::int64_t step_time_ns, ServerStats& stats) {

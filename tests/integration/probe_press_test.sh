@@ -98,7 +98,18 @@ assert deep > 1.5 * shallow, f"force does not grow with depth: {shallow:.3f} N s
 # first contact; a soft organ in series with the penalty gives far less.
 travel = max(x["tip_z_m"] for x in down) - sum(x["tip_z_m"] for x in down[-n:]) / n
 assert deep < 0.3 * k * travel, f"the organ does not yield: {deep:.2f} N deep, penalty on a rigid surface {k * travel:.2f} N"
+# The local force model's stiffness is the tissue condensed onto the contact (static, at rest,
+# unrelaxed) in series with the penalty: it must match the force-depth slope the dynamic
+# simulation produced (another code path) within the viscoelastic relaxation and the stiffening
+# with depth, and be far below the penalty alone.
+z = [x["tip_z_m"] for x in down]; F = [x["force_n"][2] for x in down]
+mz, mF = sum(z) / len(z), sum(F) / len(F)
+slope = -sum((a - mz) * (b - mF) for a, b in zip(z, F)) / sum((a - mz) ** 2 for a in z)
+local = sorted(x["normal_stiffness_n_per_m"] for x in down)[len(down) // 2]
+assert 0.5 * slope < local < 3 * slope, f"local model stiffness {local:.0f} N/m against the force-depth slope {slope:.0f} N/m"
+assert local < 0.2 * k, f"local model stiffness {local:.0f} N/m is not far below the penalty {k:.0f} N/m"
 rt = r["round_trip_us"]
+print(f"[ figure ] local force model: median normal stiffness {local:.0f} N/m, force-depth slope of the simulation {slope:.0f} N/m, penalty {k:.0f} N/m")
 print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% opposing, mean F_z {shallow:.2f} N shallow, {deep:.2f} N deep "
       f"({100 * deep / (k * travel):.0f}% of the penalty on a rigid surface over {1000 * travel:.0f} mm); "
       f"round trip p50 {rt['p50']:.0f} us, p99 {rt['p99']:.0f} us, max {rt['max']:.0f} us over {rt['samples']} commands")

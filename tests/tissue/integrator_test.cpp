@@ -256,3 +256,46 @@ TEST(Explicit, AdvanceUsesEqualSubStepsSoTicksNotAMultipleOfTheStepStayStable) {
   for (std::size_t i = 0; i < st.x.size(); ++i) amplitude = std::max(amplitude, (st.x[i] - s.mesh->nodes[i]).norm());
   EXPECT_LT(amplitude, 1e-6);
 }
+
+TEST(Implicit, StaticComplianceEqualsTheDenseInverseOfTheRestStiffness) {
+  // The calibrated GPS equals linear FE at small strain, so its factorised rest tangent must
+  // invert the dense linear-FE stiffness assembled above, fixed nodes removed.
+  Fixture s;
+  const GpsModel gps(s.mesh, {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.0});
+  BoundaryConditions bc;
+  const Box box = bounding_box(*s.mesh);
+  bc.fixed_nodes = nodes_in_box(*s.mesh, {box.lo, Vec3(box.lo.x() + 0.2 * (box.hi.x() - box.lo.x()), box.hi.y(), box.hi.z())});
+  ImplicitIntegrator implicit(gps, s.rho(), bc, {1e-3});
+  ASSERT_TRUE(implicit.factorize_stiffness(s.mesh->nodes));
+  const Eigen::MatrixXd K = dense_stiffness(*s.mesh, test::soft_tissue());
+  std::vector<bool> fixed(s.mesh->node_count(), false);
+  for (auto i : bc.fixed_nodes) fixed[static_cast<std::size_t>(i)] = true;
+  std::vector<Eigen::Index> free;
+  for (Eigen::Index c = 0; c < K.rows(); ++c)
+    if (!fixed[static_cast<std::size_t>(c / 3)]) free.push_back(c);
+  Eigen::MatrixXd Kf(free.size(), free.size());
+  for (std::size_t a = 0; a < free.size(); ++a)
+    for (std::size_t b = 0; b < free.size(); ++b) Kf(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = K(free[a], free[b]);
+  const Eigen::LLT<Eigen::MatrixXd> llt(Kf);
+  // A load at the node farthest from the fixed end, along each axis.
+  std::size_t tip = 0;
+  for (std::size_t i = 0; i < s.mesh->node_count(); ++i)
+    if (s.mesh->nodes[i].x() > s.mesh->nodes[tip].x()) tip = i;
+  std::vector<Vec3> f(s.mesh->node_count(), Vec3::Zero()), u(s.mesh->node_count());
+  for (int d = 0; d < 3; ++d) {
+    f[tip] = Vec3::Unit(d);
+    implicit.compliance(f, u);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()));
+    for (std::size_t a = 0; a < free.size(); ++a)
+      if (free[a] == static_cast<Eigen::Index>(3 * tip) + d) b(static_cast<Eigen::Index>(a)) = 1.0;
+    const Eigen::VectorXd ref = llt.solve(b);
+    double err = 0, scale = 0;
+    for (std::size_t a = 0; a < free.size(); ++a) {
+      const double mine = u[static_cast<std::size_t>(free[a] / 3)][static_cast<int>(free[a] % 3)];
+      err = std::max(err, std::abs(mine - ref(static_cast<Eigen::Index>(a))));
+      scale = std::max(scale, std::abs(ref(static_cast<Eigen::Index>(a))));
+    }
+    EXPECT_LT(err, 1e-8 * scale) << "axis " << d;
+    for (auto i : bc.fixed_nodes) EXPECT_EQ(u[static_cast<std::size_t>(i)].norm(), 0.0);
+  }
+}

@@ -149,8 +149,12 @@ int main(int argc, char** argv) {
                                                : viscera::client::RenderedForce{};
         device->render(rendered.force, f->in_contact);
         clamps += rendered.clamped;
+        double normal_stiffness = 0;  // n^T K n of the local model [N/m]
+        for (std::size_t i = 0; i < 3; ++i)
+          for (std::size_t j = 0; j < 3; ++j) normal_stiffness += f->contact_normal[i] * f->stiffness[3 * i + j] * f->contact_normal[j];
         samples.push_back({{"t_s", t}, {"tip_z_m", in.tip_m[2]}, {"jaw_rad", in.jaw_rad}, {"force_n", {f->force[0], f->force[1], f->force[2]}},
                            {"in_contact", f->in_contact}, {"penetration_m", f->penetration_m},
+                           {"normal_stiffness_n_per_m", normal_stiffness},
                            {"rendered_force_n", {rendered.force[0], rendered.force[1], rendered.force[2]}},
                            {"model_age_commands", seq - f->command_seq}, {"command_seq", f->command_seq}});
         if (!quiet && t - last_print >= 0.25) {

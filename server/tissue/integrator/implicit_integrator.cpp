@@ -126,6 +126,20 @@ void ImplicitIntegrator::assemble(const std::vector<Vec3>& x, double mass_scale,
   }
 }
 
+bool ImplicitIntegrator::factorize_stiffness(const std::vector<Vec3>& x) {
+  if (!solver_) return false;
+  assemble(x, 0.0, 0.0);
+  return solver_->factorize();
+}
+
+void ImplicitIntegrator::compliance(std::span<const Vec3> f, std::span<Vec3> u) {
+  std::vector<double> b(static_cast<std::size_t>(free_dofs_)), y(b.size());
+  for (std::size_t c = 0; c < dof_.size(); ++c)
+    if (dof_[c] >= 0) b[static_cast<std::size_t>(dof_[c])] = f[c / 3][static_cast<int>(c % 3)];
+  solver_->solve(b, y);
+  for (std::size_t c = 0; c < dof_.size(); ++c) u[c / 3][static_cast<int>(c % 3)] = dof_[c] >= 0 ? y[static_cast<std::size_t>(dof_[c])] : 0.0;
+}
+
 void ImplicitIntegrator::update_external(double t) {
   for (std::size_t i = 0; i < mass_.size(); ++i) external_[i] = mass_[i] * bc_.gravity_m_s2 + bc_.nodal_force(i, t);
 }

@@ -6,6 +6,7 @@
 // (never a single linearised step) and reports iterations and residuals. The same machinery
 // solves for static equilibrium (-f_int(x) - f_ext = 0).
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "integrator/boundary_conditions.hpp"
@@ -43,6 +44,13 @@ class ImplicitIntegrator {
   /// Static equilibrium at time state.time_s (prescribed motions evaluated then); v is zeroed.
   /// Memory variables are not used: the response is the instantaneous (unrelaxed) one.
   NewtonReport solve_static(State& state);
+
+  /// The static stiffness at configuration x (tangent, constrained coordinates removed),
+  /// factorised for compliance(); false if it is not positive definite.
+  bool factorize_stiffness(const std::vector<Vec3>& x);
+  /// Displacements u = K^-1 f for nodal forces f [N] with the last factorize_stiffness();
+  /// constrained coordinates get 0. Several threads must not call it at once.
+  void compliance(std::span<const Vec3> f, std::span<Vec3> u);
 
   const std::vector<double>& masses() const { return mass_; }
   /// Internal forces [N] at the state the last step or solve ended in (reactions at constrained
