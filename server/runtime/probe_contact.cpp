@@ -40,10 +40,11 @@ ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, double tip_rad
 ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f,
                                   std::span<double> node_stiffness) const {
   ContactResult r;
-  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
-  Vec3 weighted_point = Vec3::Zero();
+  // First pass: the triangles the tip sphere touches, with their depths.
+  touching_.clear();
   double total = 0.0;
-  for (const auto& t : surface_) {
+  for (std::size_t k = 0; k < surface_.size(); ++k) {
+    const auto& t = surface_[k];
     const Vec3 &a = x[t[0]], &b = x[t[1]], &c = x[t[2]];
     Vec3 n = (b - a).cross(c - a);
     const double area2 = n.norm();
@@ -57,30 +58,39 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
     const bool interior = w.minCoeff() > 0;
     if (!interior && (s < 0 || (centre - q).norm() >= radius_)) continue;
     const double depth = radius_ - s;
-    const Vec3 push = stiffness_ * depth * n;  // on the tool, out of the tissue
-    if (!f.empty())
-      for (int k = 0; k < 3; ++k) f[t[k]] -= w[k] * push;
-    if (!node_stiffness.empty())
-      for (int k = 0; k < 3; ++k) node_stiffness[t[k]] += std::sqrt(3.0) * stiffness_ * w[k];
-    r.force_on_tool += push;
-    K += stiffness_ * n * n.transpose();
-    weighted_point += depth * q;
+    touching_.push_back({k, n, w, q, depth});
     total += depth;
     if (depth > r.depth_m) {
       r.depth_m = depth;
       r.deepest_triangle = t;
       r.deepest_weights = w;
     }
-    ++r.triangles_in_contact;
   }
-  if (r.triangles_in_contact > 0) {
-    r.in_contact = true;
-    r.point = weighted_point / total;
-    const double fn = r.force_on_tool.norm();
-    if (fn > 0) r.normal = r.force_on_tool / fn;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) r.stiffness[3 * i + j] = K(i, j);
+  if (touching_.empty()) return r;
+  // Second pass: one contact of stiffness k at the deepest penetration, shared among the touched
+  // triangles by depth, so the force does not grow with the number of triangles under the tip
+  // (a finer mesh would otherwise push harder for the same indentation).
+  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
+  Vec3 weighted_point = Vec3::Zero();
+  for (const auto& c : touching_) {
+    const double share = c.depth / total;
+    const Vec3 push = stiffness_ * r.depth_m * share * c.normal;  // on the tool, out of the tissue
+    const auto& t = surface_[c.triangle];
+    if (!f.empty())
+      for (int k = 0; k < 3; ++k) f[t[k]] -= c.weights[k] * push;
+    if (!node_stiffness.empty())
+      for (int k = 0; k < 3; ++k) node_stiffness[t[k]] += std::sqrt(3.0) * stiffness_ * share * c.weights[k];
+    r.force_on_tool += push;
+    K += stiffness_ * share * c.normal * c.normal.transpose();
+    weighted_point += share * c.point;
   }
+  r.triangles_in_contact = static_cast<int>(touching_.size());
+  r.in_contact = true;
+  r.point = weighted_point;
+  const double fn = r.force_on_tool.norm();
+  if (fn > 0) r.normal = r.force_on_tool / fn;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.stiffness[3 * i + j] = K(i, j);
   return r;
 }
 

@@ -2,11 +2,14 @@
 // Contact of a sphere-tipped probe with the organ's boundary triangles (HAPTICS.md, "Probe").
 // For every triangle, the closest point q to the tip centre c and the signed distance
 // s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r.
+// The contact is one penalty spring k at the deepest penetration d, its force k d shared among
+// the touched triangles in proportion to their depths, so it does not depend on how finely the
+// surface is meshed.
 // Because s keeps decreasing (and goes negative) when the centre passes below the surface, a tip
 // that moved deeper than its radius within one step is still pushed out along the normal: it does
 // not tunnel (triangles whose plane is more than `max_depth` behind the tip are ignored, so the
-// far side of the organ does not pull). The penalty force k (r - s) n acts on the triangle's
-// vertices with barycentric weights; the tool feels the opposite.
+// far side of the organ does not pull). Each triangle's share acts on its vertices with
+// barycentric weights; the tool feels the opposite.
 #include <array>
 #include <span>
 #include <vector>
@@ -32,14 +35,21 @@ class ProbeContact {
  public:
   ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m = 0.02);
   /// Adds the penalty forces on the organ to f for the tip at `centre`, and to `node_stiffness`
-  /// (if not empty) a bound on their stiffness per node, sqrt(3) k w (the Gershgorin row sum);
-  /// returns the reaction. With an empty f it only queries the reaction (the state is not changed).
+  /// (if not empty) a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row
+  /// sum); returns the reaction. With an empty f it only queries the reaction (the state is not
+  /// changed). Not for concurrent calls on one object (it reuses a scratch list).
   ContactResult apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f,
                       std::span<double> node_stiffness = {}) const;
 
  private:
+  struct Touch {
+    std::size_t triangle;
+    Vec3 normal, weights, point;
+    double depth;
+  };
   std::vector<tissue::Triangle> surface_;
   double radius_, stiffness_, max_depth_;
+  mutable std::vector<Touch> touching_;
 };
 
 /// Closest point on triangle (a, b, c) to p, with its barycentric coordinates (Ericson 2005, 5.1.5).

@@ -55,6 +55,7 @@ SceneSpec read_scene_file(const std::string& path) {
   s.global_stable_step = step == "global";
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
+  s.max_tool_speed_m_s = number(j, "max_tool_speed_m_s", "", 1e-3, 100, 0.5);
   if (o.contains("fix_slab")) {
     const json& f = o["fix_slab"];
     if (!f.is_array() || f.size() != 3 || !f[0].is_string() || !f[1].is_string() || !f[2].is_number())

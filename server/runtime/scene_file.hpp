@@ -27,6 +27,7 @@ struct SceneSpec {
   bool global_stable_step = false;  ///< "stable_step": "global" | "element"
   double contact_stiffness_n_per_m = 200.0;
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
+  double max_tool_speed_m_s = 0.5;  ///< simulated tools follow commands at most this fast (simulated time)
   std::string fix_axis = "z", fix_side = "max";
   double fix_fraction = 0.2;
   std::vector<InstrumentSpec> instruments;

@@ -53,6 +53,10 @@ struct SimulationServer::Impl {
     // Grasper: nodes held by the closed jaws, with their offsets from the tip when grasped.
     std::vector<std::pair<std::int32_t, Vec3>> grasped;
     proto::Command last;
+    // The simulated tool: follows the commanded tip at most at the scene's tool speed limit in
+    // simulated time, so a server that runs slower than real time (or a jumping device) never
+    // drives the tool through the tissue within one tick.
+    Vec3 proxy = Vec3::Zero();
     ContactResult result;
   };
   std::map<std::uint32_t, Instrument> instruments;
@@ -99,8 +103,7 @@ struct SimulationServer::Impl {
           inst.result = {};
           continue;
         }
-        const auto& p = inst.last.tip_position;
-        const Vec3 tip(p[0], p[1], p[2]);
+        const Vec3& tip = inst.proxy;
         inst.result = inst.contact->apply(tip, x, f, stiffness);
         // Grasped nodes follow the jaws through stiff springs; the tool feels their reaction.
         for (const auto& [node, offset] : inst.grasped) {
@@ -186,13 +189,24 @@ struct SimulationServer::Impl {
   /// radius of the tip; opening them (above 0.2 rad, hysteresis) releases them.
   void update_grasp(Instrument& inst) {
     if (inst.spec.kind != "grasper") return;
-    const auto& p = inst.last.tip_position;
-    const Vec3 tip(p[0], p[1], p[2]);
+    const Vec3& tip = inst.proxy;  // the grasped nodes follow the simulated tool
     if (inst.grasped.empty() && inst.last.jaw_opening < 0.1) {
       for (auto n : surface_nodes)
         if ((state.x[n] - tip).norm() < inst.spec.grasp_radius_m) inst.grasped.emplace_back(n, state.x[n] - tip);
     } else if (!inst.grasped.empty() && inst.last.jaw_opening > 0.2) {
       inst.grasped.clear();
+    }
+  }
+
+  /// Each simulated tool moves toward its commanded tip by at most the speed limit times dt.
+  void move_proxies(double dt_s) {
+    const double reach = scene.max_tool_speed_m_s * dt_s;
+    for (auto& [id, inst] : instruments) {
+      if (!inst.has_command) continue;
+      const auto& p = inst.last.tip_position;
+      const Vec3 gap = Vec3(p[0], p[1], p[2]) - inst.proxy;
+      const double d = gap.norm();
+      inst.proxy += d <= reach ? gap : (reach / d) * gap;
     }
   }
 
@@ -232,6 +246,7 @@ struct SimulationServer::Impl {
       Instrument& inst = it->second;
       inst.last_heard_ns = proto::now_ns();
       if (!inst.has_command || c->seq > inst.last.seq) {
+        if (!inst.has_command) inst.proxy = Vec3(c->tip_position[0], c->tip_position[1], c->tip_position[2]);
         inst.last = *c;
         inst.has_command = true;
         update_grasp(inst);
@@ -320,6 +335,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     s.take_sessions();
     s.answer_new_commands(stats);
     s.release_silent(500'000'000, status);  // the DDS liveliness lease of the command stream
+    s.move_proxies(1.0 / s.scene.physics_rate_hz);
     const auto t0 = clock::now();
     try {
       s.integrator->advance(s.state, 1.0 / s.scene.physics_rate_hz);
