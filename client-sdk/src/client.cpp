@@ -61,6 +61,18 @@ void Client::release(std::uint32_t instrument_id) {
   impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, proto::Action::release_instrument, instrument_id}));
 }
 
+bool Client::control(proto::Action action, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  do {
+    impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, action, 0}));
+    if (action == proto::Action::reset) return true;
+    impl_->scene.wait(std::chrono::milliseconds(100));
+    impl_->take_scene(rejected_);
+    if (impl_->last_scene && impl_->last_scene->paused == (action == proto::Action::pause)) return true;
+  } while (std::chrono::steady_clock::now() < end);
+  return false;
+}
+
 void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad) {
   proto::Command c;
   c.instrument_id = instrument_id;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <mutex>
 #include <thread>
 
 #include "common/input_error.hpp"
@@ -44,29 +45,48 @@ struct SimulationServer::Impl {
   double sim_time_s = 0;
   Box bounds;
 
+  // Two threads: the physics thread (run()) steps the organ at the fixed rate; the command thread
+  // answers every command the moment it arrives with the reaction at the commanded pose on the
+  // newest published state (a Snapshot), so the round trip never waits for a step.
   struct Instrument {
     InstrumentSpec spec;
-    std::unique_ptr<ProbeContact> contact;
+    // Shared, guarded by command_mutex: who owns it and the newest command.
     std::uint32_t owner = 0;
     bool has_command = false;
     std::int64_t last_heard_ns = 0;  // owner's last command or claim
-    // Grasper: nodes held by the closed jaws, with their offsets from the tip when grasped.
-    std::vector<std::pair<std::int32_t, Vec3>> grasped;
     proto::Command last;
+    // Physics thread only.
+    std::unique_ptr<ProbeContact> contact;
+    bool active = false;       // owned and commanded during the current tick
+    std::uint32_t tick_owner = 0;
+    proto::Command tick;       // the command the current tick steps with
     // The simulated tool: follows the commanded tip at most at the scene's tool speed limit in
     // simulated time, so a server that runs slower than real time (or a jumping device) never
     // drives the tool through the tissue within one tick.
     Vec3 proxy = Vec3::Zero();
+    // Grasper: nodes held by the closed jaws, with their offsets from the tool when grasped.
+    std::vector<std::pair<std::int32_t, Vec3>> grasped;
     ContactResult result;
+    // Command thread only: its own contact query (ProbeContact keeps scratch space).
+    std::unique_ptr<ProbeContact> query;
   };
   std::map<std::uint32_t, Instrument> instruments;
+  std::mutex command_mutex;
   std::vector<std::int32_t> surface_nodes;
+
+  /// What the command thread answers from: the organ after the last tick and the grasped nodes.
+  struct Snapshot {
+    std::vector<Vec3> x;
+    std::map<std::uint32_t, std::vector<std::pair<std::int32_t, Vec3>>> grasped;
+  };
+  std::atomic<std::shared_ptr<const Snapshot>> snapshot;
+  bool paused = false;  // physics thread
 
   proto::Participant participant;
   proto::Reader commands, sessions;
   proto::Writer forces, scene_state, telemetry;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread; after the writers it uses
-  std::uint64_t rejected = 0;
+  std::atomic<std::uint64_t> rejected{0}, forces_sent{0};
 
   explicit Impl(const SceneSpec& s)
       : scene(s),
@@ -99,7 +119,7 @@ struct SimulationServer::Impl {
     bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
     bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
       for (auto& [id, inst] : instruments) {
-        if (inst.owner == 0 || !inst.has_command) {
+        if (!inst.active) {
           inst.result = {};
           continue;
         }
@@ -123,8 +143,13 @@ struct SimulationServer::Impl {
     state = State::at_rest(*mesh);
     compliance = std::make_unique<ContactCompliance>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc);
     surface_nodes = boundary.nodes;
-    for (const auto& spec : s.instruments)
-      instruments[spec.id] = Instrument{spec, std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m)};
+    for (const auto& spec : s.instruments) {
+      Instrument& inst = instruments[spec.id];
+      inst.spec = spec;
+      inst.contact = std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m);
+      inst.query = std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m);
+    }
+    publish_snapshot();
     if (s.mesh_rate_hz > 0) mesh_publisher = std::make_unique<MeshPublisher>(participant, surface_topology(boundary), boundary.nodes, s.mesh_rate_hz);
     publish_scene();
   }
@@ -149,13 +174,19 @@ struct SimulationServer::Impl {
     proto::Scene sc;
     sc.name = scene.name;
     sc.physics_rate_hz = scene.physics_rate_hz;
-    for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, inst.spec.kind == "grasper", inst.spec.tip_radius_m, inst.owner});
+    sc.paused = paused;
+    {
+      std::lock_guard lock(command_mutex);
+      for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, inst.spec.kind == "grasper", inst.spec.tip_radius_m, inst.owner});
+    }
     sc.bounds_min = {bounds.lo.x(), bounds.lo.y(), bounds.lo.z()};
     sc.bounds_max = {bounds.hi.x(), bounds.hi.y(), bounds.hi.z()};
     scene_state.write(0, proto::encode(sc));
   }
 
-  void take_sessions() {
+  /// Session requests (physics thread): claim and release an instrument (its owner only);
+  /// pause, resume and reset the organ (any client: an instructor's console or a trainer).
+  void take_sessions(const std::function<void(const std::string&)>& status) {
     bool changed = false;
     sessions.take([&](const proto::Received& r) {
       std::string why;
@@ -164,6 +195,22 @@ struct SimulationServer::Impl {
         ++rejected;
         return;
       }
+      const std::string who = "client " + std::to_string(req->client_id);
+      switch (req->action) {
+        case proto::Action::pause:
+        case proto::Action::resume:
+          if (paused != (req->action == proto::Action::pause) && status) status(who + (paused ? " resumed" : " paused") + " the simulation");
+          paused = req->action == proto::Action::pause;
+          changed = true;
+          return;
+        case proto::Action::reset:
+          reset_organ();
+          if (status) status(who + " reset the organ to rest");
+          return;
+        default:
+          break;
+      }
+      std::lock_guard lock(command_mutex);
       const auto it = instruments.find(req->instrument_id);
       if (it == instruments.end()) {
         ++rejected;
@@ -178,11 +225,32 @@ struct SimulationServer::Impl {
       } else if (req->action == proto::Action::release_instrument && inst.owner == req->client_id) {
         inst.owner = 0;
         inst.has_command = false;
-        inst.grasped.clear();
         changed = true;
       }
     });
     if (changed) publish_scene();
+  }
+
+  /// The organ back at rest (memory variables relaxed); graspers let go.
+  void reset_organ() {
+    state = State::at_rest(*mesh);
+    for (auto& [id, inst] : instruments) inst.grasped.clear();
+  }
+
+  /// Tick start (physics thread): which instruments are owned and commanded, with which command.
+  void take_tick_commands() {
+    std::lock_guard lock(command_mutex);
+    for (auto& [id, inst] : instruments) {
+      const bool was_active = inst.active;
+      inst.active = inst.owner != 0 && inst.has_command;
+      inst.tick_owner = inst.owner;
+      if (!inst.active) {
+        inst.grasped.clear();  // released, or its client silent: a grasper lets go
+        continue;
+      }
+      inst.tick = inst.last;
+      if (!was_active) inst.proxy = Vec3(inst.tick.tip_position[0], inst.tick.tip_position[1], inst.tick.tip_position[2]);
+    }
   }
 
   /// Graspers: jaws closing (opening below 0.1 rad) grasp the surface nodes within the grasp
@@ -190,23 +258,25 @@ struct SimulationServer::Impl {
   void update_grasp(Instrument& inst) {
     if (inst.spec.kind != "grasper") return;
     const Vec3& tip = inst.proxy;  // the grasped nodes follow the simulated tool
-    if (inst.grasped.empty() && inst.last.jaw_opening < 0.1) {
+    if (inst.grasped.empty() && inst.tick.jaw_opening < 0.1) {
       for (auto n : surface_nodes)
         if ((state.x[n] - tip).norm() < inst.spec.grasp_radius_m) inst.grasped.emplace_back(n, state.x[n] - tip);
-    } else if (!inst.grasped.empty() && inst.last.jaw_opening > 0.2) {
+    } else if (!inst.grasped.empty() && inst.tick.jaw_opening > 0.2) {
       inst.grasped.clear();
     }
   }
 
-  /// Each simulated tool moves toward its commanded tip by at most the speed limit times dt.
-  void move_proxies(double dt_s) {
+  /// Each simulated tool moves toward its commanded tip by at most the speed limit times dt;
+  /// graspers then close on or let go of the tissue.
+  void move_tools(double dt_s) {
     const double reach = scene.max_tool_speed_m_s * dt_s;
     for (auto& [id, inst] : instruments) {
-      if (!inst.has_command) continue;
-      const auto& p = inst.last.tip_position;
+      if (!inst.active) continue;
+      const auto& p = inst.tick.tip_position;
       const Vec3 gap = Vec3(p[0], p[1], p[2]) - inst.proxy;
       const double d = gap.norm();
       inst.proxy += d <= reach ? gap : (reach / d) * gap;
+      update_grasp(inst);
     }
   }
 
@@ -214,23 +284,31 @@ struct SimulationServer::Impl {
   /// released safely (no force on the tissue from it any more).
   void release_silent(std::int64_t lease_ns, const std::function<void(const std::string&)>& status) {
     const std::int64_t now = proto::now_ns();
-    bool changed = false;
-    for (auto& [id, inst] : instruments)
-      if (inst.owner != 0 && now - inst.last_heard_ns > lease_ns) {
-        if (status) status("instrument " + std::to_string(id) + " released: client " + std::to_string(inst.owner) + " silent for more than the lease");
-        inst.owner = 0;
-        inst.has_command = false;
-        inst.grasped.clear();  // a dead client's grasper lets go
-        changed = true;
-      }
-    if (changed) publish_scene();
+    std::vector<std::string> released;
+    {
+      std::lock_guard lock(command_mutex);
+      for (auto& [id, inst] : instruments)
+        if (inst.owner != 0 && now - inst.last_heard_ns > lease_ns) {
+          released.push_back("instrument " + std::to_string(id) + " released: client " + std::to_string(inst.owner) +
+                             " silent for more than the lease");
+          inst.owner = 0;  // its grasper lets go at the next tick (take_tick_commands)
+          inst.has_command = false;
+        }
+    }
+    for (const auto& line : released)
+      if (status) status(line);
+    if (!released.empty()) publish_scene();
   }
 
-  /// Commands that arrive between ticks are answered at once: the reaction at the commanded pose
-  /// on the current tissue state (contact query, no step), so the round trip does not wait for
-  /// the next tick. The tick then steps the tissue with the newest pose.
-  void answer_new_commands(ServerStats& stats) {
-    std::vector<std::uint32_t> updated;
+  /// Command thread: each valid command from an instrument's owner becomes the instrument's
+  /// newest command and is answered at once with the reaction at the commanded pose on the
+  /// newest snapshot (contact query, no step). The next tick steps the tissue with it.
+  void answer_new_commands() {
+    struct Update {
+      std::uint32_t id, owner;
+      proto::Command command;
+    };
+    std::vector<Update> updated;
     commands.take([&](const proto::Received& r) {
       std::string why;
       const auto c = proto::decode_command(r.payload, &why);
@@ -238,6 +316,7 @@ struct SimulationServer::Impl {
         ++rejected;
         return;
       }
+      std::lock_guard lock(command_mutex);
       const auto it = instruments.find(c->instrument_id);
       if (it == instruments.end() || it->second.owner != c->client_id) {
         ++rejected;
@@ -246,40 +325,50 @@ struct SimulationServer::Impl {
       Instrument& inst = it->second;
       inst.last_heard_ns = proto::now_ns();
       if (!inst.has_command || c->seq > inst.last.seq) {
-        if (!inst.has_command) inst.proxy = Vec3(c->tip_position[0], c->tip_position[1], c->tip_position[2]);
         inst.last = *c;
         inst.has_command = true;
-        update_grasp(inst);
-        updated.push_back(c->instrument_id);
+        updated.push_back({c->instrument_id, inst.owner, *c});
       }
     });
-    for (auto id : updated) {
-      Instrument& inst = instruments[id];
-      const auto& p = inst.last.tip_position;
+    if (updated.empty()) return;
+    const auto snap = snapshot.load();
+    for (const auto& u : updated) {
+      const auto& p = u.command.tip_position;
       const Vec3 tip(p[0], p[1], p[2]);
-      inst.result = inst.contact->apply(tip, state.x, {});
-      for (const auto& [node, offset] : inst.grasped) inst.result.force_on_tool -= scene.grasp_stiffness_n_per_m * (tip + offset - state.x[node]);
-      if (!inst.grasped.empty()) inst.result.in_contact = true;
-      publish_force(id, inst, 0, stats);
+      ContactResult result = instruments.at(u.id).query->apply(tip, snap->x, {});
+      if (const auto g = snap->grasped.find(u.id); g != snap->grasped.end()) {
+        for (const auto& [node, offset] : g->second) result.force_on_tool -= scene.grasp_stiffness_n_per_m * (tip + offset - snap->x[node]);
+        if (!g->second.empty()) result.in_contact = true;
+      }
+      publish_force(u.id, u.owner, u.command, result, 0);
     }
   }
 
-  void publish_force(std::uint32_t id, const Instrument& inst, std::int64_t step_time_ns, ServerStats& stats) {
+  void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns) {
     proto::Force f;
     f.instrument_id = id;
-    f.client_id = inst.owner;
-    f.command_seq = inst.last.seq;
-    f.command_client_stamp_ns = inst.last.client_stamp_ns;
+    f.client_id = owner;
+    f.command_seq = command.seq;
+    f.command_client_stamp_ns = command.client_stamp_ns;
     f.server_stamp_ns = proto::now_ns();
     f.step_time_ns = step_time_ns;
-    f.force = {inst.result.force_on_tool.x(), inst.result.force_on_tool.y(), inst.result.force_on_tool.z()};
-    f.in_contact = inst.result.in_contact;
-    f.contact_point = {inst.result.point.x(), inst.result.point.y(), inst.result.point.z()};
-    f.contact_normal = {inst.result.normal.x(), inst.result.normal.y(), inst.result.normal.z()};
-    f.stiffness = local_stiffness(inst.result);
-    f.penetration_m = inst.result.depth_m;
+    f.force = {r.force_on_tool.x(), r.force_on_tool.y(), r.force_on_tool.z()};
+    f.in_contact = r.in_contact;
+    f.contact_point = {r.point.x(), r.point.y(), r.point.z()};
+    f.contact_normal = {r.normal.x(), r.normal.y(), r.normal.z()};
+    f.stiffness = local_stiffness(r);
+    f.penetration_m = r.depth_m;
     forces.write(id, proto::encode(f));
-    ++stats.forces_sent;
+    ++forces_sent;
+  }
+
+  /// After a tick (physics thread): the command thread answers from this state from now on.
+  void publish_snapshot() {
+    auto snap = std::make_shared<Snapshot>();
+    snap->x = state.x;
+    for (const auto& [id, inst] : instruments)
+      if (!inst.grasped.empty()) snap->grasped[id] = inst.grasped;
+    snapshot.store(std::move(snap));
   }
 
   /// The local force model's stiffness: the contact penalty in series with the tissue condensed
@@ -302,9 +391,9 @@ struct SimulationServer::Impl {
     return out;
   }
 
-  void publish_forces(std::int64_t step_time_ns, ServerStats& stats) {
+  void publish_forces(std::int64_t step_time_ns) {
     for (const auto& [id, inst] : instruments)
-      if (inst.owner != 0 && inst.has_command) publish_force(id, inst, step_time_ns, stats);
+      if (inst.active) publish_force(id, inst.tick_owner, inst.tick, inst.result, step_time_ns);
   }
 };
 
@@ -323,7 +412,23 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
   Impl& s = *impl_;
   ServerStats stats;
   using clock = std::chrono::steady_clock;
-  const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / s.scene.physics_rate_hz));
+  // The command thread answers commands as they arrive, on the other core, while this thread steps.
+  std::atomic<bool> stopping{false};
+  std::thread command_thread([&] {
+    while (!stopping.load())
+      if (s.commands.wait(std::chrono::milliseconds(20))) s.answer_new_commands();
+  });
+  struct Join {
+    std::atomic<bool>& stopping;
+    std::thread& thread;
+    ~Join() {
+      stopping = true;
+      thread.join();
+    }
+  } join{stopping, command_thread};
+
+  const double dt = 1.0 / s.scene.physics_rate_hz;
+  const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 * dt));
   const auto start = clock::now();
   auto next = start;
   auto last_report = start;
@@ -332,25 +437,27 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
   while (!stop.load()) {
     const auto tick_start = clock::now();
     jitter_us.push_back(std::chrono::duration<double, std::micro>(tick_start - next).count());
-    s.take_sessions();
-    s.answer_new_commands(stats);
+    s.take_sessions(status);
     s.release_silent(500'000'000, status);  // the DDS liveliness lease of the command stream
-    s.move_proxies(1.0 / s.scene.physics_rate_hz);
+    s.take_tick_commands();
     const auto t0 = clock::now();
-    try {
-      s.integrator->advance(s.state, 1.0 / s.scene.physics_rate_hz);
-      s.sim_time_s += 1.0 / s.scene.physics_rate_hz;
-    } catch (const SimulationError& e) {
-      // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
-      // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.
-      s.state = State::at_rest(*s.mesh);
-      for (auto& [id, inst] : s.instruments) inst.grasped.clear();
-      ++stats.physics_resets;
-      if (status) status(std::string("physics: ") + e.what() + "; organ reset to rest");
+    if (!s.paused) {
+      s.move_tools(dt);
+      try {
+        s.integrator->advance(s.state, dt);
+        s.sim_time_s += dt;
+      } catch (const SimulationError& e) {
+        // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
+        // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.
+        s.reset_organ();
+        ++stats.physics_resets;
+        if (status) status(std::string("physics: ") + e.what() + "; organ reset to rest");
+      }
     }
     const auto t1 = clock::now();
     step_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-    s.publish_forces(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), stats);
+    s.publish_snapshot();
+    s.publish_forces(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
     if (s.mesh_publisher) s.mesh_publisher->offer(s.state.x, s.sim_time_s, proto::now_ns());
     ++stats.ticks;
     if (t1 - last_report >= std::chrono::seconds(1)) {
@@ -372,12 +479,12 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
         int owned = 0;
         double fmax = 0;
         for (const auto& [id, inst] : s.instruments) {
-          owned += inst.owner != 0;
+          owned += inst.active;
           fmax = std::max(fmax, inst.result.force_on_tool.norm());
         }
-        std::snprintf(line, sizeof line, "%.0f Hz physics, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, overruns %llu, "
-                      "%d instruments claimed, |F| %.3f N, rejected %llu, physics resets %llu, mesh frames %llu (%llu skipped)",
-                      stats.rate_hz, stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
+        std::snprintf(line, sizeof line, "%.0f Hz physics%s, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, overruns %llu, "
+                      "%d instruments in use, |F| %.3f N, rejected %llu, physics resets %llu, mesh frames %llu (%llu skipped)",
+                      stats.rate_hz, s.paused ? " (paused)" : "", stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
                       static_cast<unsigned long long>(stats.overruns), owned, fmax, static_cast<unsigned long long>(stats.rejected),
                       static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.mesh_frames),
                       static_cast<unsigned long long>(stats.mesh_frames_skipped));
@@ -395,13 +502,11 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       ++stats.overruns;  // missed the deadline: do not try to catch up with a burst
       next = now;
     } else {
-      // Until the next tick: answer commands as they arrive.
-      while (clock::now() < next) {
-        if (s.commands.wait(next - clock::now())) s.answer_new_commands(stats);
-      }
+      std::this_thread::sleep_until(next);
     }
   }
   stats.rejected = s.rejected;
+  stats.forces_sent = s.forces_sent;
   if (s.mesh_publisher) {
     stats.mesh_frames = s.mesh_publisher->frames_published();
     stats.mesh_frames_skipped = s.mesh_publisher->frames_skipped();

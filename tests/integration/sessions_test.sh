@@ -2,7 +2,8 @@
 # Integration, separate processes over a real DDS domain on loopback: two clients with two
 # instruments at once; a hostile publisher's garbage, truncated, wrong-schema, NaN and not-owned
 # payloads are rejected and counted while the good clients keep their 1 kHz force stream; a client
-# killed with SIGKILL loses its instrument within the lease (another client can then claim it).
+# killed with SIGKILL loses its instrument within the lease (another client can then claim it);
+# another process pauses the simulation mid-press, resets the organ while paused and resumes it.
 # Usage: sessions_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
@@ -27,7 +28,51 @@ kill -KILL "$victim"; killed_at=$(date +%s.%N)
 # Another client must get instrument 1 within the lease (0.5 s) plus discovery slack.
 "$hc" --domain "$domain" --client-id 22 --instrument 1 --duration 0.5 > "$tmp/heir.log" 2>&1
 rc_heir=$?; claimed_at=$(date +%s.%N)
+# Session control from another process (an instructor): pause mid-press, reset while paused, resume.
+ctl="$build/tools/viscera-control/viscera-control"
+"$hc" --domain "$domain" --client-id 31 --instrument 2 --duration 12 --depth 0.02 --watch-mesh --quiet --report "$tmp/ctl.json" > "$tmp/ctl.log" 2>&1 &
+presser=$!
+for _ in $(seq 100); do grep -q "contact at" "$tmp/ctl.log" && break; sleep 0.05; done
+sleep 1
+"$ctl" pause --domain "$domain" > "$tmp/control.log" 2>&1; rc_pause=$?
+sleep 0.8
+"$ctl" reset --domain "$domain" >> "$tmp/control.log" 2>&1; rc_reset=$?
+sleep 0.8
+"$ctl" resume --domain "$domain" >> "$tmp/control.log" 2>&1; rc_resume=$?
+wait $presser; rc_presser=$?
 kill -INT "$server"; wait "$server"; rc_server=$?
+cat "$tmp/control.log" "$tmp/ctl.log"
+check "pause, reset, resume accepted (rc $rc_pause $rc_reset $rc_resume)" "[ $rc_pause -eq 0 ] && [ $rc_reset -eq 0 ] && [ $rc_resume -eq 0 ]"
+check "pausing client ran (rc $rc_presser)" "[ $rc_presser -eq 0 ]"
+check "control reports the paused scene" "grep -q 'scene liver: paused' '$tmp/control.log'"
+check "server logged the reset" "grep -q 'reset the organ to rest' '$tmp/server.log'"
+python3 - "$tmp/ctl.json" <<'PY' || failures=$((failures+1))
+import json, sys
+r = json.load(open(sys.argv[1]))
+frames = sorted(r["mesh"]["samples"], key=lambda f: f["t_s"])
+# The pause: the longest run of frames whose simulated time does not advance.
+best, start = (0, 0), 0
+for i in range(1, len(frames) + 1):
+    if i == len(frames) or frames[i]["sim_time_s"] != frames[start]["sim_time_s"]:
+        if i - start > best[1] - best[0]: best = (start, i)
+        start = i
+held = frames[best[0]:best[1]]
+t0, t1 = held[0]["t_s"], held[-1]["t_s"]
+assert t1 - t0 > 1.2, f"simulated time stood still for only {t1 - t0:.2f} s (pause to resume takes at least 1.6 s)"
+before = [f for f in held if f["t_s"] < t0 + 0.5]
+after = [f for f in held if f["t_s"] > t1 - 0.5]
+assert min(f["max_displacement_m"] for f in before) > 0.003, "the paused organ was not pressed in"
+assert max(f["max_displacement_m"] for f in after) < 0.0005, "reset did not put the organ back at rest"
+later = [f for f in frames if f["t_s"] > t1 + 0.5]
+assert later and later[-1]["sim_time_s"] > held[0]["sim_time_s"] + 0.3, "simulated time did not resume"
+forces = [x for x in r["samples"] if t0 < x["t_s"] < t1]
+rate = len(forces) / (t1 - t0)
+assert rate > 800, f"forces at {rate:.0f}/s while paused"
+print(f"[ figure ] session control: paused for {t1 - t0:.2f} s (simulated time held at {held[0]['sim_time_s']:.3f} s), "
+      f"surface displaced {1000 * min(f['max_displacement_m'] for f in before):.1f} mm before the reset, "
+      f"{1000 * max(f['max_displacement_m'] for f in after):.2f} mm after; forces still answered at {rate:.0f}/s")
+PY
+[ $? -eq 0 ] && passed=$((passed+1))
 cat "$tmp/a.log" "$tmp/b.log" "$tmp/hostile.log" "$tmp/victim.log" "$tmp/heir.log" "$tmp/server.log"
 check "client A ran (rc $rc_a)" "[ $rc_a -eq 0 ]"
 check "client B ran (rc $rc_b)" "[ $rc_b -eq 0 ]"

@@ -49,6 +49,9 @@ expect hc-traj-time 2 "t2.csv:4: column time_s" -- "$hc" --trajectory "$tmp/t2.c
 expect hc-traj-header 2 "t3.csv:1: column z_m: missing from the header" -- "$hc" --trajectory "$tmp/t3.csv"
 expect hc-traj-units 2 "t4.csv:3: column z_m: .* are the units metres" -- "$hc" --trajectory "$tmp/t4.csv"
 expect hc-traj-jaw 2 "t5.csv:3: column jaw_rad" -- "$hc" --trajectory "$tmp/t5.csv"
+expect control-help 0 "Usage: viscera-control" -- "$build/tools/viscera-control/viscera-control" --help
+expect control-bad-action 2 "ACTION 'explode' is not pause" -- "$build/tools/viscera-control/viscera-control" explode
+expect control-two-actions 2 "unexpected argument 'resume'" -- "$build/tools/viscera-control/viscera-control" pause resume
 expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"

@@ -44,7 +44,11 @@ bool CommandLine::parse(int argc, char** argv) {
       std::cout << help();
       return false;
     }
-    if (!arg.starts_with("--")) throw UsageError("unexpected argument '" + arg + "' (see --help)");
+    if (!arg.starts_with("--")) {
+      if (positional_.size() >= max_positional_) throw UsageError("unexpected argument '" + arg + "' (see --help)");
+      positional_.push_back(arg);
+      continue;
+    }
     std::string name = arg.substr(2), value;
     const auto eq = name.find('=');
     bool has_value = false;

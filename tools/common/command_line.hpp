@@ -23,6 +23,10 @@ class CommandLine {
             std::optional<std::string> default_value = std::nullopt);
   void option_switch(const std::string& name, const std::string& help);
 
+  /// Accepts up to n arguments that are not flags (default none: they are errors).
+  void allow_positional(std::size_t n) { max_positional_ = n; }
+  const std::vector<std::string>& positional() const { return positional_; }
+
   /// Parses argv. Returns false if --help was given (help already printed to stdout).
   bool parse(int argc, char** argv);
 
@@ -46,6 +50,8 @@ class CommandLine {
   std::vector<std::string> order_;
   std::map<std::string, Flag> flags_;
   std::map<std::string, std::string> values_;
+  std::vector<std::string> positional_;
+  std::size_t max_positional_ = 0;
 };
 
 }  // namespace viscera::cli

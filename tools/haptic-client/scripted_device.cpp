@@ -41,6 +41,7 @@ void ScriptedDevice::render(const protocol::Vector3&, bool in_contact) {
     contact_z_ = z_;
     contact_t_ = t_;
     std::printf("t = %5.2f s  contact at tip z %.4f m\n", t_, z_);
+    std::fflush(stdout);
   }
 }
 

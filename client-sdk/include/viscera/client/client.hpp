@@ -31,6 +31,10 @@ class Client {
   /// Claims an instrument; true once the scene state shows this client as its owner.
   bool claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
   void release(std::uint32_t instrument_id);
+  /// Session control for the whole scene (any client, e.g. an instructor's console): pause,
+  /// resume or reset. True once the scene state shows the pause state asked for (for reset:
+  /// once the request was sent).
+  bool control(protocol::Action action, std::chrono::milliseconds timeout);
   /// Sends the instrument's tip position [m] and jaw opening [rad] (next sequence number,
   /// current stamp).
   void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip, double jaw_opening_rad = 0.5);
