@@ -1,6 +1,7 @@
 #include "viscera/client/client.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <thread>
 
 #include "viscera/protocol/dds.hpp"
@@ -14,7 +15,8 @@ struct Client::Impl {
   proto::Writer commands, sessions;
   proto::Reader forces, scene;
   std::optional<proto::Scene> last_scene;
-  std::unique_ptr<proto::Reader> topology, frames;  // created on first use
+  std::unique_ptr<proto::Reader> topology, frames, events;  // created on first use
+  std::unique_ptr<proto::Writer> annotations;
   std::optional<proto::SurfaceTopology> surface;
   explicit Impl(std::uint32_t domain)
       : participant(domain),
@@ -143,6 +145,23 @@ std::optional<proto::MeshFrame> Client::poll_mesh_frame() {
     if (!newest || f->frame > newest->frame) newest = std::move(f);
   });
   return newest;
+}
+
+std::vector<proto::Event> Client::poll_events() {
+  if (!impl_->events) impl_->events = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::event);
+  std::vector<proto::Event> out;
+  impl_->events->take([&](const proto::Received& r) {
+    std::string why;
+    if (auto e = proto::decode_event(r.payload, &why)) out.push_back(std::move(*e));
+    else ++rejected_;
+  });
+  return out;
+}
+
+void Client::annotate(const std::string& text) {
+  if (text.size() > 1024) throw std::invalid_argument("annotation of " + std::to_string(text.size()) + " bytes (at most 1024)");
+  if (!impl_->annotations) impl_->annotations = std::make_unique<proto::Writer>(impl_->participant, proto::Stream::event);
+  impl_->annotations->write(client_id_, proto::encode(proto::Event{client_id_, proto::EventKind::annotation, 0, client_id_, 0, proto::now_ns(), text}));
 }
 
 LatencyStats Client::round_trip() const {

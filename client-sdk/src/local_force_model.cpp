@@ -1,6 +1,8 @@
 #include "viscera/client/local_force_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace viscera::client {
 
@@ -21,6 +23,38 @@ RenderedForce render_local_model(const protocol::Force& f, const protocol::Vecto
     r.clamped = true;
   }
   return r;
+}
+
+void LocalForceRenderer::update(const protocol::Force& f, const protocol::Vector3& x0, double t_s) {
+  if (has_new_) {
+    old_ = new_;
+    has_old_ = true;
+  }
+  new_ = {f, x0};
+  has_new_ = true;
+  arrived_s_ = t_s;
+}
+
+RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s) const {
+  if (!has_new_) return {};
+  constexpr double kUnlimited = std::numeric_limits<double>::infinity();
+  const auto now = render_local_model(new_.force, new_.x0, x, kUnlimited);
+  const double a = blend_ > 0 && has_old_ ? std::clamp((t_s - arrived_s_) / blend_, 0.0, 1.0) : 1.0;
+  RenderedForce r = now;
+  if (a < 1.0) {
+    const auto before = render_local_model(old_.force, old_.x0, x, kUnlimited);
+    for (int i = 0; i < 3; ++i) r.force[i] = a * now.force[i] + (1 - a) * before.force[i];
+  }
+  const double mag = std::sqrt(r.force[0] * r.force[0] + r.force[1] * r.force[1] + r.force[2] * r.force[2]);
+  if (mag > max_force_) {
+    for (double& c : r.force) c *= max_force_ / mag;
+    r.clamped = true;
+  }
+  return r;
+}
+
+double LocalForceRenderer::model_age_s(double t_s) const {
+  return has_new_ ? t_s - arrived_s_ : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace viscera::client

@@ -23,8 +23,9 @@ dds_qos_t* qos_for(Stream s) {
       dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
       break;
     case Stream::session_request:
+    case Stream::event:
       dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
+      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, s == Stream::event ? 64 : 16);
       dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
       break;
     case Stream::mesh_frame:
@@ -57,6 +58,7 @@ const char* topic_name(Stream s) {
     case Stream::telemetry: return "viscera_telemetry";
     case Stream::surface_topology: return "viscera_surface_topology";
     case Stream::mesh_frame: return "viscera_mesh_frame";
+    case Stream::event: return "viscera_event";
   }
   return "?";
 }

@@ -1,5 +1,6 @@
 #include <cmath>
 
+#include "event_generated.h"
 #include "force_feedback_generated.h"
 #include "instrument_command_generated.h"
 #include "mesh_frame_generated.h"
@@ -23,14 +24,16 @@ Vector3 from_fb(const fb::Vec3* v) { return v ? Vector3{v->x(), v->y(), v->z()} 
 bool finite(const Vector3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 bool within(const Vector3& v, double limit) { return std::abs(v[0]) <= limit && std::abs(v[1]) <= limit && std::abs(v[2]) <= limit; }
 
+/// identifier: the schema's file identifier (4 characters), or nullptr for the schema-1 messages,
+/// which have none.
 template <typename T>
-const T* verified_root(std::span<const std::uint8_t> bytes, std::string* why) {
+const T* verified_root(std::span<const std::uint8_t> bytes, std::string* why, const char* identifier = nullptr) {
   if (bytes.size() < 8) {
     *why = "payload of " + std::to_string(bytes.size()) + " bytes is too short";
     return nullptr;
   }
   flatbuffers::Verifier v(bytes.data(), bytes.size(), 64, 10000);
-  if (!v.VerifyBuffer<T>(nullptr)) {
+  if (!v.VerifyBuffer<T>(identifier)) {
     *why = "FlatBuffers verification failed (truncated, garbage or another schema)";
     return nullptr;
   }
@@ -90,13 +93,41 @@ std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
   const auto name = b.CreateString(t.organ_name);
   const auto tris = b.CreateVector(t.triangles);
   const auto rest = b.CreateVector(t.rest_positions);
-  return finish(b, fb::CreateSurfaceTopology(b, t.mesh_id, name, t.vertex_count, tris, rest));
+  b.Finish(fb::CreateSurfaceTopology(b, t.mesh_id, name, t.vertex_count, tris, rest), fb::SurfaceTopologyIdentifier());
+  return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
 
 std::vector<std::uint8_t> encode(const MeshFrame& m) {
   flatbuffers::FlatBufferBuilder b(64 + 4 * m.positions.size());
   const auto positions = b.CreateVector(m.positions);
-  return finish(b, fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions));
+  b.Finish(fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions), fb::MeshFrameIdentifier());
+  return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
+}
+
+std::vector<std::uint8_t> encode(const Event& e) {
+  flatbuffers::FlatBufferBuilder b(128 + e.text.size());
+  const auto text = b.CreateString(e.text);
+  b.Finish(fb::CreateEvent(b, e.source_client_id, static_cast<fb::EventKind>(e.kind), e.instrument_id, e.client_id, e.sim_time_s,
+                           e.stamp_ns, text),
+           fb::EventIdentifier());
+  return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
+}
+
+const char* event_name(EventKind k) {
+  switch (k) {
+    case EventKind::annotation: return "annotation";
+    case EventKind::instrument_claimed: return "instrument_claimed";
+    case EventKind::instrument_released: return "instrument_released";
+    case EventKind::paused: return "paused";
+    case EventKind::resumed: return "resumed";
+    case EventKind::organ_reset: return "organ_reset";
+    case EventKind::physics_reset: return "physics_reset";
+    case EventKind::contact_started: return "contact_started";
+    case EventKind::contact_ended: return "contact_ended";
+    case EventKind::grasped: return "grasped";
+    case EventKind::let_go: return "let_go";
+  }
+  return "?";
 }
 
 std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why) {
@@ -227,7 +258,7 @@ bool valid_positions(const flatbuffers::Vector<float>* p, std::string* why) {
 }  // namespace
 
 std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint8_t> bytes, std::string* why) {
-  const auto* m = verified_root<fb::SurfaceTopology>(bytes, why);
+  const auto* m = verified_root<fb::SurfaceTopology>(bytes, why, fb::SurfaceTopologyIdentifier());
   if (!m) return std::nullopt;
   if (!valid_positions(m->rest_positions(), why)) return std::nullopt;
   SurfaceTopology t;
@@ -253,7 +284,7 @@ std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint
 }
 
 std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, std::string* why) {
-  const auto* m = verified_root<fb::MeshFrame>(bytes, why);
+  const auto* m = verified_root<fb::MeshFrame>(bytes, why, fb::MeshFrameIdentifier());
   if (!m) return std::nullopt;
   if (!valid_positions(m->positions(), why)) return std::nullopt;
   if (!std::isfinite(m->sim_time_s()) || m->sim_time_s() < 0) {
@@ -261,6 +292,26 @@ std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, 
     return std::nullopt;
   }
   return MeshFrame{m->mesh_id(), m->frame(), m->sim_time_s(), m->server_stamp_ns(), {m->positions()->begin(), m->positions()->end()}};
+}
+
+std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::string* why) {
+  const auto* m = verified_root<fb::Event>(bytes, why, fb::EventIdentifier());
+  if (!m) return std::nullopt;
+  const auto k = static_cast<int>(m->kind());
+  if (k < 0 || k > static_cast<int>(EventKind::let_go)) {
+    *why = "unknown event kind " + std::to_string(k);
+    return std::nullopt;
+  }
+  if (m->text() && m->text()->size() > 1024) {
+    *why = "text of " + std::to_string(m->text()->size()) + " bytes (at most 1024)";
+    return std::nullopt;
+  }
+  if (!std::isfinite(m->sim_time_s()) || m->sim_time_s() < 0) {
+    *why = "sim_time_s not finite or negative";
+    return std::nullopt;
+  }
+  return Event{m->source_client_id(), static_cast<EventKind>(k), m->instrument_id(), m->client_id(), m->sim_time_s(), m->stamp_ns(),
+               m->text() ? m->text()->str() : ""};
 }
 
 }  // namespace viscera::protocol

@@ -67,6 +67,8 @@ struct SimulationServer::Impl {
     // Grasper: nodes held by the closed jaws, with their offsets from the tool when grasped.
     std::vector<std::pair<std::int32_t, Vec3>> grasped;
     ContactResult result;
+    bool touching = false;    // in contact (for contact events, with hysteresis)
+    double last_touch_s = 0;  // simulated time it last touched
     // Command thread only: its own contact query (ProbeContact keeps scratch space).
     std::unique_ptr<ProbeContact> query;
   };
@@ -84,7 +86,7 @@ struct SimulationServer::Impl {
 
   proto::Participant participant;
   proto::Reader commands, sessions;
-  proto::Writer forces, scene_state, telemetry;
+  proto::Writer forces, scene_state, telemetry, events;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread; after the writers it uses
   std::atomic<std::uint64_t> rejected{0}, forces_sent{0};
 
@@ -95,7 +97,8 @@ struct SimulationServer::Impl {
         sessions(participant, proto::Stream::session_request),
         forces(participant, proto::Stream::force_feedback),
         scene_state(participant, proto::Stream::scene_state),
-        telemetry(participant, proto::Stream::telemetry) {
+        telemetry(participant, proto::Stream::telemetry),
+        events(participant, proto::Stream::event) {
     mesh = std::make_shared<TetMesh>(read_tet_mesh(s.mesh));
     for (int k = 0; k < s.refine; ++k) *mesh = refine_uniform(*mesh);
     scale_mesh(*mesh, s.scale_m_per_unit);
@@ -199,13 +202,17 @@ struct SimulationServer::Impl {
       switch (req->action) {
         case proto::Action::pause:
         case proto::Action::resume:
-          if (paused != (req->action == proto::Action::pause) && status) status(who + (paused ? " resumed" : " paused") + " the simulation");
+          if (paused != (req->action == proto::Action::pause)) {
+            if (status) status(who + (paused ? " resumed" : " paused") + " the simulation");
+            event(paused ? proto::EventKind::resumed : proto::EventKind::paused, 0, req->client_id);
+          }
           paused = req->action == proto::Action::pause;
           changed = true;
           return;
         case proto::Action::reset:
           reset_organ();
           if (status) status(who + " reset the organ to rest");
+          event(proto::EventKind::organ_reset, 0, req->client_id);
           return;
         default:
           break;
@@ -222,13 +229,20 @@ struct SimulationServer::Impl {
         inst.has_command = false;
         inst.last_heard_ns = proto::now_ns();
         changed = true;
+        event(proto::EventKind::instrument_claimed, req->instrument_id, req->client_id);
       } else if (req->action == proto::Action::release_instrument && inst.owner == req->client_id) {
         inst.owner = 0;
         inst.has_command = false;
         changed = true;
+        event(proto::EventKind::instrument_released, req->instrument_id, req->client_id, "released by its owner");
       }
     });
     if (changed) publish_scene();
+  }
+
+  /// A session event for recorders, trainers and consoles (physics thread).
+  void event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text = {}) {
+    events.write(0, proto::encode(proto::Event{0, kind, instrument_id, client_id, sim_time_s, proto::now_ns(), std::move(text)}));
   }
 
   /// The organ back at rest (memory variables relaxed); graspers let go.
@@ -261,8 +275,11 @@ struct SimulationServer::Impl {
     if (inst.grasped.empty() && inst.tick.jaw_opening < 0.1) {
       for (auto n : surface_nodes)
         if ((state.x[n] - tip).norm() < inst.spec.grasp_radius_m) inst.grasped.emplace_back(n, state.x[n] - tip);
+      if (!inst.grasped.empty())
+        event(proto::EventKind::grasped, inst.spec.id, inst.tick_owner, std::to_string(inst.grasped.size()) + " surface nodes");
     } else if (!inst.grasped.empty() && inst.tick.jaw_opening > 0.2) {
       inst.grasped.clear();
+      event(proto::EventKind::let_go, inst.spec.id, inst.tick_owner);
     }
   }
 
@@ -284,19 +301,20 @@ struct SimulationServer::Impl {
   /// released safely (no force on the tissue from it any more).
   void release_silent(std::int64_t lease_ns, const std::function<void(const std::string&)>& status) {
     const std::int64_t now = proto::now_ns();
-    std::vector<std::string> released;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> released;  // instrument, its silent owner
     {
       std::lock_guard lock(command_mutex);
       for (auto& [id, inst] : instruments)
         if (inst.owner != 0 && now - inst.last_heard_ns > lease_ns) {
-          released.push_back("instrument " + std::to_string(id) + " released: client " + std::to_string(inst.owner) +
-                             " silent for more than the lease");
+          released.emplace_back(id, inst.owner);
           inst.owner = 0;  // its grasper lets go at the next tick (take_tick_commands)
           inst.has_command = false;
         }
     }
-    for (const auto& line : released)
-      if (status) status(line);
+    for (const auto& [id, owner] : released) {
+      if (status) status("instrument " + std::to_string(id) + " released: client " + std::to_string(owner) + " silent for more than the lease");
+      event(proto::EventKind::instrument_released, id, owner, "owner silent for more than the lease");
+    }
     if (!released.empty()) publish_scene();
   }
 
@@ -392,8 +410,20 @@ struct SimulationServer::Impl {
   }
 
   void publish_forces(std::int64_t step_time_ns) {
-    for (const auto& [id, inst] : instruments)
+    for (auto& [id, inst] : instruments) {
       if (inst.active) publish_force(id, inst.tick_owner, inst.tick, inst.result, step_time_ns);
+      // Contact events with hysteresis: a tool that bounces on the surface (a few ms apart) is one
+      // contact; it ends after 50 ms of simulated time without touching, or when the tool is gone.
+      const bool touching = inst.active && inst.result.in_contact;
+      if (touching) {
+        if (!inst.touching) event(proto::EventKind::contact_started, id, inst.tick_owner);
+        inst.touching = true;
+        inst.last_touch_s = sim_time_s;
+      } else if (inst.touching && (!inst.active || sim_time_s - inst.last_touch_s > 0.05)) {
+        event(proto::EventKind::contact_ended, id, inst.tick_owner);
+        inst.touching = false;
+      }
+    }
   }
 };
 
@@ -452,6 +482,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
         s.reset_organ();
         ++stats.physics_resets;
         if (status) status(std::string("physics: ") + e.what() + "; organ reset to rest");
+        s.event(proto::EventKind::physics_reset, 0, 0, e.what());
       }
     }
     const auto t1 = clock::now();

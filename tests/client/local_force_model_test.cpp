@@ -33,3 +33,25 @@ TEST(LocalForceModel, PushesOnlyAndNeverBeyondTheDeviceLimit) {
   protocol::Force free_space;
   EXPECT_EQ(client::render_local_model(free_space, {0, 0, 0}, {0, 0, -1}, 10.0).force[2], 0.0);
 }
+
+TEST(LocalForceRenderer, BlendsFromTheOldModelToTheNewOneWithoutAJump) {
+  client::LocalForceRenderer renderer(10.0, 0.004);
+  EXPECT_EQ(renderer.render({0, 0, 0}, 0.0).force[2], 0.0);  // no model yet
+  renderer.update(contact(), {0, 0, 0.01}, 1.000);            // 2 N at z = 1 cm, 200 N/m
+  const protocol::Vector3 x{0, 0, 0.01};
+  EXPECT_NEAR(renderer.render(x, 1.0005).force[2], 2.0, 1e-12);  // the first model: no blending
+  auto stiffer = contact();
+  stiffer.force = {0, 0, 4.0};
+  renderer.update(stiffer, {0, 0, 0.01}, 1.010);
+  // At the update the force is still the old model's, then moves linearly to the new one.
+  EXPECT_NEAR(renderer.render(x, 1.010).force[2], 2.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.011).force[2], 2.5, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.012).force[2], 3.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.014).force[2], 4.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.100).force[2], 4.0, 1e-12);
+  EXPECT_NEAR(renderer.model_age_s(1.015), 0.005, 1e-12);
+  // The device limit holds for the blend too.
+  const auto deep = renderer.render({0, 0, -1.0}, 1.011);
+  EXPECT_NEAR(deep.force[2], 10.0, 1e-12);
+  EXPECT_TRUE(deep.clamped);
+}

@@ -19,5 +19,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (auto t = decode_telemetry(bytes, &why)) (void)encode(*t);
   if (auto t = decode_surface_topology(bytes, &why)) (void)encode(*t);
   if (auto m = decode_mesh_frame(bytes, &why)) (void)encode(*m);
+  if (auto e = decode_event(bytes, &why)) (void)encode(*e);
   return 0;
 }

@@ -8,7 +8,8 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" "$victim" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "$server" "$victim" "$watcher" 2>/dev/null; rm -rf "$tmp"' EXIT
+watcher=
 hc="$build/tools/haptic-client/haptic-client"
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
@@ -30,18 +31,42 @@ kill -KILL "$victim"; killed_at=$(date +%s.%N)
 rc_heir=$?; claimed_at=$(date +%s.%N)
 # Session control from another process (an instructor): pause mid-press, reset while paused, resume.
 ctl="$build/tools/viscera-control/viscera-control"
+"$ctl" events --domain "$domain" --client-id 902 --duration 60 > "$tmp/events.log" 2>&1 &
+watcher=$!
+for _ in $(seq 100); do grep -q "following the events" "$tmp/events.log" && break; sleep 0.05; done
 "$hc" --domain "$domain" --client-id 31 --instrument 2 --duration 12 --depth 0.02 --watch-mesh --quiet --report "$tmp/ctl.json" > "$tmp/ctl.log" 2>&1 &
 presser=$!
 for _ in $(seq 100); do grep -q "contact at" "$tmp/ctl.log" && break; sleep 0.05; done
-sleep 1
+sleep 2
 "$ctl" pause --domain "$domain" > "$tmp/control.log" 2>&1; rc_pause=$?
 sleep 0.8
 "$ctl" reset --domain "$domain" >> "$tmp/control.log" 2>&1; rc_reset=$?
 sleep 0.8
+"$ctl" annotate "resected segment IV" --domain "$domain" --client-id 901 >> "$tmp/control.log" 2>&1; rc_note=$?
 "$ctl" resume --domain "$domain" >> "$tmp/control.log" 2>&1; rc_resume=$?
 wait $presser; rc_presser=$?
+sleep 0.5; kill "$watcher"; wait "$watcher" 2>/dev/null
 kill -INT "$server"; wait "$server"; rc_server=$?
-cat "$tmp/control.log" "$tmp/ctl.log"
+cat "$tmp/control.log" "$tmp/ctl.log" "$tmp/events.log"
+check "annotation sent (rc $rc_note)" "[ $rc_note -eq 0 ]"
+python3 - "$tmp/events.log" <<'PY' || failures=$((failures+1))
+import sys
+lines = [l.split() for l in open(sys.argv[1]) if l.startswith("event ")]
+kinds = [l[1] for l in lines]
+def first(kind, **want):
+    for i, l in enumerate(lines):
+        if l[1] == kind and all(l[l.index(k) + 1].rstrip(":") == str(v) for k, v in want.items()):
+            return i
+    raise AssertionError(f"no {kind} {want} among the events: {kinds}")
+claimed = first("instrument_claimed", instrument=2, client=31)
+touched = first("contact_started", instrument=2, client=31)
+paused, reset, note, resumed = first("paused", client=900), first("organ_reset", client=900), first("annotation", client=901), first("resumed", client=900)
+released = first("instrument_released", instrument=2, client=31)
+assert claimed < touched < paused < reset < note < resumed < released, f"events out of order: {kinds}"
+assert "resected segment IV" in open(sys.argv[1]).read()
+print(f"[ figure ] events seen by a console: {len(lines)}, in order: claimed, contact_started, paused, organ_reset, annotation, resumed, released")
+PY
+[ $? -eq 0 ] && passed=$((passed+1))
 check "pause, reset, resume accepted (rc $rc_pause $rc_reset $rc_resume)" "[ $rc_pause -eq 0 ] && [ $rc_reset -eq 0 ] && [ $rc_resume -eq 0 ]"
 check "pausing client ran (rc $rc_presser)" "[ $rc_presser -eq 0 ]"
 check "control reports the paused scene" "grep -q 'scene liver: paused' '$tmp/control.log'"

@@ -136,3 +136,24 @@ TEST(Messages, SurfaceTopologyAndFramesRoundTripAndBadOnesAreRejected) {
   const auto bytes = encode(good_topology());
   EXPECT_FALSE(decode_surface_topology(std::span(bytes).first(bytes.size() / 2), &why));  // truncated
 }
+
+TEST(Messages, EventsRoundTripAndBadOnesAreRejected) {
+  std::string why;
+  Event e{0, EventKind::grasped, 3, 12, 1.25, 77, ""};
+  const auto d = decode_event(encode(e), &why);
+  ASSERT_TRUE(d) << why;
+  EXPECT_EQ(d->kind, EventKind::grasped);
+  EXPECT_EQ(d->client_id, 12u);
+  EXPECT_EQ(d->sim_time_s, 1.25);
+  EXPECT_STREQ(event_name(d->kind), "grasped");
+  Event note{900, EventKind::annotation, 0, 900, 0, 5, "bleeding at segment IV"};
+  EXPECT_EQ(decode_event(encode(note), &why)->text, "bleeding at segment IV");
+  note.text.assign(1025, 'x');
+  EXPECT_FALSE(decode_event(encode(note), &why));
+  EXPECT_NE(why.find("1025 bytes"), std::string::npos) << why;
+  e.sim_time_s = std::nan("");
+  EXPECT_FALSE(decode_event(encode(e), &why));
+  auto bytes = encode(Event{});
+  EXPECT_FALSE(decode_event(std::span(bytes).first(bytes.size() - 6), &why));  // truncated
+  EXPECT_FALSE(decode_event(encode(good_command()), &why));                   // another schema
+}

@@ -52,6 +52,7 @@ expect hc-traj-jaw 2 "t5.csv:3: column jaw_rad" -- "$hc" --trajectory "$tmp/t5.c
 expect control-help 0 "Usage: viscera-control" -- "$build/tools/viscera-control/viscera-control" --help
 expect control-bad-action 2 "ACTION 'explode' is not pause" -- "$build/tools/viscera-control/viscera-control" explode
 expect control-two-actions 2 "unexpected argument 'resume'" -- "$build/tools/viscera-control/viscera-control" pause resume
+expect control-annotate-no-text 2 "annotate needs the TEXT" -- "$build/tools/viscera-control/viscera-control" annotate
 expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"

@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
   cl.flag("trajectory", "FILE.csv", "play this trajectory file (time_s,x_m,y_m,z_m[,jaw_rad][,buttons]) instead of a script");
   cl.flag("frame", "NAME", "trajectory positions: scene (absolute) | organ-top (relative to the organ's top centre)", "scene");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
+  cl.flag("blend", "S", "blend from one local force model to the next over this time [s]", "0.003");
   cl.option_switch("watch-mesh", "receive the organ's surface frames and report their rate and the surface's displacement");
   cl.option_switch("quiet", "no live lines, only the summary");
   cl.flag("report", "FILE.json", "write samples and statistics here");
@@ -126,7 +127,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
 
     std::map<std::uint64_t, Vector3> sent;  // tip of each recent command, for the local model
-    std::uint64_t seq = 0, clamps = 0;
+    std::uint64_t seq = 0, clamps = 0, model_seq = 0;
+    viscera::client::LocalForceRenderer renderer(max_force, cl.number_in("blend", 0, 0.1));
     MeshWatch mesh;
     nlohmann::json samples = nlohmann::json::array();
     const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / rate));
@@ -143,10 +145,14 @@ int main(int argc, char** argv) {
       if (sent.size() > 4096) sent.erase(sent.begin());
       // Wait for the answer to this command until shortly before the next device period.
       if (const auto f = client.wait_force(instrument, next + period - std::chrono::microseconds(100))) {
-        // The force rendered now, from the server's latest local model at the current tip.
-        const auto it = sent.find(f->command_seq);
-        const auto rendered = it != sent.end() ? viscera::client::render_local_model(*f, it->second, in.tip_m, max_force)
-                                               : viscera::client::RenderedForce{};
+        // The force rendered now, from the server's local models at the current tip: a new model
+        // (the answer to a newer command) is blended in over --blend seconds.
+        if (f->command_seq > model_seq)
+          if (const auto it = sent.find(f->command_seq); it != sent.end()) {
+            renderer.update(*f, it->second, t);
+            model_seq = f->command_seq;
+          }
+        const auto rendered = renderer.render(in.tip_m, t);
         device->render(rendered.force, f->in_contact);
         clamps += rendered.clamped;
         double normal_stiffness = 0;  // n^T K n of the local model [N/m]
@@ -156,7 +162,8 @@ int main(int argc, char** argv) {
                            {"in_contact", f->in_contact}, {"penetration_m", f->penetration_m},
                            {"normal_stiffness_n_per_m", normal_stiffness},
                            {"rendered_force_n", {rendered.force[0], rendered.force[1], rendered.force[2]}},
-                           {"model_age_commands", seq - f->command_seq}, {"command_seq", f->command_seq}});
+                           {"model_age_commands", seq - f->command_seq}, {"model_age_ms", 1e3 * renderer.model_age_s(t)},
+                           {"command_seq", f->command_seq}});
         if (!quiet && t - last_print >= 0.25) {
           const auto rtt = client.round_trip();
           std::printf("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s\n", t,

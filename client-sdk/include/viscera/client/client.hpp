@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "viscera/protocol/messages.hpp"
@@ -53,6 +54,12 @@ class Client {
   /// (frames of another mesh_id or with another vertex count are dropped and counted).
   std::optional<protocol::MeshFrame> poll_mesh_frame();
   std::uint64_t mesh_frames_received() const { return mesh_frames_; }
+
+  /// Session events (server) and annotations (clients) that arrived since the last call, in
+  /// order. The first call subscribes; events before it are not seen.
+  std::vector<protocol::Event> poll_events();
+  /// Publishes an annotation (at most 1024 bytes of text) for recorders and consoles.
+  void annotate(const std::string& text);
   std::uint32_t id() const { return client_id_; }
   /// Payloads that failed verification and were dropped.
   std::uint64_t rejected() const { return rejected_; }

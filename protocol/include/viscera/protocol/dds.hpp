@@ -25,8 +25,9 @@ enum class Stream {
   telemetry,           ///< best effort, keep last 1, volatile
   surface_topology,    ///< reliable, keep last 1 per key, transient local (late joiners get it)
   mesh_frame,          ///< reliable, keep last 1 per key, volatile (slow readers skip frames)
+  event,               ///< reliable, keep last 64, volatile (server events and client annotations)
 };
-constexpr int kStreamCount = 7;
+constexpr int kStreamCount = 8;
 const char* topic_name(Stream s);
 
 class Participant {

@@ -81,6 +81,22 @@ struct MeshFrame {
   std::vector<float> positions;  ///< [m] 3 per vertex
 };
 
+enum class EventKind : std::int8_t {
+  annotation = 0, instrument_claimed, instrument_released, paused, resumed, organ_reset, physics_reset,
+  contact_started, contact_ended, grasped, let_go
+};
+const char* event_name(EventKind k);
+
+/// Something that happened in a session (server events) or a client's annotation.
+struct Event {
+  std::uint32_t source_client_id = 0;  ///< 0: the server
+  EventKind kind = EventKind::annotation;
+  std::uint32_t instrument_id = 0, client_id = 0;
+  double sim_time_s = 0;
+  std::int64_t stamp_ns = 0;
+  std::string text;  ///< at most 1024 bytes
+};
+
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);
 std::vector<std::uint8_t> encode(const SessionRequest& r);
@@ -88,6 +104,7 @@ std::vector<std::uint8_t> encode(const Scene& s);
 std::vector<std::uint8_t> encode(const TelemetryReport& t);
 std::vector<std::uint8_t> encode(const SurfaceTopology& t);
 std::vector<std::uint8_t> encode(const MeshFrame& m);
+std::vector<std::uint8_t> encode(const Event& e);
 
 std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::string* why);
@@ -98,5 +115,6 @@ std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint
 /// Checks the frame on its own (finite positions within 10 m, whole vertices); that its vertex
 /// count matches the topology of its mesh_id is the receiver's check (it holds the topology).
 std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::string* why);
 
 }  // namespace viscera::protocol
