@@ -34,8 +34,17 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return *w = Vec3(1 - v - u, v, u), a + v * ab + u * ac;
 }
 
-ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m)
-    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m) {}
+ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
+                           double max_depth_m)
+    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m) {
+  reach2_.reserve(surface_.size());
+  for (const auto& t : surface_) {
+    const Vec3 &a = rest[t[0]], &b = rest[t[1]], &c = rest[t[2]];
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const double reach = radius_ + max_depth_ + 3.0 * longest;
+    reach2_.push_back(reach * reach);
+  }
+}
 
 ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f,
                                   std::span<double> node_stiffness) const {
@@ -45,7 +54,9 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
   double total = 0.0;
   for (std::size_t k = 0; k < surface_.size(); ++k) {
     const auto& t = surface_[k];
-    const Vec3 &a = x[t[0]], &b = x[t[1]], &c = x[t[2]];
+    const Vec3& a = x[t[0]];
+    if ((centre - a).squaredNorm() > reach2_[k]) continue;  // broad phase
+    const Vec3 &b = x[t[1]], &c = x[t[2]];
     Vec3 n = (b - a).cross(c - a);
     const double area2 = n.norm();
     if (area2 <= 0) continue;

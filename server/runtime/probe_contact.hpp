@@ -33,7 +33,11 @@ struct ContactResult {
 
 class ProbeContact {
  public:
-  ProbeContact(std::vector<tissue::Triangle> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m = 0.02);
+  /// rest: the mesh's rest positions, for the broad phase (a triangle is skipped when its first
+  /// vertex is farther from the tip than the tip radius, the depth limit and three times its
+  /// longest rest edge: an edge stretched beyond 3x fails the integration's strain check first).
+  ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
+               double max_depth_m = 0.02);
   /// Adds the penalty forces on the organ to f for the tip at `centre`, and to `node_stiffness`
   /// (if not empty) a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row
   /// sum); returns the reaction. With an empty f it only queries the reaction (the state is not
@@ -48,6 +52,7 @@ class ProbeContact {
     double depth;
   };
   std::vector<tissue::Triangle> surface_;
+  std::vector<double> reach2_;  // per triangle: squared broad-phase distance from its first vertex
   double radius_, stiffness_, max_depth_;
   mutable std::vector<Touch> touching_;
 };

@@ -149,8 +149,8 @@ struct SimulationServer::Impl {
     for (const auto& spec : s.instruments) {
       Instrument& inst = instruments[spec.id];
       inst.spec = spec;
-      inst.contact = std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m);
-      inst.query = std::make_unique<ProbeContact>(surface, spec.tip_radius_m, s.contact_stiffness_n_per_m);
+      inst.contact = std::make_unique<ProbeContact>(surface, mesh->nodes, spec.tip_radius_m, s.contact_stiffness_n_per_m);
+      inst.query = std::make_unique<ProbeContact>(surface, mesh->nodes, spec.tip_radius_m, s.contact_stiffness_n_per_m);
     }
     publish_snapshot();
     if (s.mesh_rate_hz > 0) mesh_publisher = std::make_unique<MeshPublisher>(participant, surface_topology(boundary), boundary.nodes, s.mesh_rate_hz);

@@ -1,0 +1,63 @@
+// Probe contact against closed form on a flat, finely triangulated plate: one spring k at the
+// deepest penetration whatever the number of triangles under the tip, pushing out along the
+// normal even when the tip centre has passed below the surface (no tunnelling), nothing out of
+// reach, and the broad phase still finds the contact on a plate stretched well beyond rest.
+#include <gtest/gtest.h>
+
+#include "probe_contact.hpp"
+
+using namespace viscera::runtime;
+using viscera::tissue::Triangle;
+
+namespace {
+struct Plate {
+  std::vector<Vec3> x;
+  std::vector<Triangle> triangles;
+  /// n x n squares of side h in the plane z = 0, two triangles each, normals +z.
+  Plate(int n, double h) {
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) x.emplace_back(i * h - 0.5 * n * h, j * h - 0.5 * n * h, 0.0);
+    const auto id = [n](int i, int j) { return static_cast<std::int32_t>(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+        triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+      }
+  }
+};
+}  // namespace
+
+TEST(ProbeContact, OneSpringAtTheDeepestPenetrationWhateverTheMeshing) {
+  const double r = 0.006, k = 1000.0;
+  for (const double h : {0.01, 0.002}) {  // 1 or 2 triangles under the tip, or dozens
+    const Plate p(20, h);
+    const ProbeContact contact(p.triangles, p.x, r, k);
+    std::vector<Vec3> f(p.x.size(), Vec3::Zero());
+    for (const double depth : {0.001, 0.004, 0.009, 0.015}) {  // the last two: centre below the surface
+      std::fill(f.begin(), f.end(), Vec3::Zero());
+      const ContactResult c = contact.apply(Vec3(0.0003, -0.0002, r - depth), p.x, f);
+      ASSERT_TRUE(c.in_contact) << "h " << h << " depth " << depth;
+      EXPECT_NEAR(c.force_on_tool.z(), k * depth, 1e-9) << "h " << h << " depth " << depth;
+      EXPECT_NEAR(c.force_on_tool.head<2>().norm(), 0.0, 1e-12);
+      EXPECT_NEAR(c.depth_m, depth, 1e-12);
+      Vec3 on_plate = Vec3::Zero();
+      for (const auto& v : f) on_plate += v;
+      EXPECT_NEAR((on_plate + c.force_on_tool).norm(), 0.0, 1e-9) << "action and reaction";
+    }
+    EXPECT_FALSE(contact.apply(Vec3(0, 0, r + 1e-4), p.x, {}).in_contact);     // just above
+    EXPECT_FALSE(contact.apply(Vec3(0, 0, -0.0201), p.x, {}).in_contact);  // centre beyond the 2 cm depth limit
+  }
+}
+
+TEST(ProbeContact, BroadPhaseFindsContactOnAStretchedSurface) {
+  const double r = 0.006, k = 1000.0;
+  const Plate rest(10, 0.01);
+  const ProbeContact contact(rest.triangles, rest.x, r, k);
+  std::vector<Vec3> stretched = rest.x;
+  for (auto& v : stretched) v.head<2>() *= 2.5;  // every edge 2.5x its rest length
+  for (const double xy : {0.0, 0.013, 0.041, 0.087}) {
+    const ContactResult c = contact.apply(Vec3(xy, -0.6 * xy, r - 0.002), stretched, {});
+    ASSERT_TRUE(c.in_contact) << "tip over (" << xy << ", " << -0.6 * xy << ")";
+    EXPECT_NEAR(c.force_on_tool.z(), k * 0.002, 1e-9);
+  }
+}
