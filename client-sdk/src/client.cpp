@@ -65,9 +65,11 @@ void Client::release(std::uint32_t instrument_id) {
 
 bool Client::control(proto::Action action, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
+  impl_->sessions.wait_for_readers(timeout);  // the server's reader must know this writer
   do {
     impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, action, 0}));
-    if (action == proto::Action::reset) return true;
+    // A reset shows in no state: it is done once the server acknowledged the request.
+    if (action == proto::Action::reset) return impl_->sessions.wait_for_acks(timeout);
     impl_->scene.wait(std::chrono::milliseconds(100));
     impl_->take_scene(rejected_);
     if (impl_->last_scene && impl_->last_scene->paused == (action == proto::Action::pause)) return true;
@@ -160,8 +162,13 @@ std::vector<proto::Event> Client::poll_events() {
 
 void Client::annotate(const std::string& text) {
   if (text.size() > 1024) throw std::invalid_argument("annotation of " + std::to_string(text.size()) + " bytes (at most 1024)");
-  if (!impl_->annotations) impl_->annotations = std::make_unique<proto::Writer>(impl_->participant, proto::Stream::event);
+  if (!impl_->annotations) {
+    impl_->annotations = std::make_unique<proto::Writer>(impl_->participant, proto::Stream::event);
+    // A new writer's first sample reaches only the readers discovered by then.
+    impl_->annotations->wait_for_readers(std::chrono::seconds(1));
+  }
   impl_->annotations->write(client_id_, proto::encode(proto::Event{client_id_, proto::EventKind::annotation, 0, client_id_, 0, proto::now_ns(), text}));
+  impl_->annotations->wait_for_acks(std::chrono::seconds(1));
 }
 
 LatencyStats Client::round_trip() const {

@@ -101,6 +101,19 @@ int Writer::matched() const {
   return static_cast<int>(st.current_count);
 }
 
+bool Writer::wait_for_readers(std::chrono::milliseconds timeout) const {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (matched() == 0) {
+    if (std::chrono::steady_clock::now() >= end) return false;
+    dds_sleepfor(DDS_MSECS(5));
+  }
+  return true;
+}
+
+bool Writer::wait_for_acks(std::chrono::milliseconds timeout) const {
+  return dds_wait_for_acks(handle_, DDS_MSECS(timeout.count())) == DDS_RETCODE_OK;
+}
+
 Reader::Reader(Participant& p, Stream s) {
   dds_qos_t* q = qos_for(s);
   handle_ = dds_create_reader(p.handle(), p.topic(s), q, nullptr);

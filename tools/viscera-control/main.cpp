@@ -53,8 +53,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (action == "annotate") {
-      client.annotate(rest[1]);
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));  // let reliable delivery finish before leaving
+      client.annotate(rest[1]);  // waits for the readers' acknowledgements
       std::printf("annotated scene %s\n", scene->name.c_str());
       return 0;
     }

@@ -34,7 +34,7 @@ class Client {
   void release(std::uint32_t instrument_id);
   /// Session control for the whole scene (any client, e.g. an instructor's console): pause,
   /// resume or reset. True once the scene state shows the pause state asked for (for reset:
-  /// once the request was sent).
+  /// once the server acknowledged the request).
   bool control(protocol::Action action, std::chrono::milliseconds timeout);
   /// Sends the instrument's tip position [m] and jaw opening [rad] (next sequence number,
   /// current stamp).
@@ -58,7 +58,9 @@ class Client {
   /// Session events (server) and annotations (clients) that arrived since the last call, in
   /// order. The first call subscribes; events before it are not seen.
   std::vector<protocol::Event> poll_events();
-  /// Publishes an annotation (at most 1024 bytes of text) for recorders and consoles.
+  /// Publishes an annotation (at most 1024 bytes of text) for recorders and consoles. The first
+  /// call waits (up to 1 s) for a reader to be discovered; each waits (up to 1 s) for the readers'
+  /// acknowledgements, so a client that exits right after still delivers it.
   void annotate(const std::string& text);
   std::uint32_t id() const { return client_id_; }
   /// Payloads that failed verification and were dropped.

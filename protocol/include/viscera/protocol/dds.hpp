@@ -2,6 +2,7 @@
 // The one wrapper of Cyclone DDS's C API in viscera: RAII entities, the envelope topic per
 // stream with its QoS (TRANSPORT.md), and typed writes/takes of FlatBuffer payloads. No other
 // code calls dds_* directly.
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -61,10 +62,15 @@ class Writer {
   void write(std::uint32_t source_id, std::span<const std::uint8_t> payload);
   /// Number of matched readers.
   int matched() const;
+  /// Waits until at least one reader is matched (a new writer's first samples reach only the
+  /// readers discovered by then); false on timeout.
+  bool wait_for_readers(std::chrono::milliseconds timeout) const;
+  /// Waits until every matched reliable reader acknowledged what was written; false on timeout.
+  bool wait_for_acks(std::chrono::milliseconds timeout) const;
 
  private:
   int32_t handle_;
-  std::uint64_t seq_ = 0;
+  std::atomic<std::uint64_t> seq_{0};  // a writer may be shared by threads (dds_write is thread-safe)
 };
 
 class Reader {
