@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
       "Script 'press': the probe starts 1 cm above the organ at the centre of its top and moves down until the\n"
       "server reports contact, presses DEPTH further by mid-run and comes back to the contact height by the end.\n"
       "Script 'grasp': the grasper moves down to contact (plus DEPTH), closes its jaws, pulls up PULL, opens.\n"
-      "--trajectory FILE.csv plays a recorded or designed trajectory instead (docs/HAPTIC_CLIENT.md).\n"
+      "--trajectory FILE.csv plays a recorded or designed trajectory instead (docs/PROTOCOL.md).\n"
       "Prints force and command-to-force round trip live; --report writes every sample as JSON.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");

@@ -1,5 +1,5 @@
 #pragma once
-// A virtual device that plays a trajectory file (docs/HAPTIC_CLIENT.md): CSV with a header row,
+// A virtual device that plays a trajectory file (docs/PROTOCOL.md): CSV with a header row,
 // columns time_s, x_m, y_m, z_m and optionally jaw_rad and buttons; times strictly increasing
 // from 0. Positions are in the scene frame, or relative to the organ's top centre (the centre of
 // its bounds in x and y, the top of its bounds in z) with frame "organ-top". Between rows the
