@@ -81,7 +81,12 @@ struct SimulationServer::Impl {
     std::vector<Vec3> x;
     std::map<std::uint32_t, std::vector<std::pair<std::int32_t, Vec3>>> grasped;
   };
-  std::atomic<std::shared_ptr<const Snapshot>> snapshot;
+  std::mutex snapshot_mutex;  // guards the pointer only; a Snapshot is never changed once shared
+  std::shared_ptr<const Snapshot> snapshot;
+  std::shared_ptr<const Snapshot> latest_snapshot() {
+    std::lock_guard lock(snapshot_mutex);
+    return snapshot;
+  }
   bool paused = false;  // physics thread
 
   proto::Participant participant;
@@ -349,7 +354,7 @@ struct SimulationServer::Impl {
       }
     });
     if (updated.empty()) return;
-    const auto snap = snapshot.load();
+    const auto snap = latest_snapshot();
     for (const auto& u : updated) {
       const auto& p = u.command.tip_position;
       const Vec3 tip(p[0], p[1], p[2]);
@@ -386,7 +391,8 @@ struct SimulationServer::Impl {
     snap->x = state.x;
     for (const auto& [id, inst] : instruments)
       if (!inst.grasped.empty()) snap->grasped[id] = inst.grasped;
-    snapshot.store(std::move(snap));
+    std::lock_guard lock(snapshot_mutex);
+    snapshot = std::move(snap);
   }
 
   /// The local force model's stiffness: the contact penalty in series with the tissue condensed
