@@ -46,6 +46,11 @@ std::optional<proto::Scene> Client::wait_for_scene(std::chrono::milliseconds tim
   return std::nullopt;
 }
 
+std::optional<proto::Scene> Client::scene() {
+  impl_->take_scene(rejected_);
+  return impl_->last_scene;
+}
+
 bool Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
@@ -75,6 +80,46 @@ bool Client::control(proto::Action action, std::chrono::milliseconds timeout) {
     if (impl_->last_scene && impl_->last_scene->paused == (action == proto::Action::pause)) return true;
   } while (std::chrono::steady_clock::now() < end);
   return false;
+}
+
+std::optional<proto::RequestOutcome> Client::request(proto::SessionRequest r, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  if (request_seq_ == 0) request_seq_ = static_cast<std::uint64_t>(proto::now_ns());
+  r.client_id = client_id_;
+  r.request_seq = ++request_seq_;
+  // Sent once: a second copy would load the scene twice. The server's reader must know this
+  // writer first, or the sample is lost.
+  if (!impl_->sessions.wait_for_readers(timeout)) return std::nullopt;
+  impl_->sessions.write(client_id_, proto::encode(r));
+  while (std::chrono::steady_clock::now() < end) {
+    impl_->scene.wait(std::chrono::milliseconds(100));
+    impl_->take_scene(rejected_);
+    if (impl_->last_scene)
+      for (const auto& o : impl_->last_scene->recent_requests)
+        if (o.client_id == client_id_ && o.request_seq == r.request_seq) return o;
+  }
+  return std::nullopt;
+}
+
+std::optional<proto::RequestOutcome> Client::load_scene(const std::string& name, std::chrono::milliseconds timeout) {
+  proto::SessionRequest r;
+  r.action = proto::Action::load_scene;
+  r.scene_name = name;
+  return request(std::move(r), timeout);
+}
+
+std::optional<proto::RequestOutcome> Client::set_material(const proto::MaterialChange& change, std::chrono::milliseconds timeout) {
+  proto::SessionRequest r;
+  r.action = proto::Action::set_material;
+  r.material = change;
+  return request(std::move(r), timeout);
+}
+
+std::optional<proto::RequestOutcome> Client::set_physics_rate(double rate_hz, std::chrono::milliseconds timeout) {
+  proto::SessionRequest r;
+  r.action = proto::Action::set_physics_rate;
+  r.physics_rate_hz = rate_hz;
+  return request(std::move(r), timeout);
 }
 
 void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad) {
@@ -138,7 +183,7 @@ std::optional<proto::MeshFrame> Client::poll_mesh_frame() {
   impl_->frames->take([&](const proto::Received& r) {
     std::string why;
     auto f = proto::decode_mesh_frame(r.payload, &why);
-    if (f && !topology) return;  // the topology (transient local) is still on its way
+    if (f && (!topology || f->mesh_id > topology->mesh_id)) return;  // its topology (transient local) is still on its way
     if (!f || !topology || f->mesh_id != topology->mesh_id || f->positions.size() != 3ull * topology->vertex_count) {
       ++rejected_;
       return;

@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "event_generated.h"
@@ -66,8 +68,20 @@ std::vector<std::uint8_t> encode(const Force& f) {
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
-  flatbuffers::FlatBufferBuilder b(64);
-  return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id));
+  flatbuffers::FlatBufferBuilder b(128);
+  const auto name = r.scene_name.empty() ? 0 : b.CreateString(r.scene_name);
+  flatbuffers::Offset<fb::MaterialChange> material = 0;
+  if (!r.material.empty()) {
+    fb::MaterialChangeBuilder m(b);
+    if (r.material.youngs_modulus_pa) m.add_youngs_modulus_pa(*r.material.youngs_modulus_pa);
+    if (r.material.poisson_ratio) m.add_poisson_ratio(*r.material.poisson_ratio);
+    if (r.material.density_kg_m3) m.add_density_kg_m3(*r.material.density_kg_m3);
+    if (r.material.shear_q) m.add_shear_q(*r.material.shear_q);
+    if (r.material.damping_per_s) m.add_damping_per_s(*r.material.damping_per_s);
+    material = m.Finish();
+  }
+  return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id, r.request_seq, name,
+                                            material, r.physics_rate_hz));
 }
 
 std::vector<std::uint8_t> encode(const Scene& s) {
@@ -79,7 +93,17 @@ std::vector<std::uint8_t> encode(const Scene& s) {
   const auto name = b.CreateString(s.name);
   const auto list = b.CreateVector(inst);
   const fb::Vec3 lo = to_fb(s.bounds_min), hi = to_fb(s.bounds_max);
-  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi));
+  const auto& m = s.material;
+  const auto material = fb::CreateMaterialState(b, b.CreateString(m.name), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q,
+                                                m.damping_per_s);
+  const auto scenes = b.CreateVectorOfStrings(s.available_scenes);
+  const auto preparing = b.CreateString(s.preparing);
+  std::vector<flatbuffers::Offset<fb::RequestOutcome>> outcomes;
+  for (const auto& o : s.recent_requests)
+    outcomes.push_back(fb::CreateRequestOutcome(b, o.client_id, o.request_seq, static_cast<fb::SessionAction>(o.action), o.accepted,
+                                                b.CreateString(o.message)));
+  const auto recent = b.CreateVector(outcomes);
+  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent));
 }
 
 std::vector<std::uint8_t> encode(const TelemetryReport& t) {
@@ -113,6 +137,20 @@ std::vector<std::uint8_t> encode(const Event& e) {
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
 
+const char* action_name(Action a) {
+  switch (a) {
+    case Action::claim_instrument: return "claim_instrument";
+    case Action::release_instrument: return "release_instrument";
+    case Action::pause: return "pause";
+    case Action::resume: return "resume";
+    case Action::reset: return "reset";
+    case Action::load_scene: return "load_scene";
+    case Action::set_material: return "set_material";
+    case Action::set_physics_rate: return "set_physics_rate";
+  }
+  return "unknown";
+}
+
 const char* event_name(EventKind k) {
   switch (k) {
     case EventKind::annotation: return "annotation";
@@ -126,8 +164,12 @@ const char* event_name(EventKind k) {
     case EventKind::contact_ended: return "contact_ended";
     case EventKind::grasped: return "grasped";
     case EventKind::let_go: return "let_go";
+    case EventKind::scene_loaded: return "scene_loaded";
+    case EventKind::material_changed: return "material_changed";
+    case EventKind::physics_rate_changed: return "physics_rate_changed";
+    case EventKind::request_refused: return "request_refused";
   }
-  return "?";
+  return "unknown";
 }
 
 std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why) {
@@ -204,7 +246,7 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
   const auto* m = verified_root<fb::SessionRequest>(bytes, why);
   if (!m) return std::nullopt;
   const auto a = static_cast<int>(m->action());
-  if (a < 0 || a > 4) {
+  if (a < 0 || a > static_cast<int>(Action::set_physics_rate)) {
     *why = "unknown action " + std::to_string(a);
     return std::nullopt;
   }
@@ -212,7 +254,49 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
     *why = "client_id 0 is reserved";
     return std::nullopt;
   }
-  return SessionRequest{m->client_id(), static_cast<Action>(a), m->instrument_id()};
+  SessionRequest r{m->client_id(), static_cast<Action>(a), m->instrument_id(), m->request_seq(), {}, {}, m->physics_rate_hz()};
+  if (r.action == Action::load_scene) {
+    r.scene_name = m->scene_name() ? m->scene_name()->str() : "";
+    const bool plain = std::all_of(r.scene_name.begin(), r.scene_name.end(),
+                                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
+    if (r.scene_name.empty() || r.scene_name.size() > 64 || r.scene_name[0] == '.' || !plain) {
+      *why = "scene_name '" + r.scene_name.substr(0, 64) + "' is not a plain scene name ([A-Za-z0-9._-], 1-64 characters, no leading '.')";
+      return std::nullopt;
+    }
+  }
+  if (r.action == Action::set_material) {
+    const auto* c = m->material();
+    if (!c) {
+      *why = "set_material without material";
+      return std::nullopt;
+    }
+    const auto take = [&](flatbuffers::Optional<double> v, const char* field, double lo, double hi, bool open_hi,
+                          std::optional<double>& out) {
+      if (!v.has_value()) return true;
+      const double x = *v;
+      if (!std::isfinite(x) || x < lo || (open_hi ? x >= hi : x > hi)) {
+        *why = std::string("material.") + field + " = " + std::to_string(x) + " is out of range";
+        return false;
+      }
+      out = x;
+      return true;
+    };
+    if (!take(c->youngs_modulus_pa(), "youngs_modulus_pa", 1.0, 1e9, false, r.material.youngs_modulus_pa) ||
+        !take(c->poisson_ratio(), "poisson_ratio", 0.0, 0.5, true, r.material.poisson_ratio) ||
+        !take(c->density_kg_m3(), "density_kg_m3", 1.0, 1e5, false, r.material.density_kg_m3) ||
+        !take(c->shear_q(), "shear_q", 0.5, 1e4, false, r.material.shear_q) ||
+        !take(c->damping_per_s(), "damping_per_s", 0.0, 1e4, false, r.material.damping_per_s))
+      return std::nullopt;
+    if (r.material.empty()) {
+      *why = "set_material with no parameter";
+      return std::nullopt;
+    }
+  }
+  if (r.action == Action::set_physics_rate && !(r.physics_rate_hz >= 10.0 && r.physics_rate_hz <= 10000.0)) {
+    *why = "physics_rate_hz = " + std::to_string(r.physics_rate_hz) + " is outside [10, 10000] Hz";
+    return std::nullopt;
+  }
+  return r;
 }
 
 std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::string* why) {
@@ -227,6 +311,23 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
       s.instruments.push_back({i->instrument_id(), i->kind() == fb::InstrumentKind::grasper, i->tip_radius_m(), i->owner_client_id()});
   s.bounds_min = from_fb(m->organ_bounds_min());
   s.bounds_max = from_fb(m->organ_bounds_max());
+  s.generation = m->generation();
+  if (const auto* mat = m->material()) {
+    s.material = {mat->name() ? mat->name()->str() : "", mat->youngs_modulus_pa(), mat->poisson_ratio(), mat->density_kg_m3(), mat->shear_q(),
+                  mat->damping_per_s()};
+    const auto& x = s.material;
+    if (!std::isfinite(x.youngs_modulus_pa + x.poisson_ratio + x.density_kg_m3 + x.shear_q + x.damping_per_s)) {
+      *why = "material numbers not finite";
+      return std::nullopt;
+    }
+  }
+  if (m->available_scenes())
+    for (const auto* n : *m->available_scenes()) s.available_scenes.push_back(n->str());
+  s.preparing = m->preparing() ? m->preparing()->str() : "";
+  if (m->recent_requests())
+    for (const auto* o : *m->recent_requests())
+      s.recent_requests.push_back({o->client_id(), o->request_seq(), static_cast<Action>(o->action()), o->accepted(),
+                                   o->message() ? o->message()->str() : ""});
   if (!finite(s.bounds_min) || !finite(s.bounds_max) || !std::isfinite(s.physics_rate_hz)) {
     *why = "scene numbers not finite";
     return std::nullopt;
@@ -297,9 +398,11 @@ std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, 
 std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::string* why) {
   const auto* m = verified_root<fb::Event>(bytes, why, fb::EventIdentifier());
   if (!m) return std::nullopt;
+  // Kinds this build does not know (added by a newer server) pass through: event_name() says
+  // "unknown". Negative kinds are never defined.
   const auto k = static_cast<int>(m->kind());
-  if (k < 0 || k > static_cast<int>(EventKind::let_go)) {
-    *why = "unknown event kind " + std::to_string(k);
+  if (k < 0) {
+    *why = "negative event kind " + std::to_string(k);
     return std::nullopt;
   }
   if (m->text() && m->text()->size() > 1024) {

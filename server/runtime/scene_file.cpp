@@ -1,5 +1,6 @@
 #include "scene_file.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -85,6 +86,22 @@ SceneSpec read_scene_file(const std::string& path) {
     s.instruments.push_back(spec);
   }
   return s;
+}
+
+std::vector<std::string> list_scenes(const std::string& directory) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
+    if (entry.path().extension() != ".json") continue;
+    try {
+      read_scene_file(entry.path().string());
+      names.push_back(entry.path().stem().string());
+    } catch (const InputError&) {
+      // not a scene (or a broken one): not offered
+    }
+  }
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
 }  // namespace viscera::runtime

@@ -35,4 +35,8 @@ struct SceneSpec {
 
 SceneSpec read_scene_file(const std::string& path);
 
+/// The scenes of a directory that load_scene may name: the stems of its *.json files that read
+/// as scene files, sorted.
+std::vector<std::string> list_scenes(const std::string& directory);
+
 }  // namespace viscera::runtime

@@ -3,23 +3,20 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <future>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "common/input_error.hpp"
-#include "integrator/explicit_integrator.hpp"
-#include "material/material_file.hpp"
-#include "mesh/boundary_surface.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/refinement.hpp"
-#include "contact_compliance.hpp"
 #include "mesh_publisher.hpp"
-#include "model/model_factory.hpp"
+#include "organ.hpp"
 #include "probe_contact.hpp"
 #include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/messages.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
 
 namespace viscera::runtime {
 
@@ -36,14 +33,16 @@ double percentile(std::vector<double> v, double p) {
 }  // namespace
 
 struct SimulationServer::Impl {
-  SceneSpec scene;
-  std::shared_ptr<TetMesh> mesh;
-  std::unique_ptr<ForceModel> model;
-  std::unique_ptr<ExplicitIntegrator> integrator;
-  std::unique_ptr<ContactCompliance> compliance;  // worker thread; uses *model
+  SceneSpec scene;  // physics thread: the running scene (its rate may change at run time)
+  std::string scene_dir;
+  // The organ (mesh, model, integrator, compliance) is the physics thread's. Session control
+  // replaces it between ticks; the command thread reads it (compliance, instruments' queries)
+  // only while holding organ_mutex, which the physics thread takes to swap it.
+  std::unique_ptr<Organ> organ;
+  std::mutex organ_mutex;
   State state;
   double sim_time_s = 0;
-  Box bounds;
+  std::uint32_t generation = 1;  // +1 per scene loaded: the surface's mesh_id
 
   // Two threads: the physics thread (run()) steps the organ at the fixed rate; the command thread
   // answers every command the moment it arrives with the reaction at the commanded pose on the
@@ -74,7 +73,6 @@ struct SimulationServer::Impl {
   };
   std::map<std::uint32_t, Instrument> instruments;
   std::mutex command_mutex;
-  std::vector<std::int32_t> surface_nodes;
 
   /// What the command thread answers from: the organ after the last tick and the grasped nodes.
   struct Snapshot {
@@ -93,10 +91,24 @@ struct SimulationServer::Impl {
   proto::Reader commands, sessions;
   proto::Writer forces, scene_state, telemetry, events;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread; after the writers it uses
+  std::uint64_t mesh_frames_before = 0, mesh_skipped_before = 0;  // of the publishers of earlier scenes
   std::atomic<std::uint64_t> rejected{0}, forces_sent{0};
 
-  explicit Impl(const SceneSpec& s)
+  // Session control: a scene or material is built on a thread of its own while the physics goes
+  // on; the physics thread swaps it in when ready. One at a time.
+  struct Preparing {
+    std::future<std::unique_ptr<Organ>> organ;
+    proto::SessionRequest request;
+    std::string what;
+  };
+  std::optional<Preparing> preparing;
+  std::deque<proto::RequestOutcome> outcomes;  // the last 8, for the scene state
+  std::vector<std::string> available_scenes;
+  std::vector<std::future<void>> retiring;  // organs being destroyed (a compliance worker may be mid-factorisation)
+
+  Impl(const SceneSpec& s, std::string dir)
       : scene(s),
+        scene_dir(std::move(dir)),
         participant(s.domain_id),
         commands(participant, proto::Stream::instrument_command),
         sessions(participant, proto::Stream::session_request),
@@ -104,74 +116,104 @@ struct SimulationServer::Impl {
         scene_state(participant, proto::Stream::scene_state),
         telemetry(participant, proto::Stream::telemetry),
         events(participant, proto::Stream::event) {
-    mesh = std::make_shared<TetMesh>(read_tet_mesh(s.mesh));
-    for (int k = 0; k < s.refine; ++k) *mesh = refine_uniform(*mesh);
-    scale_mesh(*mesh, s.scale_m_per_unit);
-    const Material material = read_material_file(s.material);
-    Mat6 D = material.elasticity;
-    GpsViscoelasticity ve;
-    if (material.viscoelasticity) {
-      const ViscoelasticSetup setup = make_viscoelastic(material.elasticity, *material.viscoelasticity, s.material);
-      D = setup.unrelaxed_elasticity;
-      ve = setup.gps;
-    }
-    model = make_force_model(s.model, mesh, {D}, s.volume_term, ve);
-    bounds = bounding_box(*mesh);
-    BoundaryConditions bc;
-    bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
-    const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
-    Box slab = bounds;
-    const double extent = bounds.hi[a] - bounds.lo[a];
-    if (s.fix_side == "min") slab.hi[a] = bounds.lo[a] + s.fix_fraction * extent;
-    else slab.lo[a] = bounds.hi[a] - s.fix_fraction * extent;
-    bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
-    bc.force_field = [this](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
-      for (auto& [id, inst] : instruments) {
-        if (!inst.active) {
-          inst.result = {};
-          continue;
-        }
-        const Vec3& tip = inst.proxy;
-        inst.result = inst.contact->apply(tip, x, f, stiffness);
-        // Grasped nodes follow the jaws through stiff springs; the tool feels their reaction.
-        for (const auto& [node, offset] : inst.grasped) {
-          const Vec3 pull = scene.grasp_stiffness_n_per_m * (tip + offset - x[node]);
-          f[node] += pull;
-          stiffness[node] += scene.grasp_stiffness_n_per_m;
-          inst.result.force_on_tool -= pull;
-        }
-        if (!inst.grasped.empty()) inst.result.in_contact = true;
-      }
-    };
-    const BoundarySurface boundary = extract_boundary(*mesh);
-    const auto& surface = boundary.triangles;
-    // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
-    integrator = std::make_unique<ExplicitIntegrator>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc,
-                                                      ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step});
-    state = State::at_rest(*mesh);
-    compliance = std::make_unique<ContactCompliance>(*model, std::vector<double>(mesh->tet_count(), material.density_kg_m3), bc);
-    surface_nodes = boundary.nodes;
-    for (const auto& spec : s.instruments) {
-      Instrument& inst = instruments[spec.id];
-      inst.spec = spec;
-      inst.contact = std::make_unique<ProbeContact>(surface, mesh->nodes, spec.tip_radius_m, s.contact_stiffness_n_per_m);
-      inst.query = std::make_unique<ProbeContact>(surface, mesh->nodes, spec.tip_radius_m, s.contact_stiffness_n_per_m);
-    }
-    publish_snapshot();
-    if (s.mesh_rate_hz > 0) mesh_publisher = std::make_unique<MeshPublisher>(participant, surface_topology(boundary), boundary.nodes, s.mesh_rate_hz);
+    available_scenes = list_scenes(scene_dir);
+    adopt(build_organ(s), true);
     publish_scene();
+  }
+
+  ~Impl() {
+    if (preparing) preparing->organ.wait();
+  }
+
+  /// The instruments of the scene, each with its contact on the organ's surface.
+  std::map<std::uint32_t, Instrument> make_instruments(const Organ& o) const {
+    std::map<std::uint32_t, Instrument> made;
+    for (const auto& spec : o.scene.instruments) {
+      Instrument& inst = made[spec.id];
+      inst.spec = spec;
+      inst.contact = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m);
+      inst.query = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m);
+    }
+    return made;
+  }
+
+  /// Physics thread, between ticks: `next` becomes the organ. A new scene starts at rest with its
+  /// own instruments (owners lose theirs and must claim again) and a new surface; a new material
+  /// on the same mesh keeps the organ's deformation, its owners and its tools.
+  void adopt(std::unique_ptr<Organ> next, bool new_scene) {
+    next->integrator->boundary_conditions().force_field = [this](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
+      apply_instruments(x, f, stiffness);
+    };
+    std::map<std::uint32_t, Instrument> made;
+    if (new_scene) made = make_instruments(*next);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> released;  // instrument, owner
+    std::unique_ptr<Organ> old;
+    {
+      std::lock_guard world(organ_mutex);
+      std::lock_guard lock(command_mutex);
+      old = std::move(organ);
+      organ = std::move(next);
+      const double rate = scene.physics_rate_hz;
+      scene = organ->scene;
+      if (new_scene) {
+        for (const auto& [id, inst] : instruments)
+          if (inst.owner != 0) released.emplace_back(id, inst.owner);
+        instruments = std::move(made);
+        state = State::at_rest(*organ->mesh);
+        if (old) ++generation;
+      } else {
+        scene.physics_rate_hz = rate;  // a set_physics_rate outlives a material change
+        if (state.memory.size() != organ->model->memory_size()) state.memory.clear();  // relaxed
+      }
+      publish_snapshot();
+    }
+    for (const auto& [id, owner] : released)
+      event(proto::EventKind::instrument_released, id, owner, "the scene was replaced by " + scene.name);
+    if (new_scene) {
+      if (mesh_publisher) {
+        mesh_frames_before += mesh_publisher->frames_published();
+        mesh_skipped_before += mesh_publisher->frames_skipped();
+      }
+      mesh_publisher.reset();
+      if (scene.mesh_rate_hz > 0)
+        mesh_publisher = std::make_unique<MeshPublisher>(participant, surface_topology(organ->boundary), organ->boundary.nodes, scene.mesh_rate_hz);
+    }
+    if (old) retiring.push_back(std::async(std::launch::async, [o = std::move(old)]() mutable { o.reset(); }));
+    std::erase_if(retiring, [](const std::future<void>& f) { return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready; });
+  }
+
+  /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
+  /// contact of each active tool, and the springs holding grasped nodes to the jaws.
+  void apply_instruments(std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
+    for (auto& [id, inst] : instruments) {
+      if (!inst.active) {
+        inst.result = {};
+        continue;
+      }
+      const Vec3& tip = inst.proxy;
+      inst.result = inst.contact->apply(tip, x, f, stiffness);
+      // Grasped nodes follow the jaws through stiff springs; the tool feels their reaction.
+      for (const auto& [node, offset] : inst.grasped) {
+        const Vec3 pull = scene.grasp_stiffness_n_per_m * (tip + offset - x[node]);
+        f[node] += pull;
+        stiffness[node] += scene.grasp_stiffness_n_per_m;
+        inst.result.force_on_tool -= pull;
+      }
+      if (!inst.grasped.empty()) inst.result.in_contact = true;
+    }
   }
 
   /// The boundary surface with its vertices numbered in the order of boundary.nodes.
   proto::SurfaceTopology surface_topology(const BoundarySurface& boundary) const {
     proto::SurfaceTopology t;
-    t.mesh_id = 1;
+    t.mesh_id = generation;
     t.organ_name = scene.name;
     t.vertex_count = static_cast<std::uint32_t>(boundary.nodes.size());
-    std::vector<std::uint32_t> vertex_of(mesh->node_count(), 0);
+    const auto& nodes = organ->mesh->nodes;
+    std::vector<std::uint32_t> vertex_of(nodes.size(), 0);
     for (std::size_t k = 0; k < boundary.nodes.size(); ++k) {
       vertex_of[boundary.nodes[k]] = static_cast<std::uint32_t>(k);
-      for (int d = 0; d < 3; ++d) t.rest_positions.push_back(static_cast<float>(mesh->nodes[boundary.nodes[k]][d]));
+      for (int d = 0; d < 3; ++d) t.rest_positions.push_back(static_cast<float>(nodes[boundary.nodes[k]][d]));
     }
     for (const auto& tri : boundary.triangles)
       for (const auto n : tri) t.triangles.push_back(vertex_of[n]);
@@ -187,8 +229,14 @@ struct SimulationServer::Impl {
       std::lock_guard lock(command_mutex);
       for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, inst.spec.kind == "grasper", inst.spec.tip_radius_m, inst.owner});
     }
+    const Box& bounds = organ->bounds;
     sc.bounds_min = {bounds.lo.x(), bounds.lo.y(), bounds.lo.z()};
     sc.bounds_max = {bounds.hi.x(), bounds.hi.y(), bounds.hi.z()};
+    sc.generation = generation;
+    sc.material = organ->material_info();
+    sc.available_scenes = available_scenes;
+    if (preparing) sc.preparing = preparing->what;
+    sc.recent_requests.assign(outcomes.begin(), outcomes.end());
     scene_state.write(0, proto::encode(sc));
   }
 
@@ -219,6 +267,12 @@ struct SimulationServer::Impl {
           if (status) status(who + " reset the organ to rest");
           event(proto::EventKind::organ_reset, 0, req->client_id);
           return;
+        case proto::Action::load_scene:
+        case proto::Action::set_material:
+        case proto::Action::set_physics_rate:
+          control(*req, status);
+          changed = true;
+          return;
         default:
           break;
       }
@@ -245,6 +299,94 @@ struct SimulationServer::Impl {
     if (changed) publish_scene();
   }
 
+  /// Run-time control (physics thread): a new physics rate at once; a scene or material is
+  /// prepared in the background (finish_preparing() swaps it in). Every request gets an outcome
+  /// in the scene state and an event; a refusal says why.
+  void control(const proto::SessionRequest& req, const std::function<void(const std::string&)>& status) {
+    const auto refuse = [&](const std::string& why) { conclude(req, false, why, status); };
+    if (req.action == proto::Action::set_physics_rate) {
+      char text[160];
+      std::snprintf(text, sizeof text, "physics rate %.0f Hz (was %.0f Hz)", req.physics_rate_hz, scene.physics_rate_hz);
+      scene.physics_rate_hz = req.physics_rate_hz;
+      conclude(req, true, text, status);
+      return;
+    }
+    if (preparing) return refuse("busy: still preparing " + preparing->what);
+    if (req.action == proto::Action::load_scene) {
+      const std::string path = (std::filesystem::path(scene_dir) / (req.scene_name + ".json")).string();
+      if (!std::filesystem::exists(path)) {
+        std::string list;
+        for (const auto& n : available_scenes) list += (list.empty() ? "" : ", ") + n;
+        return refuse("no scene '" + req.scene_name + "' in " + scene_dir + " (available: " + list + ")");
+      }
+      SceneSpec spec;
+      try {
+        spec = read_scene_file(path);
+      } catch (const InputError& e) {
+        return refuse(e.what());
+      }
+      if (spec.domain_id != scene.domain_id) spec.domain_id = scene.domain_id;  // the server stays on its domain
+      preparing = Preparing{std::async(std::launch::async, [spec] { return build_organ(spec); }), req, "scene " + req.scene_name};
+    } else {
+      const Organ& current = *organ;  // stays alive: nothing else replaces it while this is prepared
+      preparing = Preparing{std::async(std::launch::async, [&current, change = req.material] { return rebuild_with_material(current, change); }),
+                            req, "material " + describe_change(req.material)};
+    }
+    if (status) status("client " + std::to_string(req.client_id) + " asked for " + preparing->what + "; preparing it");
+  }
+
+  static std::string describe_change(const proto::MaterialChange& m) {
+    std::string out;
+    const auto add = [&](const char* name, const std::optional<double>& v) {
+      if (!v) return;
+      char b[80];
+      std::snprintf(b, sizeof b, "%s%s %.6g", out.empty() ? "" : ", ", name, *v);
+      out += b;
+    };
+    add("youngs_modulus_pa", m.youngs_modulus_pa);
+    add("poisson_ratio", m.poisson_ratio);
+    add("density_kg_m3", m.density_kg_m3);
+    add("shear_q", m.shear_q);
+    add("damping_per_s", m.damping_per_s);
+    return out;
+  }
+
+  /// Physics thread, between ticks: a prepared scene or material that is ready replaces the organ.
+  void finish_preparing(const std::function<void(const std::string&)>& status) {
+    if (!preparing || preparing->organ.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    Preparing done = std::move(*preparing);
+    preparing.reset();
+    const bool new_scene = done.request.action == proto::Action::load_scene;
+    try {
+      adopt(done.organ.get(), new_scene);
+    } catch (const std::exception& e) {
+      conclude(done.request, false, done.what + ": " + e.what(), status);
+      return;
+    }
+    char dt[64];
+    std::snprintf(dt, sizeof dt, " (explicit step %.3g s)", organ->integrator->dt_s());
+    if (new_scene) available_scenes = list_scenes(scene_dir);
+    conclude(done.request, true, (new_scene ? "loaded " : "changed to ") + done.what + dt, status);
+  }
+
+  /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
+  void conclude(const proto::SessionRequest& req, bool accepted, const std::string& message, const std::function<void(const std::string&)>& status) {
+    outcomes.push_back({req.client_id, req.request_seq, req.action, accepted, message.substr(0, 1000)});
+    while (outcomes.size() > 8) outcomes.pop_front();
+    const proto::EventKind kind = !accepted ? proto::EventKind::request_refused
+                                  : req.action == proto::Action::load_scene ? proto::EventKind::scene_loaded
+                                  : req.action == proto::Action::set_material ? proto::EventKind::material_changed
+                                                                               : proto::EventKind::physics_rate_changed;
+    event(kind, 0, req.client_id, message.substr(0, 1000));
+    if (status) status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + (accepted ? "" : "refused: ") + message);
+    publish_scene();
+  }
+
+  void mesh_counts(ServerStats& stats) const {
+    stats.mesh_frames = mesh_frames_before + (mesh_publisher ? mesh_publisher->frames_published() : 0);
+    stats.mesh_frames_skipped = mesh_skipped_before + (mesh_publisher ? mesh_publisher->frames_skipped() : 0);
+  }
+
   /// A session event for recorders, trainers and consoles (physics thread).
   void event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text = {}) {
     events.write(0, proto::encode(proto::Event{0, kind, instrument_id, client_id, sim_time_s, proto::now_ns(), std::move(text)}));
@@ -252,7 +394,7 @@ struct SimulationServer::Impl {
 
   /// The organ back at rest (memory variables relaxed); graspers let go.
   void reset_organ() {
-    state = State::at_rest(*mesh);
+    state = State::at_rest(*organ->mesh);
     for (auto& [id, inst] : instruments) inst.grasped.clear();
   }
 
@@ -278,7 +420,7 @@ struct SimulationServer::Impl {
     if (inst.spec.kind != "grasper") return;
     const Vec3& tip = inst.proxy;  // the grasped nodes follow the simulated tool
     if (inst.grasped.empty() && inst.tick.jaw_opening < 0.1) {
-      for (auto n : surface_nodes)
+      for (auto n : organ->boundary.nodes)
         if ((state.x[n] - tip).norm() < inst.spec.grasp_radius_m) inst.grasped.emplace_back(n, state.x[n] - tip);
       if (!inst.grasped.empty())
         event(proto::EventKind::grasped, inst.spec.id, inst.tick_owner, std::to_string(inst.grasped.size()) + " surface nodes");
@@ -332,6 +474,7 @@ struct SimulationServer::Impl {
       proto::Command command;
     };
     std::vector<Update> updated;
+    std::lock_guard world(organ_mutex);  // the organ and instruments stay while we answer
     commands.take([&](const proto::Received& r) {
       std::string why;
       const auto c = proto::decode_command(r.payload, &why);
@@ -404,7 +547,7 @@ struct SimulationServer::Impl {
     const double k_penalty = r.normal.dot(penalty * r.normal);
     Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
     for (int k = 0; k < 3; ++k) {
-      const auto block = compliance->node(r.deepest_triangle[k]);
+      const auto block = organ->compliance->node(r.deepest_triangle[k]);
       if (!block) return r.stiffness;
       C += r.deepest_weights[k] * *block;
     }
@@ -433,14 +576,15 @@ struct SimulationServer::Impl {
   }
 };
 
-SimulationServer::SimulationServer(const SceneSpec& scene) : impl_(std::make_unique<Impl>(scene)) {}
+SimulationServer::SimulationServer(const SceneSpec& scene, const std::string& scene_dir)
+    : impl_(std::make_unique<Impl>(scene, scene_dir.empty() ? std::filesystem::path(scene.source).parent_path().string() : scene_dir)) {}
 SimulationServer::~SimulationServer() = default;
 
 std::string SimulationServer::describe() const {
   char b[400];
   std::snprintf(b, sizeof b, "scene %s: %zu nodes, %zu tets, model %s, explicit step %.3g s, %zu instruments, %.0f Hz, DDS domain %u",
-                impl_->scene.name.c_str(), impl_->mesh->node_count(), impl_->mesh->tet_count(), std::string(impl_->model->name()).c_str(),
-                impl_->integrator->dt_s(), impl_->instruments.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
+                impl_->scene.name.c_str(), impl_->organ->mesh->node_count(), impl_->organ->mesh->tet_count(),
+                std::string(impl_->organ->model->name()).c_str(), impl_->organ->integrator->dt_s(), impl_->instruments.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
   return b;
 }
 
@@ -463,8 +607,6 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     }
   } join{stopping, command_thread};
 
-  const double dt = 1.0 / s.scene.physics_rate_hz;
-  const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 * dt));
   const auto start = clock::now();
   auto next = start;
   auto last_report = start;
@@ -474,13 +616,15 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     const auto tick_start = clock::now();
     jitter_us.push_back(std::chrono::duration<double, std::micro>(tick_start - next).count());
     s.take_sessions(status);
+    s.finish_preparing(status);
+    const double dt = 1.0 / s.scene.physics_rate_hz;  // session control may change it
     s.release_silent(500'000'000, status);  // the DDS liveliness lease of the command stream
     s.take_tick_commands();
     const auto t0 = clock::now();
     if (!s.paused) {
       s.move_tools(dt);
       try {
-        s.integrator->advance(s.state, dt);
+        s.organ->integrator->advance(s.state, dt);
         s.sim_time_s += dt;
       } catch (const SimulationError& e) {
         // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
@@ -505,10 +649,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       stats.step_max_us = *std::max_element(step_us.begin(), step_us.end());
       stats.jitter_p99_us = percentile(jitter_us, 0.99);
       stats.rejected = s.rejected;
-      if (s.mesh_publisher) {
-        stats.mesh_frames = s.mesh_publisher->frames_published();
-        stats.mesh_frames_skipped = s.mesh_publisher->frames_skipped();
-      }
+      s.mesh_counts(stats);
       s.telemetry.write(0, proto::encode(proto::TelemetryReport{proto::now_ns(), stats.ticks, stats.overruns, stats.rejected, stats.rate_hz,
                                                                 stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us}));
       if (status) {
@@ -533,7 +674,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       ticks_at_report = stats.ticks;
     }
     if (duration_s > 0 && std::chrono::duration<double>(t1 - start).count() >= duration_s) break;
-    next += period;
+    next += std::chrono::nanoseconds(static_cast<long long>(1e9 * dt));
     const auto now = clock::now();
     if (now > next) {
       ++stats.overruns;  // missed the deadline: do not try to catch up with a burst
@@ -544,10 +685,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
   }
   stats.rejected = s.rejected;
   stats.forces_sent = s.forces_sent;
-  if (s.mesh_publisher) {
-    stats.mesh_frames = s.mesh_publisher->frames_published();
-    stats.mesh_frames_skipped = s.mesh_publisher->frames_skipped();
-  }
+  s.mesh_counts(stats);
   return stats;
 }
 

@@ -20,7 +20,8 @@ struct ServerStats {
 
 class SimulationServer {
  public:
-  explicit SimulationServer(const SceneSpec& scene);
+  /// scene_dir: where load_scene requests find scenes (empty: the scene file's directory).
+  explicit SimulationServer(const SceneSpec& scene, const std::string& scene_dir = {});
   ~SimulationServer();
   /// Runs until `stop` becomes true (or for duration_s > 0). `status` gets a line each second.
   ServerStats run(const std::atomic<bool>& stop, double duration_s, const std::function<void(const std::string&)>& status);

@@ -3,6 +3,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "common/input_error.hpp"
@@ -13,16 +14,18 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 const char* kHelp =
-    "Usage: viscera-server --scene FILE.json [--duration S] [--quiet]\n\n"
+    "Usage: viscera-server --scene FILE.json [--scene-dir DIR] [--duration S] [--quiet]\n\n"
     "Runs the tissue simulation of a scene (organ mesh, material, instruments; docs/SCENE.md) at its physics rate\n"
     "and serves instruments over Cyclone DDS (domain from the scene; configuration from CYCLONEDDS_URI, see\n"
-    "deploy/cyclonedds.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n\n"
-    "Options:\n  --scene FILE    scene file (required)\n  --duration S    stop after S seconds (default: run until signalled)\n"
+    "deploy/cyclonedds.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n"
+    "Clients may load another scene of the scene directory, change the material or the physics rate while it runs\n"
+    "(viscera-control; docs/PROTOCOL.md).\n\n"
+    "Options:\n  --scene FILE    scene file (required)\n  --scene-dir DIR scenes that clients may load by name (default: the scene file's directory)\n  --duration S    stop after S seconds (default: run until signalled)\n"
     "  --quiet         no status lines\n  --help          this text\n";
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene;
+  std::string scene, scene_dir;
   double duration = 0;
   bool quiet = false;
   for (int i = 1; i < argc; ++i) {
@@ -32,6 +35,12 @@ int main(int argc, char** argv) {
       return 0;
     } else if (a == "--scene" && i + 1 < argc) {
       scene = argv[++i];
+    } else if (a == "--scene-dir" && i + 1 < argc) {
+      scene_dir = argv[++i];
+      if (!std::filesystem::is_directory(scene_dir)) {
+        std::fprintf(stderr, "viscera-server: --scene-dir: '%s' is not a directory\n", scene_dir.c_str());
+        return 2;
+      }
     } else if (a == "--duration" && i + 1 < argc) {
       char* end = nullptr;
       duration = std::strtod(argv[++i], &end);
@@ -53,7 +62,7 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
-    viscera::runtime::SimulationServer server(viscera::runtime::read_scene_file(scene));
+    viscera::runtime::SimulationServer server(viscera::runtime::read_scene_file(scene), scene_dir);
     std::printf("viscera-server: %s\n", server.describe().c_str());
     std::fflush(stdout);
     const auto stats = server.run(g_stop, duration, [&](const std::string& line) {

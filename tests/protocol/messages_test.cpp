@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "viscera/protocol/messages.hpp"
@@ -156,4 +157,94 @@ TEST(Messages, EventsRoundTripAndBadOnesAreRejected) {
   auto bytes = encode(Event{});
   EXPECT_FALSE(decode_event(std::span(bytes).first(bytes.size() - 6), &why));  // truncated
   EXPECT_FALSE(decode_event(encode(good_command()), &why));                   // another schema
+}
+
+TEST(Messages, RunTimeControlRequestsRoundTripAndBadOnesAreRejected) {
+  std::string why;
+  SessionRequest load;
+  load.client_id = 900;
+  load.action = Action::load_scene;
+  load.request_seq = 1'000'000'000'001;
+  load.scene_name = "liver-12k";
+  const auto l = decode_session_request(encode(load), &why);
+  ASSERT_TRUE(l) << why;
+  EXPECT_EQ(l->scene_name, "liver-12k");
+  EXPECT_EQ(l->request_seq, 1'000'000'000'001u);
+  // A scene name is a name in the server's scene directory, never a path.
+  for (const std::string& bad : std::vector<std::string>{"", "../etc/passwd", "/etc/passwd", ".hidden", "a b", std::string(65, 'a')}) {
+    load.scene_name = bad;
+    EXPECT_FALSE(decode_session_request(encode(load), &why)) << "scene_name '" << bad << "'";
+  }
+  SessionRequest mat;
+  mat.client_id = 900;
+  mat.action = Action::set_material;
+  mat.material.youngs_modulus_pa = 8000;
+  mat.material.shear_q = 3;
+  const auto m = decode_session_request(encode(mat), &why);
+  ASSERT_TRUE(m) << why;
+  EXPECT_EQ(m->material.youngs_modulus_pa, 8000);
+  EXPECT_EQ(m->material.shear_q, 3);
+  EXPECT_FALSE(m->material.poisson_ratio);  // absent stays absent (FlatBuffers optional scalar)
+  EXPECT_FALSE(m->material.density_kg_m3);
+  const auto rejects = [&](MaterialChange c, const std::string& field) {
+    SessionRequest r = mat;
+    r.material = c;
+    EXPECT_FALSE(decode_session_request(encode(r), &why)) << field;
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+  };
+  rejects({std::nan(""), {}, {}, {}, {}}, "youngs_modulus_pa");
+  rejects({-5.0, {}, {}, {}, {}}, "youngs_modulus_pa");
+  rejects({{}, 0.5, {}, {}, {}}, "poisson_ratio");
+  rejects({{}, {}, 0.0, {}, {}}, "density_kg_m3");
+  rejects({{}, {}, {}, std::numeric_limits<double>::infinity(), {}}, "shear_q");
+  rejects({{}, {}, {}, {}, -1.0}, "damping_per_s");
+  rejects({}, "material");  // nothing to change
+  SessionRequest rate;
+  rate.client_id = 900;
+  rate.action = Action::set_physics_rate;
+  rate.physics_rate_hz = 500;
+  ASSERT_TRUE(decode_session_request(encode(rate), &why)) << why;
+  for (double bad : {5.0, 20000.0, std::nan("")}) {
+    rate.physics_rate_hz = bad;
+    EXPECT_FALSE(decode_session_request(encode(rate), &why)) << bad;
+  }
+}
+
+TEST(Messages, SceneStateCarriesMaterialScenesAndOutcomes) {
+  Scene sc;
+  sc.name = "liver";
+  sc.physics_rate_hz = 500;
+  sc.generation = 3;
+  sc.material = {"liver", 5000, 0.45, 1060, 4.8, 2};
+  sc.available_scenes = {"liver", "liver-12k"};
+  sc.preparing = "scene liver-12k";
+  sc.recent_requests.push_back({900, 17, Action::load_scene, false, "no scene 'x'"});
+  sc.recent_requests.push_back({901, 18, Action::set_physics_rate, true, "physics rate 500 Hz"});
+  std::string why;
+  const auto d = decode_scene(encode(sc), &why);
+  ASSERT_TRUE(d) << why;
+  EXPECT_EQ(d->generation, 3u);
+  EXPECT_EQ(d->material.poisson_ratio, 0.45);
+  EXPECT_EQ(d->material.shear_q, 4.8);
+  EXPECT_EQ(d->available_scenes, sc.available_scenes);
+  EXPECT_EQ(d->preparing, "scene liver-12k");
+  ASSERT_EQ(d->recent_requests.size(), 2u);
+  EXPECT_EQ(d->recent_requests[0].request_seq, 17u);
+  EXPECT_FALSE(d->recent_requests[0].accepted);
+  EXPECT_EQ(d->recent_requests[1].action, Action::set_physics_rate);
+  EXPECT_EQ(d->recent_requests[1].message, "physics rate 500 Hz");
+  sc.material.youngs_modulus_pa = std::nan("");
+  EXPECT_FALSE(decode_scene(encode(sc), &why));
+}
+
+TEST(Messages, EventKindsOfANewerServerPassThroughAsUnknown) {
+  std::string why;
+  Event e{0, static_cast<EventKind>(100), 0, 0, 1.0, 5, "from the future"};
+  const auto d = decode_event(encode(e), &why);
+  ASSERT_TRUE(d) << why;
+  EXPECT_STREQ(event_name(d->kind), "unknown");
+  EXPECT_EQ(d->text, "from the future");
+  EXPECT_STREQ(event_name(EventKind::request_refused), "request_refused");
+  e.kind = static_cast<EventKind>(-3);
+  EXPECT_FALSE(decode_event(encode(e), &why));
 }

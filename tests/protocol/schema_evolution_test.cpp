@@ -5,6 +5,7 @@
 
 #include "force_feedback_generated.h"  // schema 1, from tests/protocol/schema_v1
 #include "instrument_command_generated.h"
+#include "session_generated.h"
 #include "viscera/protocol/messages.hpp"  // schema 2 (current)
 
 namespace v1 = viscera::wire_v1;
@@ -59,4 +60,38 @@ TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
   ASSERT_TRUE(cmd) << why;
   EXPECT_EQ(cmd->seq, 5u);
   EXPECT_EQ(cmd->tip_position[2], 0.05);
+}
+
+TEST(SchemaEvolution, OldClientReadsTheSceneStateOfSchema3) {
+  Scene sc;
+  sc.name = "liver";
+  sc.physics_rate_hz = 1000;
+  sc.paused = true;
+  sc.instruments.push_back({2, true, 0.004, 31});
+  sc.generation = 2;  // the fields schema 1 does not know:
+  sc.material = {"liver", 5000, 0.45, 1060, 4.8, 2};
+  sc.available_scenes = {"liver", "liver-12k"};
+  sc.recent_requests.push_back({900, 17, Action::load_scene, true, "loaded scene liver"});
+  const auto bytes = encode(sc);
+  flatbuffers::Verifier verifier(bytes.data(), bytes.size());
+  ASSERT_TRUE(v1::VerifySceneStateBuffer(verifier));
+  const auto* old = v1::GetSceneState(bytes.data());
+  EXPECT_EQ(old->scene_name()->str(), "liver");
+  EXPECT_EQ(old->physics_rate_hz(), 1000);
+  EXPECT_TRUE(old->paused());
+  ASSERT_EQ(old->instruments()->size(), 1u);
+  EXPECT_EQ(old->instruments()->Get(0)->owner_client_id(), 31u);
+  EXPECT_EQ(old->instruments()->Get(0)->kind(), v1::InstrumentKind::grasper);
+}
+
+TEST(SchemaEvolution, SchemaOneSessionRequestsStillDecode) {
+  flatbuffers::FlatBufferBuilder b;
+  b.Finish(v1::CreateSessionRequest(b, 9, v1::SessionAction::claim_instrument, 2));
+  std::string why;
+  const auto r = decode_session_request({b.GetBufferPointer(), b.GetSize()}, &why);
+  ASSERT_TRUE(r) << why;
+  EXPECT_EQ(r->action, Action::claim_instrument);
+  EXPECT_EQ(r->instrument_id, 2u);
+  EXPECT_EQ(r->request_seq, 0u);  // absent: defaults
+  EXPECT_TRUE(r->material.empty());
 }

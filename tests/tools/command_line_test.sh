@@ -36,6 +36,7 @@ expect server-help 0 "Usage: viscera-server" -- "$server" --help
 expect server-no-scene 2 "--scene FILE is required" -- "$server"
 expect server-bad-scene 2 "bad_scene.json: organ.material: missing" -- "$server" --scene "$tmp/bad_scene.json"
 expect server-bad-duration 2 "'soon' is not a non-negative number" -- "$server" --scene x --duration soon
+expect server-bad-scene-dir 2 "--scene-dir: '/nonexistent' is not a directory" -- "$server" --scene x --scene-dir /nonexistent
 expect hc-help 0 "Usage: haptic-client" -- "$hc" --help
 expect hc-bad-rate 2 "--rate: 0 is outside" -- "$hc" --rate 0
 printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n0.5,0,0,abc\n' >"$tmp/t1.csv"
@@ -52,7 +53,13 @@ expect hc-traj-jaw 2 "t5.csv:3: column jaw_rad" -- "$hc" --trajectory "$tmp/t5.c
 expect control-help 0 "Usage: viscera-control" -- "$build/tools/viscera-control/viscera-control" --help
 expect control-bad-action 2 "ACTION 'explode' is not pause" -- "$build/tools/viscera-control/viscera-control" explode
 expect control-two-actions 2 "unexpected argument 'resume'" -- "$build/tools/viscera-control/viscera-control" pause resume
-expect control-annotate-no-text 2 "annotate needs the TEXT" -- "$build/tools/viscera-control/viscera-control" annotate
+expect control-annotate-no-text 2 "annotate needs its argument" -- "$build/tools/viscera-control/viscera-control" annotate
+expect control-load-path 2 "SCENE '../x' is not a scene name" -- "$build/tools/viscera-control/viscera-control" load ../x
+expect control-load-no-name 2 "load needs its argument" -- "$build/tools/viscera-control/viscera-control" load
+expect control-rate-range 2 "rate '5' is not a number of hertz in \[10, 10000\]" -- "$build/tools/viscera-control/viscera-control" rate 5
+expect control-material-empty 2 "material needs at least one of" -- "$build/tools/viscera-control/viscera-control" material
+expect control-material-flag-elsewhere 2 "material flags are for the material action" -- "$build/tools/viscera-control/viscera-control" pause --shear-q 3
+expect control-material-range 2 "poisson-ratio" -- "$build/tools/viscera-control/viscera-control" material --poisson-ratio 0.7
 expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"

@@ -27,16 +27,19 @@ using viscera::protocol::Vector3;
 /// Surface frames as a viewer sees them: how many, how often, how far the surface moved.
 struct MeshWatch {
   std::vector<float> rest;
+  std::uint32_t mesh_id = 0;  // the surface in use (a scene loaded at run time brings a new one)
   std::size_t frames = 0;
   double first_t = -1, last_t = -1;
   nlohmann::json samples = nlohmann::json::array();
   void take(viscera::client::Client& client, double t, const Vector3& tip) {
-    if (rest.empty()) {
-      if (const auto s = client.surface()) rest = s->rest_positions;
-      else return;
+    const auto s = client.surface();
+    if (!s) return;
+    if (s->mesh_id != mesh_id) {
+      rest = s->rest_positions;
+      mesh_id = s->mesh_id;
     }
     const auto frame = client.poll_mesh_frame();
-    if (!frame) return;
+    if (!frame || frame->mesh_id != mesh_id || frame->positions.size() != rest.size()) return;
     ++frames;
     if (first_t < 0) first_t = t;
     last_t = t;
@@ -52,7 +55,7 @@ struct MeshWatch {
         under_tip_dz = frame->positions[3 * v + 2] - rest[3 * v + 2];
       }
     }
-    samples.push_back({{"t_s", t}, {"frame", frame->frame}, {"sim_time_s", frame->sim_time_s}, {"max_displacement_m", max_d},
+    samples.push_back({{"t_s", t}, {"mesh_id", frame->mesh_id}, {"frame", frame->frame}, {"sim_time_s", frame->sim_time_s}, {"max_displacement_m", max_d},
                        {"under_tip_dz_m", under_tip_dz}});
   }
   double rate_hz() const { return frames > 1 && last_t > first_t ? static_cast<double>(frames - 1) / (last_t - first_t) : 0.0; }
@@ -133,11 +136,25 @@ int main(int argc, char** argv) {
     nlohmann::json samples = nlohmann::json::array();
     const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / rate));
     const auto start = std::chrono::steady_clock::now();
+    const double start_epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
     auto next = start;
-    double last_print = -1;
+    double last_print = -1, last_scene_check = 0;
+    std::uint32_t generation = scene->generation;
     for (;;) {
       const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (t >= duration) break;
+      if (t - last_scene_check >= 0.1) {  // a scene loaded at run time releases every instrument: claim it again
+        last_scene_check = t;
+        if (const auto now = client.scene(); now && now->generation != generation) {
+          generation = now->generation;
+          const bool again = client.claim(instrument, std::chrono::seconds(2));
+          std::printf("t = %5.2f s  the server loaded scene %s: instrument %u %s\n", t, now->name.c_str(), instrument,
+                      again ? "claimed again" : "could not be claimed again");
+          std::fflush(stdout);
+          next = std::chrono::steady_clock::now();
+          continue;
+        }
+      }
       const auto in = device->read(t);
       if (in.finished) break;
       client.send_tip(instrument, in.tip_m, in.jaw_rad);
@@ -186,6 +203,7 @@ int main(int argc, char** argv) {
       std::printf("haptic-client: %zu surface frames at %.1f Hz\n", mesh.frames, mesh.rate_hz());
     if (cl.has("report")) {
       nlohmann::json r{{"scene", scene->name}, {"instrument", instrument}, {"client_id", client_id}, {"rate_hz", rate},
+                       {"start_epoch_s", start_epoch_s},
                        {"duration_s", duration}, {"device", device->name()},
                        {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
                        {"samples", samples}};

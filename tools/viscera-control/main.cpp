@@ -1,8 +1,13 @@
 // viscera-control: session control of a running viscera-server from the command line, as an
-// instructor's console does it: pause, resume, reset the organ, show the scene state, follow the
-// session's events, or annotate the session.
+// instructor's console does it: pause, resume, reset the organ, load another scene, change the
+// material or the physics rate, show the scene state, follow the session's events, or annotate
+// the session.
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <map>
 #include <thread>
 
 #include "common/command_line.hpp"
@@ -10,25 +15,65 @@
 
 int main(int argc, char** argv) {
   viscera::cli::CommandLine cl("viscera-control",
-      "Session control of a running viscera-server: ACTION is pause (the organ stops; forces are still answered from its\n"
-      "frozen state), resume, reset (the organ back at rest, graspers let go), show (print the scene state), events\n"
-      "(print the session's events and annotations for --duration seconds) or annotate TEXT (a note for recorders).\n"
-      "Usage: viscera-control ACTION [TEXT] [--domain ID] [--duration S]");
+      "Session control of a running viscera-server. ACTION is one of\n"
+      "  pause           the organ stops; forces are still answered from its frozen state\n"
+      "  resume, reset   reset: the organ back at rest, graspers let go\n"
+      "  load SCENE      load a scene of the server's scene directory (show lists them); instruments are released\n"
+      "  material        change material parameters (the flags below; the organ keeps its deformation)\n"
+      "  rate HZ         change the physics rate [Hz]\n"
+      "  show            print the scene state\n"
+      "  events          print the session's events and annotations for --duration seconds\n"
+      "  annotate TEXT   a note for recorders and consoles\n"
+      "Usage: viscera-control ACTION [ARGUMENT] [--domain ID] [--duration S] [material flags]");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
   cl.flag("duration", "S", "events: how long to follow them [s]", "10");
+  cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
+  cl.flag("youngs-modulus-pa", "E", "material: Young's modulus [Pa] (isotropic materials)");
+  cl.flag("poisson-ratio", "NU", "material: Poisson's ratio (isotropic materials)");
+  cl.flag("density-kg-m3", "RHO", "material: density [kg/m^3]");
+  cl.flag("shear-q", "Q", "material: quality factor in shear (constant-Q materials)");
+  cl.flag("damping-per-s", "A", "material: mass-proportional damping [1/s]");
   cl.allow_positional(2);
   try {
     if (!cl.parse(argc, argv)) return 0;
     const auto& rest = cl.positional();
-    if (rest.empty()) throw viscera::cli::UsageError("missing ACTION (pause, resume, reset, show, events or annotate TEXT)");
+    const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, events or annotate TEXT";
+    if (rest.empty()) throw viscera::cli::UsageError("missing ACTION (" + actions + ")");
     const std::string action = rest[0];
-    if (action != "pause" && action != "resume" && action != "reset" && action != "show" && action != "events" && action != "annotate")
-      throw viscera::cli::UsageError("ACTION '" + action + "' is not pause, resume, reset, show, events or annotate");
-    if ((action == "annotate") != (rest.size() == 2))
-      throw viscera::cli::UsageError(action == "annotate" ? "annotate needs the TEXT" : "unexpected argument '" + rest.back() + "'");
+    const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false}, {"load", true}, {"material", false},
+                                               {"rate", true},   {"show", false},   {"events", false}, {"annotate", true}};
+    const auto k = known.find(action);
+    if (k == known.end()) throw viscera::cli::UsageError("ACTION '" + action + "' is not " + actions);
+    if (k->second != (rest.size() == 2))
+      throw viscera::cli::UsageError(k->second ? action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
     if (action == "annotate" && rest[1].size() > 1024) throw viscera::cli::UsageError("TEXT is " + std::to_string(rest[1].size()) + " bytes (at most 1024)");
+    viscera::protocol::MaterialChange change;
+    const auto material_flag = [&](const char* name, double lo, double hi, std::optional<double>& out) {
+      if (cl.has(name)) out = cl.number_in(name, lo, hi);
+    };
+    material_flag("youngs-modulus-pa", 1.0, 1e9, change.youngs_modulus_pa);
+    material_flag("poisson-ratio", 0.0, 0.4999, change.poisson_ratio);
+    material_flag("density-kg-m3", 1.0, 1e5, change.density_kg_m3);
+    material_flag("shear-q", 0.5, 1e4, change.shear_q);
+    material_flag("damping-per-s", 0.0, 1e4, change.damping_per_s);
+    if ((action == "material") != !change.empty())
+      throw viscera::cli::UsageError(action == "material" ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
+                                                          : "material flags are for the material action");
+    if (action == "load") {
+      const std::string& n = rest[1];
+      const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' &&
+                         std::all_of(n.begin(), n.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
+      if (!plain) throw viscera::cli::UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
+    }
+    double rate_hz = 0;
+    if (action == "rate") {
+      char* end = nullptr;
+      rate_hz = std::strtod(rest[1].c_str(), &end);
+      if (*end || !(rate_hz >= 10 && rate_hz <= 10000)) throw viscera::cli::UsageError("rate '" + rest[1] + "' is not a number of hertz in [10, 10000]");
+    }
     const double duration = cl.number_in("duration", 0.1, 1e6);
+    const auto timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));
     viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)),
                                    static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9)));
     auto scene = client.wait_for_scene(std::chrono::seconds(10));
@@ -57,7 +102,21 @@ int main(int argc, char** argv) {
       std::printf("annotated scene %s\n", scene->name.c_str());
       return 0;
     }
-    if (action != "show") {
+    if (action == "load" || action == "material" || action == "rate") {
+      const auto outcome = action == "load"       ? client.load_scene(rest[1], timeout)
+                           : action == "material" ? client.set_material(change, timeout)
+                                                  : client.set_physics_rate(rate_hz, timeout);
+      if (!outcome) {
+        std::fprintf(stderr, "viscera-control: no outcome of '%s' from the server within %.1f s\n", action.c_str(), 1e-3 * static_cast<double>(timeout.count()));
+        return 1;
+      }
+      if (!outcome->accepted) {
+        std::fprintf(stderr, "viscera-control: refused: %s\n", outcome->message.c_str());
+        return 1;
+      }
+      std::printf("%s\n", outcome->message.c_str());
+      scene = client.wait_for_scene(std::chrono::seconds(1));
+    } else if (action != "show") {
       const Action a = action == "pause" ? Action::pause : action == "resume" ? Action::resume : Action::reset;
       if (!client.control(a, std::chrono::seconds(5))) {
         std::fprintf(stderr, "viscera-control: the server did not confirm '%s' within 5 s\n", action.c_str());
@@ -69,7 +128,13 @@ int main(int argc, char** argv) {
     for (const auto& i : scene->instruments)
       std::printf(" %u (%s, %s)", i.instrument_id, i.grasper ? "grasper" : "probe",
                   i.owner_client_id ? ("client " + std::to_string(i.owner_client_id)).c_str() : "free");
-    std::printf("\n");
+    const auto& m = scene->material;
+    std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s\n", scene->generation,
+                m.name.c_str(), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q, m.damping_per_s);
+    std::string list;
+    for (const auto& n : scene->available_scenes) list += " " + n;
+    std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene->preparing.empty() ? "" : "; preparing ",
+                scene->preparing.c_str());
     return 0;
   } catch (const viscera::cli::UsageError& e) {
     std::fprintf(stderr, "viscera-control: %s\n", e.what());

@@ -41,9 +41,8 @@ Material parse_material(const std::string& text, const std::string& source) {
   const std::string type = e.value("type", "");
   const std::string where = source;
   if (type == "isotropic") {
-    m.elasticity = elasticity_matrix(IsotropicElasticity{number(e, "youngs_modulus_pa", source, "elasticity."),
-                                                         number(e, "poisson_ratio", source, "elasticity.")},
-                                     where);
+    m.isotropic = IsotropicElasticity{number(e, "youngs_modulus_pa", source, "elasticity."), number(e, "poisson_ratio", source, "elasticity.")};
+    m.elasticity = elasticity_matrix(*m.isotropic, where);
   } else if (type == "transversely_isotropic") {
     TransverselyIsotropicElasticity t;
     t.plane_youngs_modulus_pa = number(e, "plane_youngs_modulus_pa", source, "elasticity.");

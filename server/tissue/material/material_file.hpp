@@ -12,6 +12,7 @@
 #include <string>
 
 #include "element/tet_geometry.hpp"
+#include "material/elasticity.hpp"
 #include "viscoelastic/viscoelastic_material.hpp"
 
 namespace viscera::tissue {
@@ -20,6 +21,7 @@ struct Material {
   std::string name;
   double density_kg_m3 = 0.0;
   Mat6 elasticity = Mat6::Zero();  ///< at the reference frequency when viscoelastic
+  std::optional<IsotropicElasticity> isotropic;  ///< its constants, when the material is isotropic
   std::optional<ViscoelasticSpec> viscoelasticity;
 };
 

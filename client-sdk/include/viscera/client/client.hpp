@@ -29,6 +29,8 @@ class Client {
 
   /// Waits for the server's scene state (published reliably, transient local).
   std::optional<protocol::Scene> wait_for_scene(std::chrono::milliseconds timeout);
+  /// The newest scene state received, without waiting.
+  std::optional<protocol::Scene> scene();
   /// Claims an instrument; true once the scene state shows this client as its owner.
   bool claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
   void release(std::uint32_t instrument_id);
@@ -36,6 +38,14 @@ class Client {
   /// resume or reset. True once the scene state shows the pause state asked for (for reset:
   /// once the server acknowledged the request).
   bool control(protocol::Action action, std::chrono::milliseconds timeout);
+  /// Run-time control (any client): load a scene of the server's scene directory by name, change
+  /// material parameters (the organ keeps its deformation), or change the physics rate [Hz].
+  /// Sends the request once (reliably) and waits up to `timeout` for the server's outcome, which
+  /// says what was done or why not; nothing if no outcome came in time. Loading a scene releases
+  /// every instrument: their owners claim again (Scene::generation tells them it happened).
+  std::optional<protocol::RequestOutcome> load_scene(const std::string& name, std::chrono::milliseconds timeout);
+  std::optional<protocol::RequestOutcome> set_material(const protocol::MaterialChange& change, std::chrono::milliseconds timeout);
+  std::optional<protocol::RequestOutcome> set_physics_rate(double rate_hz, std::chrono::milliseconds timeout);
   /// Sends the instrument's tip position [m] and jaw opening [rad] (next sequence number,
   /// current stamp).
   void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip, double jaw_opening_rad = 0.5);
@@ -70,7 +80,10 @@ class Client {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::uint32_t client_id_;
+  std::optional<protocol::RequestOutcome> request(protocol::SessionRequest r, std::chrono::milliseconds timeout);
+
   std::uint64_t seq_ = 0, rejected_ = 0, mesh_frames_ = 0;
+  std::uint64_t request_seq_ = 0;  // starts at the clock: a restarted client never matches its old outcomes
   std::vector<double> rtt_us_;
   std::map<std::uint32_t, protocol::Force> latest_;
 };

@@ -34,12 +34,27 @@ struct Force {
   double penetration_m = 0;           ///< [m] tip depth in the tissue (added in schema 2)
 };
 
-enum class Action : std::int8_t { claim_instrument = 0, release_instrument = 1, pause = 2, resume = 3, reset = 4 };
+enum class Action : std::int8_t {
+  claim_instrument = 0, release_instrument = 1, pause = 2, resume = 3, reset = 4,
+  load_scene = 5, set_material = 6, set_physics_rate = 7  // schema 3
+};
+const char* action_name(Action a);
+
+/// Material parameters to change at run time (SI); empty ones keep their values.
+struct MaterialChange {
+  std::optional<double> youngs_modulus_pa, poisson_ratio, density_kg_m3, shear_q, damping_per_s;
+  bool empty() const { return !youngs_modulus_pa && !poisson_ratio && !density_kg_m3 && !shear_q && !damping_per_s; }
+};
 
 struct SessionRequest {
   std::uint32_t client_id = 0;
   Action action = Action::claim_instrument;
   std::uint32_t instrument_id = 0;
+  // schema 3:
+  std::uint64_t request_seq = 0;
+  std::string scene_name;     ///< load_scene: [A-Za-z0-9._-], at most 64, not starting with '.'
+  MaterialChange material;    ///< set_material: at least one parameter
+  double physics_rate_hz = 0; ///< set_physics_rate: [10, 10000]
 };
 
 struct InstrumentInfo {
@@ -49,12 +64,36 @@ struct InstrumentInfo {
   std::uint32_t owner_client_id = 0;
 };
 
+struct MaterialInfo {
+  std::string name;
+  double youngs_modulus_pa = 0;  ///< 0: not isotropic
+  double poisson_ratio = 0;
+  double density_kg_m3 = 0;
+  double shear_q = 0;            ///< 0: elastic
+  double damping_per_s = 0;
+};
+
+/// What the server did with a load_scene, set_material or set_physics_rate request.
+struct RequestOutcome {
+  std::uint32_t client_id = 0;
+  std::uint64_t request_seq = 0;
+  Action action = Action::load_scene;
+  bool accepted = false;
+  std::string message;
+};
+
 struct Scene {
   std::string name;
   double physics_rate_hz = 0;
   bool paused = false;
   std::vector<InstrumentInfo> instruments;
   Vector3 bounds_min{}, bounds_max{};
+  // schema 3:
+  std::uint32_t generation = 0;  ///< +1 per scene loaded; SurfaceTopology.mesh_id
+  MaterialInfo material;
+  std::vector<std::string> available_scenes;
+  std::string preparing;  ///< scene or material being built in the background
+  std::vector<RequestOutcome> recent_requests;  ///< the last few, oldest first
 };
 
 struct TelemetryReport {
@@ -83,8 +122,10 @@ struct MeshFrame {
 
 enum class EventKind : std::int8_t {
   annotation = 0, instrument_claimed, instrument_released, paused, resumed, organ_reset, physics_reset,
-  contact_started, contact_ended, grasped, let_go
+  contact_started, contact_ended, grasped, let_go,
+  scene_loaded, material_changed, physics_rate_changed, request_refused  // schema 3
 };
+/// The kind's name; "unknown" for kinds added by a newer server (decoders pass them through).
 const char* event_name(EventKind k);
 
 /// Something that happened in a session (server events) or a client's annotation.

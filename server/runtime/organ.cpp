@@ -1,0 +1,98 @@
+#include "organ.hpp"
+
+#include "common/input_error.hpp"
+#include "mesh/mesh_reader.hpp"
+#include "mesh/refinement.hpp"
+#include "model/model_factory.hpp"
+#include "viscoelastic/viscoelastic_material.hpp"
+
+namespace viscera::runtime {
+
+using namespace viscera::tissue;
+
+namespace {
+
+/// Model, integrator and compliance of `organ` from its scene, material and mesh.
+void build_physics(Organ& organ) {
+  const SceneSpec& s = organ.scene;
+  const Material& material = organ.material;
+  Mat6 D = material.elasticity;
+  GpsViscoelasticity ve;
+  if (material.viscoelasticity) {
+    const ViscoelasticSetup setup = make_viscoelastic(material.elasticity, *material.viscoelasticity, s.material);
+    D = setup.unrelaxed_elasticity;
+    ve = setup.gps;
+  }
+  organ.model = make_force_model(s.model, organ.mesh, {D}, s.volume_term, ve);
+  BoundaryConditions bc;
+  bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
+  const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
+  Box slab = organ.bounds;
+  const double extent = organ.bounds.hi[a] - organ.bounds.lo[a];
+  if (s.fix_side == "min") slab.hi[a] = organ.bounds.lo[a] + s.fix_fraction * extent;
+  else slab.lo[a] = organ.bounds.hi[a] - s.fix_fraction * extent;
+  bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, slab);
+  const std::vector<double> density(organ.mesh->tet_count(), material.density_kg_m3);
+  // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
+  organ.integrator = std::make_unique<ExplicitIntegrator>(*organ.model, density, bc,
+                                                          ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step});
+  organ.compliance = std::make_unique<ContactCompliance>(*organ.model, density, bc);
+}
+
+}  // namespace
+
+protocol::MaterialInfo Organ::material_info() const {
+  protocol::MaterialInfo m;
+  m.name = material.name;
+  if (material.isotropic) {
+    m.youngs_modulus_pa = material.isotropic->youngs_modulus_pa;
+    m.poisson_ratio = material.isotropic->poisson_ratio;
+  }
+  m.density_kg_m3 = material.density_kg_m3;
+  if (material.viscoelasticity && material.viscoelasticity->model == ViscoelasticSpec::Model::constant_q) m.shear_q = material.viscoelasticity->shear_q;
+  m.damping_per_s = scene.damping_per_s;
+  return m;
+}
+
+std::unique_ptr<Organ> build_organ(const SceneSpec& scene) {
+  auto organ = std::make_unique<Organ>();
+  organ->scene = scene;
+  organ->mesh = std::make_shared<TetMesh>(read_tet_mesh(scene.mesh));
+  for (int k = 0; k < scene.refine; ++k) *organ->mesh = refine_uniform(*organ->mesh);
+  scale_mesh(*organ->mesh, scene.scale_m_per_unit);
+  organ->material = read_material_file(scene.material);
+  organ->bounds = bounding_box(*organ->mesh);
+  organ->boundary = extract_boundary(*organ->mesh);
+  build_physics(*organ);
+  return organ;
+}
+
+std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change) {
+  auto next = std::make_unique<Organ>();
+  next->scene = organ.scene;
+  next->material = organ.material;
+  next->mesh = organ.mesh;
+  next->bounds = organ.bounds;
+  next->boundary = organ.boundary;
+  Material& m = next->material;
+  const std::string source = "set_material (material " + m.name + ")";
+  if (change.youngs_modulus_pa || change.poisson_ratio) {
+    if (!m.isotropic) throw InputError(source, 0, change.youngs_modulus_pa ? "youngs_modulus_pa" : "poisson_ratio", "the material is not isotropic");
+    if (change.youngs_modulus_pa) m.isotropic->youngs_modulus_pa = *change.youngs_modulus_pa;
+    if (change.poisson_ratio) m.isotropic->poisson_ratio = *change.poisson_ratio;
+    m.elasticity = elasticity_matrix(*m.isotropic, source);
+  }
+  if (change.density_kg_m3) m.density_kg_m3 = *change.density_kg_m3;
+  if (change.shear_q) {
+    if (!m.viscoelasticity || m.viscoelasticity->model != ViscoelasticSpec::Model::constant_q)
+      throw InputError(source, 0, "shear_q", std::to_string(*change.shear_q) + ": the material has no constant-Q viscoelasticity");
+    m.viscoelasticity->shear_q = *change.shear_q;
+  }
+  if (change.damping_per_s) next->scene.damping_per_s = *change.damping_per_s;
+  const std::string mark = " (changed at run time)";
+  if ((change.youngs_modulus_pa || change.poisson_ratio || change.shear_q || change.density_kg_m3) && !m.name.ends_with(mark)) m.name += mark;
+  build_physics(*next);
+  return next;
+}
+
+}  // namespace viscera::runtime

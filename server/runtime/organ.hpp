@@ -1,0 +1,40 @@
+#pragma once
+// The organ of a scene: its mesh, boundary surface, material, force model, explicit integrator
+// and contact compliance, all built from a scene file, and rebuilt with another material while
+// the server runs (session control). Building reads files and factorises; the server does it
+// off the physics thread and swaps the result in between ticks.
+#include <memory>
+
+#include "contact_compliance.hpp"
+#include "integrator/explicit_integrator.hpp"
+#include "material/material_file.hpp"
+#include "mesh/boundary_surface.hpp"
+#include "scene_file.hpp"
+#include "viscera/protocol/messages.hpp"
+
+namespace viscera::runtime {
+
+struct Organ {
+  SceneSpec scene;
+  tissue::Material material;
+  std::shared_ptr<tissue::TetMesh> mesh;
+  tissue::Box bounds;
+  tissue::BoundarySurface boundary;
+  std::unique_ptr<tissue::ForceModel> model;
+  std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
+  std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
+
+  /// The material as the scene state shows it.
+  protocol::MaterialInfo material_info() const;
+};
+
+/// Reads the scene's mesh and material and builds the organ. Throws InputError naming the file
+/// and field.
+std::unique_ptr<Organ> build_organ(const SceneSpec& scene);
+
+/// The same organ (mesh shared) with some material parameters changed. Throws InputError naming
+/// the parameter when the change does not apply (Young's modulus of a material that is not
+/// isotropic, Q of an elastic one) or gives an invalid material.
+std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change);
+
+}  // namespace viscera::runtime
