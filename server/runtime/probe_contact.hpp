@@ -22,6 +22,9 @@ using tissue::Vec3;
 
 struct ContactResult {
   Vec3 force_on_tool = Vec3::Zero();  ///< [N]
+  /// About the tip centre [N m]: 0 from the sphere's contact (its force passes through the
+  /// centre); a grasper's held tissue adds its moment (GraspHold).
+  Vec3 torque_on_tool = Vec3::Zero();
   bool in_contact = false;
   Vec3 point = Vec3::Zero(), normal = Vec3::UnitZ();
   std::array<double, 9> stiffness{};  ///< penalty part of -dF/dx [N/m], row-major

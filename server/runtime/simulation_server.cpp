@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "common/input_error.hpp"
+#include "grasp_hold.hpp"
 #include "mesh_publisher.hpp"
 #include "organ.hpp"
 #include "probe_contact.hpp"
@@ -63,8 +64,7 @@ struct SimulationServer::Impl {
     // simulated time, so a server that runs slower than real time (or a jumping device) never
     // drives the tool through the tissue within one tick.
     Vec3 proxy = Vec3::Zero();
-    // Grasper: nodes held by the closed jaws, with their offsets from the tool when grasped.
-    std::vector<std::pair<std::int32_t, Vec3>> grasped;
+    GraspHold grasped;  // grasper: the tissue held by the closed jaws
     ContactResult result;
     bool touching = false;    // in contact (for contact events, with hysteresis)
     double last_touch_s = 0;  // simulated time it last touched
@@ -77,7 +77,7 @@ struct SimulationServer::Impl {
   /// What the command thread answers from: the organ after the last tick and the grasped nodes.
   struct Snapshot {
     std::vector<Vec3> x;
-    std::map<std::uint32_t, std::vector<std::pair<std::int32_t, Vec3>>> grasped;
+    std::map<std::uint32_t, GraspHold> grasped;
   };
   std::mutex snapshot_mutex;  // guards the pointer only; a Snapshot is never changed once shared
   std::shared_ptr<const Snapshot> snapshot;
@@ -182,6 +182,20 @@ struct SimulationServer::Impl {
     std::erase_if(retiring, [](const std::future<void>& f) { return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready; });
   }
 
+  static Eigen::Quaterniond orientation(const proto::Command& c) {
+    return Eigen::Quaterniond(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]).normalized();
+  }
+
+  /// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.
+  static void add_grasp(ContactResult& result, const GraspHold& hold, const Vec3& tip, const proto::Command& command, std::span<const Vec3> x,
+                        std::span<Vec3> f = {}, std::span<double> stiffness = {}) {
+    if (hold.empty()) return;
+    const auto r = hold.apply(tip, orientation(command), x, f, stiffness);
+    result.force_on_tool += r.force_on_tool;
+    result.torque_on_tool += r.torque_on_tool;
+    result.in_contact = true;
+  }
+
   /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
   /// contact of each active tool, and the springs holding grasped nodes to the jaws.
   void apply_instruments(std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
@@ -190,16 +204,8 @@ struct SimulationServer::Impl {
         inst.result = {};
         continue;
       }
-      const Vec3& tip = inst.proxy;
-      inst.result = inst.contact->apply(tip, x, f, stiffness);
-      // Grasped nodes follow the jaws through stiff springs; the tool feels their reaction.
-      for (const auto& [node, offset] : inst.grasped) {
-        const Vec3 pull = scene.grasp_stiffness_n_per_m * (tip + offset - x[node]);
-        f[node] += pull;
-        stiffness[node] += scene.grasp_stiffness_n_per_m;
-        inst.result.force_on_tool -= pull;
-      }
-      if (!inst.grasped.empty()) inst.result.in_contact = true;
+      inst.result = inst.contact->apply(inst.proxy, x, f, stiffness);
+      add_grasp(inst.result, inst.grasped, inst.proxy, inst.tick, x, f, stiffness);
     }
   }
 
@@ -395,7 +401,7 @@ struct SimulationServer::Impl {
   /// The organ back at rest (memory variables relaxed); graspers let go.
   void reset_organ() {
     state = State::at_rest(*organ->mesh);
-    for (auto& [id, inst] : instruments) inst.grasped.clear();
+    for (auto& [id, inst] : instruments) inst.grasped = {};
   }
 
   /// Tick start (physics thread): which instruments are owned and commanded, with which command.
@@ -406,7 +412,7 @@ struct SimulationServer::Impl {
       inst.active = inst.owner != 0 && inst.has_command;
       inst.tick_owner = inst.owner;
       if (!inst.active) {
-        inst.grasped.clear();  // released, or its client silent: a grasper lets go
+        inst.grasped = {};  // released, or its client silent: a grasper lets go
         continue;
       }
       inst.tick = inst.last;
@@ -420,12 +426,11 @@ struct SimulationServer::Impl {
     if (inst.spec.kind != "grasper") return;
     const Vec3& tip = inst.proxy;  // the grasped nodes follow the simulated tool
     if (inst.grasped.empty() && inst.tick.jaw_opening < 0.1) {
-      for (auto n : organ->boundary.nodes)
-        if ((state.x[n] - tip).norm() < inst.spec.grasp_radius_m) inst.grasped.emplace_back(n, state.x[n] - tip);
+      inst.grasped = GraspHold(tip, orientation(inst.tick), organ->boundary.nodes, state.x, inst.spec.grasp_radius_m, scene.grasp_stiffness_n_per_m);
       if (!inst.grasped.empty())
         event(proto::EventKind::grasped, inst.spec.id, inst.tick_owner, std::to_string(inst.grasped.size()) + " surface nodes");
     } else if (!inst.grasped.empty() && inst.tick.jaw_opening > 0.2) {
-      inst.grasped.clear();
+      inst.grasped = {};
       event(proto::EventKind::let_go, inst.spec.id, inst.tick_owner);
     }
   }
@@ -502,10 +507,7 @@ struct SimulationServer::Impl {
       const auto& p = u.command.tip_position;
       const Vec3 tip(p[0], p[1], p[2]);
       ContactResult result = instruments.at(u.id).query->apply(tip, snap->x, {});
-      if (const auto g = snap->grasped.find(u.id); g != snap->grasped.end()) {
-        for (const auto& [node, offset] : g->second) result.force_on_tool -= scene.grasp_stiffness_n_per_m * (tip + offset - snap->x[node]);
-        if (!g->second.empty()) result.in_contact = true;
-      }
+      if (const auto g = snap->grasped.find(u.id); g != snap->grasped.end()) add_grasp(result, g->second, tip, u.command, snap->x);
       publish_force(u.id, u.owner, u.command, result, 0);
     }
   }
@@ -519,6 +521,7 @@ struct SimulationServer::Impl {
     f.server_stamp_ns = proto::now_ns();
     f.step_time_ns = step_time_ns;
     f.force = {r.force_on_tool.x(), r.force_on_tool.y(), r.force_on_tool.z()};
+    f.torque = {r.torque_on_tool.x(), r.torque_on_tool.y(), r.torque_on_tool.z()};
     f.in_contact = r.in_contact;
     f.contact_point = {r.point.x(), r.point.y(), r.point.z()};
     f.contact_normal = {r.normal.x(), r.normal.y(), r.normal.z()};

@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
         for (std::size_t i = 0; i < 3; ++i)
           for (std::size_t j = 0; j < 3; ++j) normal_stiffness += f->contact_normal[i] * f->stiffness[3 * i + j] * f->contact_normal[j];
         samples.push_back({{"t_s", t}, {"tip_z_m", in.tip_m[2]}, {"jaw_rad", in.jaw_rad}, {"force_n", {f->force[0], f->force[1], f->force[2]}},
+                           {"torque_n_m", {f->torque[0], f->torque[1], f->torque[2]}},
                            {"in_contact", f->in_contact}, {"penetration_m", f->penetration_m},
                            {"normal_stiffness_n_per_m", normal_stiffness},
                            {"rendered_force_n", {rendered.force[0], rendered.force[1], rendered.force[2]}},
