@@ -118,14 +118,24 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
   SpecimenCheck c;
   c.model = m.describe();
   std::string why;
-  if (!specimen_supports(m, &why)) {
+  if (!specimen_supports(m, d.mode, &why)) {
     c.note = why;
     return c;
   }
   c.note = why;
   try {
+    const StiffeningCalibration calibration = calibrate_stiffening(m, d);
+    if (m.has(Mechanism::strain_stiffening)) {
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    ": B = %.3g on the specimen for the law's %.3g (the specimen's elastic curve over strains %.3g to %.3g "
+                    "against the law's: %.1f%% RMS at the law's B, %.1f%% calibrated)",
+                    calibration.gps_b, calibration.law_b, calibration.strain_lo, calibration.strain_hi,
+                    100 * calibration.uncalibrated_mismatch, 100 * calibration.mismatch);
+      c.note += text;
+    }
     for (const auto& t : d.tests) {
-      const SpecimenResult r = simulate_specimen(m, d, t);
+      const SpecimenResult r = simulate_specimen(m, d, t, &calibration);
       c.files.push_back(t.file);
       c.specimen_rms_pa.push_back(r.rms_pa);
       if (t.control == Control::strain) {
@@ -146,10 +156,7 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
     c.files.clear();
     c.specimen_rms_pa.clear();
     c.law_rms_pa.clear();
-    c.note = std::string("the specimen simulation failed: ") + e.what() +
-             (m.has(Mechanism::strain_stiffening) ? ". The GPS applies Fung's exponential to every edge; under uniaxial stretch "
-                                                    "it loses stability near B e = 1, so only the material-point law is reported"
-                                                  : "");
+    c.note = std::string("the specimen simulation failed: ") + e.what() + "; only the material-point law is reported";
   }
   return c;
 }

@@ -14,13 +14,18 @@ namespace viscera::lab {
 
 using namespace viscera::tissue;
 
-bool specimen_supports(const MaterialModel& m, std::string* why) {
+bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
   if (m.has(Mechanism::tension_compression_asymmetry) || m.has(Mechanism::first_load_softening)) {
     *why = "the GPS has no tension/compression asymmetry or first-load softening yet: not simulated on the specimen";
     return false;
   }
+  if (m.has(Mechanism::strain_stiffening) && mode == Mode::simple_shear) {
+    *why = "the law stiffens as exp(B gamma) in shear, stiffer for positive than for negative shear; an isotropic solid's "
+           "shear stress is odd in the shear strain (mirror symmetry), so the GPS cannot represent it: not simulated on the specimen";
+    return false;
+  }
   *why = m.has(Mechanism::strain_stiffening)
-             ? "Fung stiffening is edge-wise in the GPS, an approximation of the uniaxial law fitted here"
+             ? "Fung stiffening in the GPS's energy form, its B calibrated to the law's curve over the data's strain range"
              : "";
   return true;
 }
@@ -35,14 +40,141 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& v, d
 }
 }  // namespace
 
-SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t) {
-  SpecimenResult r;
-  r.supported = specimen_supports(m, &r.note);
-  if (!r.supported) return r;
-  const bool shear = d.mode == Mode::simple_shear;
+namespace {
+
+/// The specimen meshed with tetrahedra and the grips of its mode (x: pulling / shearing
+/// direction; z: thickness); `moving` are the nodes the loading acts on.
+struct Rig {
+  std::shared_ptr<TetMesh> mesh;
+  BoundaryConditions bc;
+  std::vector<std::int32_t> moving;
+  bool shear = false;
+  double gauge = 0, area = 0;
+};
+
+Rig make_rig(const Dataset& d) {
+  Rig rig;
+  rig.shear = d.mode == Mode::simple_shear;
   const Specimen& sp = d.specimen;
-  // x: pulling / shearing direction; z: thickness.
-  auto mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(sp.length_m, sp.width_m, sp.thickness_m), 2, 1, 1));
+  rig.mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(sp.length_m, sp.width_m, sp.thickness_m), 2, 1, 1));
+  const double eps = 1e-9 * sp.length_m;
+  for (std::size_t i = 0; i < rig.mesh->node_count(); ++i) {
+    const Vec3& X = rig.mesh->nodes[i];
+    const auto n = static_cast<std::int32_t>(i);
+    auto& bc = rig.bc;
+    if (!rig.shear) {
+      if (X.x() < eps) {
+        bc.fixed_axes.push_back({n, 0});
+        if (X.y() < eps && X.z() < eps) bc.fixed_axes.push_back({n, 1}), bc.fixed_axes.push_back({n, 2});
+        else if (X.z() < eps) bc.fixed_axes.push_back({n, 2});  // on the y axis: no rotation about x, z
+        else if (X.y() < eps) bc.fixed_axes.push_back({n, 1});  // on the z axis: no rotation about y
+      }
+      if (X.x() > sp.length_m - eps) rig.moving.push_back(n);
+    } else {
+      if (X.z() < eps) {
+        bc.fixed_nodes.push_back(n);
+        continue;
+      }
+      bc.fixed_axes.push_back({n, 1});
+      bc.fixed_axes.push_back({n, 2});
+      if (X.z() > sp.thickness_m - eps) rig.moving.push_back(n);
+    }
+  }
+  rig.gauge = rig.shear ? sp.thickness_m : sp.length_m;
+  rig.area = rig.shear ? sp.length_m * sp.width_m : sp.width_m * sp.thickness_m;
+  return rig;
+}
+
+/// The law's modulus in GPS terms: uniaxial, it is Young's; simple shear, the shear modulus.
+Mat6 specimen_elasticity(double modulus_pa, bool shear) {
+  const double nu = 0.3;
+  return elasticity_matrix(IsotropicElasticity{shear ? 2 * modulus_pa * (1 + nu) : modulus_pa, nu});
+}
+
+/// The specimen's instantaneous elastic stress at each strain (static solves in order, each from
+/// the last), with the GPS's Fung stiffening b in its energy form.
+std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, const std::vector<double>& strains) {
+  GpsOptions options;
+  options.variant = GpsVariant::energy_consistent;
+  options.viscoelasticity.qlv_stiffening = b;
+  options.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+  const GpsModel model(rig.mesh, {specimen_elasticity(modulus_pa, rig.shear)}, {}, options);
+  double strain = 0.0;
+  BoundaryConditions bc = rig.bc;
+  bc.prescribed_axes.push_back({rig.moving, 0, [&](const Vec3& X, double) { return X.x() + strain * (rig.shear ? X.z() : X.x()); }});
+  ImplicitIntegrator integrator(model, std::vector<double>(rig.mesh->tet_count(), 1000.0), bc, {1e-3, 0.0, 1e-8, 50});
+  State s = State::at_rest(*rig.mesh);
+  std::vector<double> stress;
+  for (const double e : strains) {
+    if (e * strain < 0) s = State::at_rest(*rig.mesh);  // the other side of rest: start again from it
+    strain = e;
+    integrator.solve_static(s);
+    double reaction = 0.0;
+    for (auto i : rig.moving) reaction -= integrator.last_internal_forces()[i].x();
+    stress.push_back(reaction / rig.area);
+  }
+  return stress;
+}
+
+}  // namespace
+
+StiffeningCalibration calibrate_stiffening(const MaterialModel& m, const Dataset& d) {
+  StiffeningCalibration c;
+  c.law_b = c.gps_b = m.stiffening_b;
+  if (!m.has(Mechanism::strain_stiffening) || !(m.stiffening_b > 0)) return c;
+  c.strain_lo = 0.0;
+  c.strain_hi = 0.0;
+  for (const auto& t : d.tests)
+    for (const double e : t.strain) {
+      c.strain_lo = std::min(c.strain_lo, e);
+      c.strain_hi = std::max(c.strain_hi, e);
+    }
+  if (c.strain_hi - c.strain_lo < 1e-6) return c;  // no strain range to calibrate on
+  // Twelve strains over the range, ordered from 0 outwards on each side (each static solve
+  // starts from the last).
+  std::vector<double> strains, target;
+  for (int k = 1; k <= 6; ++k) strains.push_back(c.strain_hi * k / 6.0);
+  for (int k = 1; k <= 6 && c.strain_lo < 0; ++k) strains.push_back(c.strain_lo * k / 6.0);
+  const Rig rig = make_rig(d);
+  const double E = 1e4;  // the shape is what is calibrated (the stress scales with the modulus)
+  for (const double e : strains) target.push_back(E * std::expm1(m.stiffening_b * e) / m.stiffening_b);
+  const auto mismatch = [&](double b) {
+    const auto curve = static_curve(rig, E, b, strains);
+    double sq = 0.0, norm = 0.0;
+    for (std::size_t k = 0; k < strains.size(); ++k) {
+      sq += (curve[k] - target[k]) * (curve[k] - target[k]);
+      norm += target[k] * target[k];
+    }
+    return std::sqrt(sq / norm);
+  };
+  c.uncalibrated_mismatch = mismatch(m.stiffening_b);
+  // Golden-section search on b in [0.2, 1.5] x B: the response stiffens monotonically with b.
+  double lo = 0.2 * m.stiffening_b, hi = 1.5 * m.stiffening_b;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double b1 = hi - g * (hi - lo), b2 = lo + g * (hi - lo);
+  double f1 = mismatch(b1), f2 = mismatch(b2);
+  for (int it = 0; it < 30 && hi - lo > 1e-4 * m.stiffening_b; ++it) {
+    if (f1 < f2) {
+      hi = b2, b2 = b1, f2 = f1;
+      b1 = hi - g * (hi - lo), f1 = mismatch(b1);
+    } else {
+      lo = b1, b1 = b2, f1 = f2;
+      b2 = lo + g * (hi - lo), f2 = mismatch(b2);
+    }
+  }
+  c.gps_b = f1 < f2 ? b1 : b2;
+  c.mismatch = std::min(f1, f2);
+  return c;
+}
+
+SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const StiffeningCalibration* calibration) {
+  SpecimenResult r;
+  r.supported = specimen_supports(m, d.mode, &r.note);
+  if (!r.supported) return r;
+  const Rig rig = make_rig(d);
+  const bool shear = rig.shear;
+  const Specimen& sp = d.specimen;
+  const auto& mesh = rig.mesh;
   // The fitted law in GPS terms: unrelaxed modulus E_U = E + sum E_l, weights E_l / E_U on both
   // shear and bulk parts (the whole D relaxes alike), Kelvin-Voigt time eta / E_U.
   double relaxing = 0.0;
@@ -59,41 +191,21 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
       }
   ve.bulk_weight = ve.shear_weight;
   ve.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
-  if (m.has(Mechanism::strain_stiffening)) ve.qlv_stiffening = m.stiffening_b;
-  const double nu = 0.3;
-  // Uniaxial: the fitted modulus is Young's; simple shear: it is the shear modulus.
-  const double youngs = shear ? 2 * E_u * (1 + nu) : E_u;
+  if (m.has(Mechanism::strain_stiffening)) {
+    // Conservative (energy) form, with its B calibrated to the law's uniaxial (or shear) curve.
+    r.stiffening = calibration ? *calibration : calibrate_stiffening(m, d);
+    ve.qlv_stiffening = r.stiffening.gps_b;
+    ve.qlv_form = GpsViscoelasticity::QlvForm::energy;
+  }
   GpsOptions options;
   options.variant = GpsVariant::energy_consistent;
   options.viscoelasticity = ve;
-  const GpsModel model(mesh, {elasticity_matrix(IsotropicElasticity{youngs, nu})}, {}, options);
+  const GpsModel model(mesh, {specimen_elasticity(E_u, shear)}, {}, options);
 
-  BoundaryConditions bc;
-  std::vector<std::int32_t> moving;
+  BoundaryConditions bc = rig.bc;
+  const auto& moving = rig.moving;
   const double eps = 1e-9 * sp.length_m;
-  for (std::size_t i = 0; i < mesh->node_count(); ++i) {
-    const Vec3& X = mesh->nodes[i];
-    const auto n = static_cast<std::int32_t>(i);
-    if (!shear) {
-      if (X.x() < eps) {
-        bc.fixed_axes.push_back({n, 0});
-        if (X.y() < eps && X.z() < eps) bc.fixed_axes.push_back({n, 1}), bc.fixed_axes.push_back({n, 2});
-        else if (X.z() < eps) bc.fixed_axes.push_back({n, 2});  // on the y axis: no rotation about x, z
-        else if (X.y() < eps) bc.fixed_axes.push_back({n, 1});  // on the z axis: no rotation about y
-      }
-      if (X.x() > sp.length_m - eps) moving.push_back(n);
-    } else {
-      if (X.z() < eps) {
-        bc.fixed_nodes.push_back(n);
-        continue;
-      }
-      bc.fixed_axes.push_back({n, 1});
-      bc.fixed_axes.push_back({n, 2});
-      if (X.z() > sp.thickness_m - eps) moving.push_back(n);
-    }
-  }
-  const double gauge = shear ? sp.thickness_m : sp.length_m;
-  const double area = shear ? sp.length_m * sp.width_m : sp.width_m * sp.thickness_m;
+  const double gauge = rig.gauge, area = rig.area;
   const double t0 = t.time_s.front();
   if (t.control == Control::strain) {
     bc.prescribed_axes.push_back({moving, 0, [&, t0](const Vec3& X, double time) {

@@ -40,16 +40,23 @@ TEST(Tangent, MatchesFiniteDifferencesAtLargeDeformation) {
     GpsOptions qlv_options;
     qlv_options.viscoelasticity.qlv_stiffening = 8.0;
     const GpsModel qlv(mesh, {test::soft_tissue()}, {}, qlv_options);
+    GpsOptions fung_energy{GpsVariant::energy_consistent, 0.4};
+    fung_energy.viscoelasticity.qlv_stiffening = 8.0;
+    fung_energy.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+    const GpsModel qlv_energy(mesh, {test::soft_tissue()}, {}, fung_energy);
     for (const ForceModel* m : {static_cast<const ForceModel*>(&paper), static_cast<const ForceModel*>(&energy),
                                 static_cast<const ForceModel*>(&volume), static_cast<const ForceModel*>(&linear),
-                                static_cast<const ForceModel*>(&qlv)}) {
+                                static_cast<const ForceModel*>(&qlv), static_cast<const ForceModel*>(&qlv_energy)}) {
       const Mat12 K = m->element_tangent(x, 0);
       const Mat12 Kfd = finite_difference_tangent(*m, x, 1e-7);
       EXPECT_LT((K - Kfd).norm(), 1e-6 * K.norm()) << m->name();
     }
-    // Energy-consistent tangents are symmetric (they are Hessians); the paper form's is not.
+    // Energy-consistent tangents are symmetric (they are Hessians), with Fung's stiffening in its
+    // energy form too; the paper form's is not, nor the edge map's.
     EXPECT_LT((energy.element_tangent(x, 0) - energy.element_tangent(x, 0).transpose()).norm(),
               1e-12 * energy.element_tangent(x, 0).norm());
+    const Mat12 Kq = qlv_energy.element_tangent(x, 0);
+    EXPECT_LT((Kq - Kq.transpose()).norm(), 1e-12 * Kq.norm());
     EXPECT_GT((paper.element_tangent(x, 0) - paper.element_tangent(x, 0).transpose()).norm(),
               1e-4 * paper.element_tangent(x, 0).norm());
   }
@@ -58,17 +65,23 @@ TEST(Tangent, MatchesFiniteDifferencesAtLargeDeformation) {
 TEST(Tangent, EnergyConsistentForcesAreTheEnergyGradient) {
   std::mt19937_64 rng(22);
   const auto rest = test::random_tet(rng);
-  const GpsModel energy(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.5});
+  GpsOptions fung{GpsVariant::energy_consistent, 0.5};
+  fung.viscoelasticity.qlv_stiffening = 10.0;
+  fung.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+  const GpsModel linear(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.5});
+  const GpsModel stiffening(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, fung);
   std::vector<Vec3> x(rest.begin(), rest.end());
   for (auto& p : x) p = 1.1 * p + 0.001 * Vec3::Random();
-  std::vector<Vec3> f(4, Vec3::Zero());
-  energy.add_forces(x, f);
-  const double h = 1e-8;
-  for (int c = 0; c < 12; ++c) {
-    auto xp = x, xm = x;
-    xp[c / 3][c % 3] += h;
-    xm[c / 3][c % 3] -= h;
-    const double grad = (energy.energy(xp) - energy.energy(xm)) / (2 * h);
-    EXPECT_NEAR(-grad, f[c / 3][c % 3], 1e-6 * f[c / 3].norm() + 1e-12);
+  for (const GpsModel* energy : {&linear, &stiffening}) {
+    std::vector<Vec3> f(4, Vec3::Zero());
+    energy->add_forces(x, f);
+    const double h = 1e-8;
+    for (int c = 0; c < 12; ++c) {
+      auto xp = x, xm = x;
+      xp[c / 3][c % 3] += h;
+      xm[c / 3][c % 3] -= h;
+      const double grad = (energy->energy(xp) - energy->energy(xm)) / (2 * h);
+      EXPECT_NEAR(-grad, f[c / 3][c % 3], 1e-6 * f[c / 3].norm() + 1e-12);
+    }
   }
 }

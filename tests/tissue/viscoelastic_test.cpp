@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/input_error.hpp"
+#include "gps/fung_map.hpp"
 #include "gps/gps_model.hpp"
 #include "integrator/implicit_integrator.hpp"
 #include "mesh/box_mesh.hpp"
@@ -305,20 +306,41 @@ TEST(GpsMemoryVariables, ImplicitIntegratorCarriesTheMemoryAsTheExplicitOneDoes)
 
 TEST(Qlv, UniformDilatationStiffensExactlyAsFungsExponential) {
   // Every edge of a tet under uniform dilatation has the same strain e; the QLV tension is the
-  // linear one scaled by (exp(B e) - 1) / (B e).
+  // linear one scaled by (exp(B e) - 1) / (B e), in both forms (the energy form's h h' is the
+  // edge map g by construction).
   const std::array<Vec3, 4> rest{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.004, 0.009, 0), Vec3(0.003, 0.002, 0.008)};
   const double B = 12.0;
-  GpsOptions q;
-  q.viscoelasticity.qlv_stiffening = B;
   const GpsModel linear(test::single_tet_mesh(rest), {test::soft_tissue()});
-  const GpsModel qlv(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, q);
-  for (double e : {-0.1, 0.05, 0.2}) {
-    std::vector<Vec3> x;
-    for (const auto& p : rest) x.push_back((1 + e) * p);
-    std::vector<Vec3> fl(4, Vec3::Zero()), fq(4, Vec3::Zero());
-    linear.add_forces(x, fl);
-    qlv.add_forces(x, fq);
-    const double factor = std::expm1(B * e) / (B * e);
-    for (int i = 0; i < 4; ++i) EXPECT_LT((fq[i] - factor * fl[i]).norm(), 1e-10 * fl[i].norm()) << e;
+  for (const auto form : {GpsViscoelasticity::QlvForm::edge_map, GpsViscoelasticity::QlvForm::energy}) {
+    GpsOptions q;
+    q.viscoelasticity.qlv_stiffening = B;
+    q.viscoelasticity.qlv_form = form;
+    const GpsModel qlv(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, q);
+    for (double e : {-0.1, -0.0004, 0.0007, 0.05, 0.2}) {  // both sides of the series/closed-form switch at |B e| = 0.01
+      std::vector<Vec3> x;
+      for (const auto& p : rest) x.push_back((1 + e) * p);
+      std::vector<Vec3> fl(4, Vec3::Zero()), fq(4, Vec3::Zero());
+      linear.add_forces(x, fl);
+      qlv.add_forces(x, fq);
+      const double factor = std::expm1(B * e) / (B * e);
+      for (int i = 0; i < 4; ++i) EXPECT_LT((fq[i] - factor * fl[i]).norm(), 1e-10 * fl[i].norm()) << e;
+    }
   }
+}
+
+TEST(Qlv, EnergyMapSatisfiesItsDefinition) {
+  // h h' = (exp(B e) - 1) / B and h'' = d h' / de, checked against the closed form and central
+  // differences on both sides of the series switch.
+  for (const double B : {0.5, 8.0, 40.0})
+    for (const double e : {-0.3, -0.01, -1e-4, 0.0, 2e-5, 1e-3, 0.05, 0.25}) {
+      const FungEnergyMap m = fung_energy_map(B, e);
+      EXPECT_NEAR(m.h * m.dh, std::expm1(B * e) / B, 1e-13 * (1 + std::abs(std::expm1(B * e) / B))) << B << " " << e;
+      EXPECT_GT(m.dh, 0.0);
+      const double d = 1e-6 / B;
+      const double fd1 = (fung_energy_map(B, e + d).h - fung_energy_map(B, e - d).h) / (2 * d);
+      const double fd2 = (fung_energy_map(B, e + d).dh - fung_energy_map(B, e - d).dh) / (2 * d);
+      EXPECT_NEAR(m.dh, fd1, 1e-7 * m.dh) << B << " " << e;
+      EXPECT_NEAR(m.d2h, fd2, 1e-5 * (B + std::abs(m.d2h))) << B << " " << e;
+    }
+  EXPECT_NEAR(fung_energy_map(9.0, 0.0).d2h, 3.0, 1e-12);  // h''(0) = B / 3
 }

@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "gps/fung_map.hpp"
 #include "gps/gps_calibration.hpp"
 #include "material/elasticity.hpp"
 #include "viscoelastic/standard_linear_solids.hpp"
@@ -32,6 +33,8 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   if (!(ve.kelvin_voigt_time_s >= 0) || !(ve.qlv_stiffening >= 0))
     throw std::invalid_argument("GpsModel: Kelvin-Voigt time and QLV stiffening must be >= 0");
   const bool bulk_differs = !ve.bulk_weight.empty() && ve.bulk_weight != ve.shear_weight;
+  if (bulk_differs && ve.qlv_stiffening > 0 && ve.qlv_form == GpsViscoelasticity::QlvForm::energy)
+    throw std::invalid_argument("GpsModel: Fung stiffening in energy form relaxes the whole tension: bulk and shear weights must agree");
   std::vector<double> kappa(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
@@ -127,6 +130,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     rate_scale = dt > 0 ? ve.kelvin_voigt_time_s / dt : 0.0;
   }
   const double qlv = ve.qlv_stiffening;
+  const bool qlv_energy = qlv > 0 && ve.qlv_form == GpsViscoelasticity::QlvForm::energy;
   for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
     const Block& b = blocks_[bi];
     // Gather: current positions, and displacements u = x - X (exact for x near X).
@@ -163,16 +167,54 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         nan_probe[j] += dL[k][j];  // a NaN anywhere survives in the sum; max() would drop it
       }
     }
-    if (qlv > 0) {  // Fung: elongation measure L0 (exp(B e) - 1) / B, e = dL / L0
-      for (int k = 0; k < 6; ++k)
-        for (int j = 0; j < L; ++j)
-          dL[k][j] = b.rest_length[k][j] * std::expm1(qlv * dL[k][j] * b.inv_rest_length[k][j]) / qlv;
+    double dh[6][L];  // energy form: h'(e), which multiplies the tensions
+    if (qlv > 0) {  // Fung: elongation measure L0 g(e) or L0 h(e), e = dL / L0
+      if (qlv_energy) {
+        for (int k = 0; k < 6; ++k)
+          for (int j = 0; j < L; ++j) {
+            const FungEnergyMap m = fung_energy_map(qlv, dL[k][j] * b.inv_rest_length[k][j]);
+            dL[k][j] = b.rest_length[k][j] * m.h;
+            dh[k][j] = m.dh;
+          }
+      } else {
+        for (int k = 0; k < 6; ++k)
+          for (int j = 0; j < L; ++j)
+            dL[k][j] = b.rest_length[k][j] * std::expm1(qlv * dL[k][j] * b.inv_rest_length[k][j]) / qlv;
+      }
     }
     double bulk_part[6][L];  // a_b - a_s, for bulk relaxation that differs from shear
+    // Tensions t = S H dL (H packed, symmetric). The energy form of Fung's stiffening relaxes the
+    // elastic tensions h' (H h) themselves (3D QLV: the hereditary integral over the elastic
+    // response, exact in 1D); otherwise the memory filters the elongations and H acts after it.
+    double t[6][L];
+    const auto apply_h = [&](double (&v)[6][L]) {
+      for (int k = 0; k < 6; ++k)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) t[k][j] = 0.0;
+      int h = 0;
+      for (int r = 0; r < 6; ++r) {
+#pragma omp simd
+        for (int j = 0; j < L; ++j) t[r][j] += b.H[h][j] * v[r][j];
+        ++h;
+        for (int c = r + 1; c < 6; ++c, ++h)
+#pragma omp simd
+          for (int j = 0; j < L; ++j) {
+            t[r][j] += b.H[h][j] * v[c][j];
+            t[c][j] += b.H[h][j] * v[r][j];
+          }
+      }
+    };
+    if (qlv_energy) {
+      apply_h(dL);
+      for (int k = 0; k < 6; ++k)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) t[k][j] *= dh[k][j];
+    }
+    double (&filtered)[6][L] = qlv_energy ? t : dL;
     double block_probe = 0.0;  // NaN if any elongation of the block is not finite
     if constexpr (kMemory)
       for (int k = 0; k < 6; ++k)
-        for (int j = 0; j < L; ++j) block_probe += 0.0 * dL[k][j];
+        for (int j = 0; j < L; ++j) block_probe += 0.0 * filtered[k][j];
     if constexpr (kMemory) {
       // zeta_l <- e zeta_l + a dL_prev + c (dL - dL_prev): exact for dL linear over the step
       // (dt = 0 gives e = 1, a = c = 0: the memory stays).
@@ -190,7 +232,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
           const double e = me[l], a = ma[l], c = mc[l], y_s = ys[l], y_b = yb[l];
 #pragma omp simd
           for (int j = 0; j < L; ++j) {
-            const double z = e * zin[j] + a * prev[j] + c * (dL[k][j] - prev[j]);
+            const double z = e * zin[j] + a * prev[j] + c * (filtered[k][j] - prev[j]);
             zout[j] = z;
             zs[j] += y_s * z;
             zb[j] += y_b * z;
@@ -199,31 +241,15 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         double* prev_out = out + k * L;
 #pragma omp simd
         for (int j = 0; j < L; ++j) {
-          const double dl = dL[k][j];
+          const double dl = filtered[k][j];
           const double rate = (dl - prev[j]) * rate_scale;  // Kelvin-Voigt: tau d(dL)/dt
           prev_out[j] = dl;
-          dL[k][j] = dl - zs[j] + rate;  // a_s: the relaxed (shear) elongation
+          filtered[k][j] = dl - zs[j] + rate;  // a_s: the relaxed (shear) elongation (or tension)
           bulk_part[k][j] = zs[j] - zb[j];  // a_b - a_s
         }
       }
     }
-    // Tensions t = S H dL (H packed, symmetric).
-    double t[6][L];
-    for (int k = 0; k < 6; ++k)
-#pragma omp simd
-      for (int j = 0; j < L; ++j) t[k][j] = 0.0;
-    int h = 0;
-    for (int r = 0; r < 6; ++r) {
-#pragma omp simd
-      for (int j = 0; j < L; ++j) t[r][j] += b.H[h][j] * dL[r][j];
-      ++h;
-      for (int c = r + 1; c < 6; ++c, ++h)
-#pragma omp simd
-        for (int j = 0; j < L; ++j) {
-          t[r][j] += b.H[h][j] * dL[c][j];
-          t[c][j] += b.H[h][j] * dL[r][j];
-        }
-    }
+    if (!qlv_energy) apply_h(dL);
     if constexpr (kMemory) {
       if (!bulk_.empty()) {  // + (K/V0) hv (hv . (a_b - a_s))
         const BulkBlock& bb = bulk_[bi];
@@ -308,6 +334,9 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, cons
 }
 
 double GpsModel::energy(std::span<const Vec3> x) const {
+  // The elastic energy; with the edge-map stiffening there is none (linear energy returned).
+  const double qlv = options_.viscoelasticity.qlv_stiffening;
+  const bool qlv_energy = qlv > 0 && options_.viscoelasticity.qlv_form == GpsViscoelasticity::QlvForm::energy;
   double sum = 0.0;
   for (std::size_t e = 0; e < element_count(); ++e) {
     const auto p = gather(x, e);
@@ -318,6 +347,7 @@ double GpsModel::energy(std::span<const Vec3> x) const {
       const Vec3 du = (p[b] - r[b]) - (p[a] - r[a]);
       const Vec3 y = p[b] - p[a];
       dL(k) = (2.0 * y - du).dot(du) / (y.norm() + edge_length(e, k));
+      if (qlv_energy) dL(k) = edge_length(e, k) * fung_energy_map(qlv, dL(k) / edge_length(e, k)).h;
     }
     sum += 0.5 * dL.dot(packed_hessian(e) * dL);
     if (with_volume_) {
@@ -370,13 +400,24 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     G.block<1, 3>(k, 3 * b) = Y.col(k).transpose() / len(k);
   }
   Mat6x12 Gm = G;  // derivative of the (possibly QLV-mapped) elongation measure
+  const bool qlv_energy = qlv > 0 && options_.viscoelasticity.qlv_form == GpsViscoelasticity::QlvForm::energy;
+  Vec6 dh = Vec6::Ones(), d2h = Vec6::Zero();  // energy form: t_k = h'_k (H h)_k
   if (qlv > 0)
     for (int k = 0; k < 6; ++k) {
       const double strain = dL(k) / edge_length(e, k);
-      Gm.row(k) *= std::exp(qlv * strain);
-      dL(k) = edge_length(e, k) * std::expm1(qlv * strain) / qlv;
+      if (qlv_energy) {
+        const FungEnergyMap m = fung_energy_map(qlv, strain);
+        dh(k) = m.dh;
+        d2h(k) = m.d2h / edge_length(e, k);  // d h'/d dL
+        Gm.row(k) *= m.dh;
+        dL(k) = edge_length(e, k) * m.h;
+      } else {
+        Gm.row(k) *= std::exp(qlv * strain);
+        dL(k) = edge_length(e, k) * std::expm1(qlv * strain) / qlv;
+      }
     }
-  const Vec6 h = H * dL;
+  const Vec6 Hh = H * dL;
+  const Vec6 h = dh.cwiseProduct(Hh);
   const bool ec = options_.variant == GpsVariant::energy_consistent;
   Mat12 K = Mat12::Zero();
   for (int k = 0; k < 6; ++k) {
@@ -384,7 +425,8 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     const double s = ec ? 1.0 / len(k) : 1.0 / edge_length(e, k);
     const double tk = s * h(k);
     // Material part: -P_k dt_k/dx with dt_k/dx = s (H G)_k [- h_k / L_k^2 G_k for EC].
-    Eigen::Matrix<double, 1, 12> dt = s * (H.row(k) * Gm);
+    Eigen::Matrix<double, 1, 12> dt = s * dh(k) * (H.row(k) * Gm);
+    if (qlv_energy) dt += s * d2h(k) * Hh(k) * G.row(k);
     if (ec) dt -= h(k) / (len(k) * len(k)) * G.row(k);
     K.block<3, 12>(3 * a, 0) -= Y.col(k) * dt;
     K.block<3, 12>(3 * b, 0) += Y.col(k) * dt;

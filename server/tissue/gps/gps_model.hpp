@@ -33,6 +33,11 @@ struct GpsViscoelasticity {
   /// Fung's quasi-linear viscoelasticity: each edge strain e = dL/L0 is replaced by
   /// (exp(B e) - 1) / B before the elastic and relaxation response (B = 0: linear).
   double qlv_stiffening = 0.0;
+  /// How the stiffening enters (gps/fung_map.hpp): edge_map, the published form above (exact in
+  /// 1D, not conservative in 3D: its tangent is not symmetric, and Newton stalls on a stretched
+  /// specimen near B e = 1); or energy, the elastic energy 0.5 h^T H h of the energy map h
+  /// (h h' = the edge map, so a bar responds alike), tensions t_k = h'(e_k) (H (h - memory))_k.
+  enum class QlvForm { edge_map, energy } qlv_form = QlvForm::edge_map;
 
   bool has_memory() const { return !omega_rad_s.empty() || kelvin_voigt_time_s > 0; }
 };

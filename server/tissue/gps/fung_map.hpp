@@ -1,0 +1,33 @@
+#pragma once
+// Fung's exponential stiffening of an edge strain e (MODEL.md section 4), in two forms:
+//  - the edge map g(e) = (exp(B e) - 1) / B (the published QLV elastic response, applied to each
+//    edge: exact in 1D, but in a tetrahedron t = H g is not the gradient of an energy);
+//  - the energy map h(e) = e sqrt(phi(B e)), phi(x) = 2 (e^x - 1 - x) / x^2, chosen so that
+//    h h' = g: a bar with energy E h(e)^2 / 2 has the same stress E g(e), and a tetrahedron with
+//    energy 0.5 h^T H h has tensions t_k = h'(e_k) (H h)_k, a gradient with a symmetric tangent.
+// h is smooth and increasing (h' > 0), h(0) = 0, h'(0) = 1, h''(0) = B / 3.
+#include <cmath>
+
+namespace viscera::tissue {
+
+struct FungEnergyMap {
+  double h, dh, d2h;  ///< h(e), dh/de, d2h/de2
+};
+
+inline FungEnergyMap fung_energy_map(double B, double e) {
+  const double x = B * e;
+  if (std::abs(x) < 1e-2) {  // series: the closed forms cancel here
+    const double phi = 1 + x * (1.0 / 3 + x * (1.0 / 12 + x * (1.0 / 60 + x / 360)));
+    const double dphi = 1.0 / 3 + x * (1.0 / 6 + x * (1.0 / 20 + x / 90));
+    const double d2phi = 1.0 / 6 + x * (1.0 / 10 + x / 30);
+    const double s = std::sqrt(phi), ds = dphi / (2 * s), d2s = d2phi / (2 * s) - dphi * dphi / (4 * s * s * s);
+    return {e * s, s + x * ds, B * (2 * ds + x * d2s)};
+  }
+  const double em1 = std::expm1(x);
+  const double s = std::sqrt(2 * (em1 - x) / (x * x));
+  const double h = e * s;
+  const double dh = em1 / (x * s);
+  return {h, dh, (em1 + 1 - dh * dh) * B / (x * s)};  // h'' = (e^x - h'^2) / h, h = x s / B
+}
+
+}  // namespace viscera::tissue
