@@ -80,6 +80,15 @@ std::vector<double> stress_under_strain(const Truth& tr, const Protocol& p, cons
         }
         sigma += tr.spectrum_pa[l] * acc;
       }
+    if (tr.power_pa > 0) {  // closed form of the integral of (1 + (t-u)/tau0)^-alpha over each linear piece
+      double acc = 0.0;
+      const double tau0 = tr.power_tau0_s, q = 1.0 - tr.power_alpha;
+      for (std::size_t k = 1; k < p.t.size() && p.t[k - 1] < t; ++k) {
+        const double a = p.t[k - 1], b = std::min(p.t[k], t), slope = (p.v[k] - p.v[k - 1]) / (p.t[k] - p.t[k - 1]);
+        acc += slope * tau0 / q * (std::pow(1 + (t - a) / tau0, q) - std::pow(1 + (t - b) / tau0, q));
+      }
+      sigma += tr.power_pa * acc;
+    }
     out.push_back(sigma);
   }
   return out;
@@ -145,18 +154,32 @@ Protocol cycles(double amplitude, double period_s, int n, bool both_signs) {
 
 }  // namespace
 
-Truth write_synthetic_dataset(unsigned seed, const std::string& folder) {
-  std::mt19937_64 rng(seed * 7919u + 17u);
+namespace {
+Truth write_dataset_of(unsigned seed, const std::string& folder, bool power_law);
+}  // namespace
+
+Truth write_synthetic_dataset(unsigned seed, const std::string& folder) { return write_dataset_of(seed, folder, false); }
+Truth write_power_law_dataset(unsigned seed, const std::string& folder) { return write_dataset_of(seed, folder, true); }
+
+namespace {
+Truth write_dataset_of(unsigned seed, const std::string& folder, bool power_law) {
+  std::mt19937_64 rng(seed * 7919u + 17u + (power_law ? 1000003u : 0u));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto between = [&](double a, double b) { return a + (b - a) * u(rng); };
   const auto log_between = [&](double a, double b) { return std::exp(between(std::log(a), std::log(b))); };
   Truth tr;
-  tr.effect = static_cast<Effect>(seed % 5);
+  tr.effect = power_law ? Effect::broadband_relaxation : static_cast<Effect>(seed % 5);
   tr.modulus_pa = log_between(2e3, 50e3);
   tr.tau_s = log_between(0.02, 0.5);
   const double strain = between(0.06, 0.15);
   switch (tr.effect) {
     case Effect::broadband_relaxation:
+      if (power_law) {
+        tr.power_pa = tr.modulus_pa * between(0.5, 1.5);
+        tr.power_alpha = between(0.1, 0.4);
+        tr.power_tau0_s = log_between(0.01, 0.1);
+        break;
+      }
       for (int l = 0; l < 2; ++l) {
         tr.spectrum_pa[l] = tr.modulus_pa * between(0.3, 1.0);
         tr.spectrum_tau_s[l] = l == 0 ? log_between(0.3, 3.0) : log_between(5.0, 40.0);
@@ -168,7 +191,7 @@ Truth write_synthetic_dataset(unsigned seed, const std::string& folder) {
     case Effect::none: break;
   }
   Dataset d;
-  d.name = std::string("synthetic seed ") + std::to_string(seed);
+  d.name = std::string(power_law ? "synthetic power-law seed " : "synthetic seed ") + std::to_string(seed);
   d.mode = seed % 2 ? Mode::uniaxial : Mode::simple_shear;
   d.specimen = {0.01, 0.01, 0.003, 1050};
   // Protocols: ramp-holds at two rates in tension and one in compression, cycles at two rates in
@@ -220,5 +243,6 @@ Truth write_synthetic_dataset(unsigned seed, const std::string& folder) {
   write_dataset(d, folder);
   return tr;
 }
+}  // namespace
 
 }  // namespace viscera::lab::test

@@ -17,10 +17,15 @@ struct Truth {
   double modulus_pa = 0, tau_s = 0;          // Kelvin-Voigt baseline: sigma = E (s + tau ds/dt)
   double spectrum_pa[2] = {0, 0}, spectrum_tau_s[2] = {1, 1};  // broadband: two off-grid relaxations
   double stiffening_b = 0, compression_ratio = 1, softening_d = 0;
+  // Broadband, outside the lab's family: a continuous power-law relaxation E_p (1 + t/tau0)^-alpha
+  // instead of the two exponentials (no finite set of memory variables is exact for it).
+  double power_pa = 0, power_alpha = 0, power_tau0_s = 1;
   double noise_pa = 0;
 };
 
 /// Writes the data set for `seed` into `folder` and returns its truth (for messages only).
 Truth write_synthetic_dataset(unsigned seed, const std::string& folder);
+/// The same protocols with broadband relaxation from a continuous power-law spectrum (every seed).
+Truth write_power_law_dataset(unsigned seed, const std::string& folder);
 
 }  // namespace viscera::lab::test
