@@ -580,7 +580,9 @@ struct SimulationServer::Impl {
 };
 
 SimulationServer::SimulationServer(const SceneSpec& scene, const std::string& scene_dir)
-    : impl_(std::make_unique<Impl>(scene, scene_dir.empty() ? std::filesystem::path(scene.source).parent_path().string() : scene_dir)) {}
+    : impl_(std::make_unique<Impl>(scene, !scene_dir.empty() ? scene_dir
+                                          : std::filesystem::path(scene.source).has_parent_path() ? std::filesystem::path(scene.source).parent_path().string()
+                                                                                                  : std::string("."))) {}
 SimulationServer::~SimulationServer() = default;
 
 std::string SimulationServer::describe() const {
