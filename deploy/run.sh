@@ -2,9 +2,11 @@
 # The main job: installs and builds what is missing, then runs viscera as it is used: the
 # simulation server on the bundled liver (liver2, 1,493 tetrahedra, constant-Q viscoelastic GPS
 # at 1 kHz) and, as a separate process over Cyclone DDS, a scripted haptic client that presses a
-# probe into the liver and then grasps and pulls it. Both print live: the server its physics rate,
-# step times, jitter, overruns and the force on the tools; the client the force it feels, the
-# command-to-force round trip and the surface frames it receives.
+# probe into the liver and then grasps and pulls it; then an instructor's console (another
+# process) makes the liver twice as stiff while the server runs, and the probe presses again. All
+# print live: the server its physics rate, step times, jitter, overruns and the force on the
+# tools; the client the force it feels, the command-to-force round trip and the surface frames it
+# receives; the console what the server did.
 #   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene
 #   DURATION=20 ./deploy/run.sh                           a longer press (seconds)
 set -euo pipefail
@@ -24,4 +26,9 @@ echo "[demo] probe 1 presses 3 cm into the liver and comes back (${duration} s)"
 echo "[demo] grasper 3 closes its jaws on the liver, pulls it up 2 cm, lets go (6 s)"
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 2 --instrument 3 --script grasp --depth 0 --pull 0.02 \
   --duration 6 2>&1 | sed -u 's/^/[haptic] /'
+echo "[demo] an instructor's console doubles the liver's Young's modulus while the server runs"
+"$bin/tools/viscera-control/viscera-control" material --youngs-modulus-pa 10000 --domain "$domain" 2>&1 | sed -u 's/^/[console] /'
+echo "[demo] probe 1 presses 3 cm again: the stiffer liver pushes back harder (${duration} s)"
+"$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
+  --duration "$duration" 2>&1 | sed -u 's/^/[haptic] /'
 echo "[demo] done; the server stops"
