@@ -124,13 +124,13 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
   }
   c.note = why;
   try {
-    const StiffeningCalibration calibration = calibrate_stiffening(m, d);
-    if (m.has(Mechanism::strain_stiffening)) {
-      char text[400];
+    const ShapeCalibration calibration = calibrate_elastic_shape(m, d);
+    if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
+      char text[500];
       std::snprintf(text, sizeof text,
-                    ": B = %.3g on the specimen for the law's %.3g (the specimen's elastic curve over strains %.3g to %.3g "
-                    "against the law's: %.1f%% RMS at the law's B, %.1f%% calibrated)",
-                    calibration.gps_b, calibration.law_b, calibration.strain_lo, calibration.strain_hi,
+                    ": on the specimen B = %.3g, r = %.3g for the law's B = %.3g, r = %.3g (the specimen's elastic curve over strains "
+                    "%.3g to %.3g against the law's: %.1f%% RMS with the law's constants, %.1f%% calibrated)",
+                    calibration.gps_b, calibration.gps_r, calibration.law_b, calibration.law_r, calibration.strain_lo, calibration.strain_hi,
                     100 * calibration.uncalibrated_mismatch, 100 * calibration.mismatch);
       c.note += text;
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "common/input_error.hpp"
 #include "gps/gps_model.hpp"
@@ -15,18 +16,20 @@ namespace viscera::lab {
 using namespace viscera::tissue;
 
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
-  if (m.has(Mechanism::tension_compression_asymmetry) || m.has(Mechanism::first_load_softening)) {
-    *why = "the GPS has no tension/compression asymmetry or first-load softening yet: not simulated on the specimen";
+  if (m.has(Mechanism::first_load_softening)) {
+    *why = "the GPS has no first-load softening yet (it needs the strain history per edge): not simulated on the specimen";
     return false;
   }
-  if (m.has(Mechanism::strain_stiffening) && mode == Mode::simple_shear) {
-    *why = "the law stiffens as exp(B gamma) in shear, stiffer for positive than for negative shear; an isotropic solid's "
-           "shear stress is odd in the shear strain (mirror symmetry), so the GPS cannot represent it: not simulated on the specimen";
+  const bool shaped = m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry);
+  if (shaped && mode == Mode::simple_shear) {
+    *why = "the law's elastic shape differs between positive and negative shear (exp(B gamma), or a compression ratio); an "
+           "isotropic solid's shear stress is odd in the shear strain (mirror symmetry), so the GPS cannot represent it: "
+           "not simulated on the specimen";
     return false;
   }
-  *why = m.has(Mechanism::strain_stiffening)
-             ? "Fung stiffening in the GPS's energy form, its B calibrated to the law's curve over the data's strain range"
-             : "";
+  *why = shaped ? "the elastic shape (Fung stiffening, tension/compression asymmetry) in the GPS's energy form, its constants "
+                  "calibrated to the law's curve over the data's strain range"
+                : "";
   return true;
 }
 
@@ -92,11 +95,12 @@ Mat6 specimen_elasticity(double modulus_pa, bool shear) {
 }
 
 /// The specimen's instantaneous elastic stress at each strain (static solves in order, each from
-/// the last), with the GPS's Fung stiffening b in its energy form.
-std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, const std::vector<double>& strains) {
+/// the last), with the GPS's energy map of Fung's b and the compression ratio r.
+std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, double r, const std::vector<double>& strains) {
   GpsOptions options;
   options.variant = GpsVariant::energy_consistent;
   options.viscoelasticity.qlv_stiffening = b;
+  options.viscoelasticity.compression_ratio = r;
   options.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
   const GpsModel model(rig.mesh, {specimen_elasticity(modulus_pa, rig.shear)}, {}, options);
   double strain = 0.0;
@@ -116,58 +120,79 @@ std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, co
   return stress;
 }
 
+/// Golden-section search of a unimodal f on [lo, hi]; returns the argument of the minimum.
+double golden_section(const std::function<double(double)>& f, double lo, double hi, double tolerance) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  for (int it = 0; it < 40 && hi - lo > tolerance; ++it) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1;
+      x1 = hi - g * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2;
+      x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+  }
+  return f1 < f2 ? x1 : x2;
+}
+
 }  // namespace
 
-StiffeningCalibration calibrate_stiffening(const MaterialModel& m, const Dataset& d) {
-  StiffeningCalibration c;
-  c.law_b = c.gps_b = m.stiffening_b;
-  if (!m.has(Mechanism::strain_stiffening) || !(m.stiffening_b > 0)) return c;
-  c.strain_lo = 0.0;
-  c.strain_hi = 0.0;
+ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& d) {
+  ShapeCalibration c;
+  const bool stiffens = m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0;
+  const bool asymmetric = m.has(Mechanism::tension_compression_asymmetry) && m.compression_ratio != 1.0;
+  c.law_b = c.gps_b = stiffens ? m.stiffening_b : 0.0;
+  c.law_r = c.gps_r = asymmetric ? m.compression_ratio : 1.0;
+  if (!stiffens && !asymmetric) return c;
   for (const auto& t : d.tests)
     for (const double e : t.strain) {
       c.strain_lo = std::min(c.strain_lo, e);
       c.strain_hi = std::max(c.strain_hi, e);
     }
-  if (c.strain_hi - c.strain_lo < 1e-6) return c;  // no strain range to calibrate on
-  // Twelve strains over the range, ordered from 0 outwards on each side (each static solve
+  // Six strains on each side of rest that the data reach, from 0 outwards (each static solve
   // starts from the last).
-  std::vector<double> strains, target;
-  for (int k = 1; k <= 6; ++k) strains.push_back(c.strain_hi * k / 6.0);
-  for (int k = 1; k <= 6 && c.strain_lo < 0; ++k) strains.push_back(c.strain_lo * k / 6.0);
+  std::vector<double> tension, compression;
+  for (int k = 1; k <= 6; ++k) {
+    if (c.strain_hi > 1e-6) tension.push_back(c.strain_hi * k / 6.0);
+    if (c.strain_lo < -1e-6) compression.push_back(c.strain_lo * k / 6.0);
+  }
   const Rig rig = make_rig(d);
   const double E = 1e4;  // the shape is what is calibrated (the stress scales with the modulus)
-  for (const double e : strains) target.push_back(E * std::expm1(m.stiffening_b * e) / m.stiffening_b);
-  const auto mismatch = [&](double b) {
-    const auto curve = static_curve(rig, E, b, strains);
+  const auto law = [&](double e) {
+    const double g = stiffens ? std::expm1(c.law_b * e) / c.law_b : e;
+    return E * (e < 0 ? c.law_r * g : g);
+  };
+  const auto mismatch = [&](double b, double r, const std::vector<double>& strains) {
+    if (strains.empty()) return 0.0;
+    const auto curve = static_curve(rig, E, b, r, strains);
     double sq = 0.0, norm = 0.0;
     for (std::size_t k = 0; k < strains.size(); ++k) {
-      sq += (curve[k] - target[k]) * (curve[k] - target[k]);
-      norm += target[k] * target[k];
+      sq += (curve[k] - law(strains[k])) * (curve[k] - law(strains[k]));
+      norm += law(strains[k]) * law(strains[k]);
     }
     return std::sqrt(sq / norm);
   };
-  c.uncalibrated_mismatch = mismatch(m.stiffening_b);
-  // Golden-section search on b in [0.2, 1.5] x B: the response stiffens monotonically with b.
-  double lo = 0.2 * m.stiffening_b, hi = 1.5 * m.stiffening_b;
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double b1 = hi - g * (hi - lo), b2 = lo + g * (hi - lo);
-  double f1 = mismatch(b1), f2 = mismatch(b2);
-  for (int it = 0; it < 30 && hi - lo > 1e-4 * m.stiffening_b; ++it) {
-    if (f1 < f2) {
-      hi = b2, b2 = b1, f2 = f1;
-      b1 = hi - g * (hi - lo), f1 = mismatch(b1);
-    } else {
-      lo = b1, b1 = b2, f1 = f2;
-      b2 = lo + g * (hi - lo), f2 = mismatch(b2);
-    }
+  std::vector<double> all = tension;
+  all.insert(all.end(), compression.begin(), compression.end());
+  if (all.empty()) return c;
+  c.uncalibrated_mismatch = mismatch(c.law_b, c.law_r, all);
+  // B from the tension side, r from the compression side; twice, since the lateral edges of a
+  // stretched specimen are compressed (and those of a compressed one stretched).
+  for (int round = 0; round < 2; ++round) {
+    if (stiffens && !tension.empty())
+      c.gps_b = golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, 1.5 * c.law_b, 1e-4 * c.law_b);
+    if (asymmetric && !compression.empty())
+      c.gps_r = std::exp(golden_section([&](double lr) { return mismatch(c.gps_b, std::exp(lr), compression); }, std::log(c.law_r / 4),
+                                        std::log(c.law_r * 4), 1e-4));
+    if (!(stiffens && asymmetric)) break;
   }
-  c.gps_b = f1 < f2 ? b1 : b2;
-  c.mismatch = std::min(f1, f2);
+  c.mismatch = mismatch(c.gps_b, c.gps_r, all);
   return c;
 }
 
-SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const StiffeningCalibration* calibration) {
+SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration) {
   SpecimenResult r;
   r.supported = specimen_supports(m, d.mode, &r.note);
   if (!r.supported) return r;
@@ -191,10 +216,11 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
       }
   ve.bulk_weight = ve.shear_weight;
   ve.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
-  if (m.has(Mechanism::strain_stiffening)) {
-    // Conservative (energy) form, with its B calibrated to the law's uniaxial (or shear) curve.
-    r.stiffening = calibration ? *calibration : calibrate_stiffening(m, d);
-    ve.qlv_stiffening = r.stiffening.gps_b;
+  if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
+    // Conservative (energy) form, with its constants calibrated to the law's elastic curve.
+    r.shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
+    ve.qlv_stiffening = r.shape.gps_b;
+    ve.compression_ratio = r.shape.gps_r;
     ve.qlv_form = GpsViscoelasticity::QlvForm::energy;
   }
   GpsOptions options;

@@ -15,17 +15,20 @@
 
 namespace viscera::lab {
 
-/// Fung stiffening on the specimen: the GPS takes it in its energy form (conservative, symmetric
-/// tangent), whose B is calibrated so that the specimen's instantaneous elastic response to the
-/// mode's loading matches the law's (exp(B e) - 1) / B over the data's strain range (the 3D
-/// energy form stiffens faster than the 1D law at the same B).
-struct StiffeningCalibration {
-  double law_b = 0, gps_b = 0;
+/// The law's elastic shape on the specimen (Fung stiffening B, tension/compression asymmetry r):
+/// the GPS takes it in its energy form (conservative, symmetric tangent; gps/fung_map.hpp), whose
+/// constants are calibrated so that the specimen's instantaneous elastic response to the mode's
+/// loading matches the law's over the data's strain range (B on the tension side, r on the
+/// compression side): in 3D the edges across the load stiffen or soften too, so the same
+/// constants would not give the same curve.
+struct ShapeCalibration {
+  double law_b = 0, gps_b = 0;  ///< Fung's B (0: none)
+  double law_r = 1, gps_r = 1;  ///< compression ratio (1: symmetric)
   double strain_lo = 0, strain_hi = 0;
-  double uncalibrated_mismatch = 0;  ///< relative RMS of the specimen's curve against the law's at B_gps = B
-  double mismatch = 0;               ///< the same at the calibrated B_gps
+  double uncalibrated_mismatch = 0;  ///< relative RMS of the specimen's curve against the law's with the law's constants
+  double mismatch = 0;               ///< the same with the calibrated constants
 };
-StiffeningCalibration calibrate_stiffening(const MaterialModel& m, const Dataset& d);
+ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& d);
 
 struct SpecimenResult {
   bool supported = false;
@@ -34,16 +37,17 @@ struct SpecimenResult {
   std::vector<double> strain;       ///< at the data times (stress control: predicted)
   double rms_pa = 0.0;              ///< strain control: RMS stress error; stress control: RMS strain error x modulus
   long steps = 0, newton_iterations = 0, step_cuts = 0;
-  StiffeningCalibration stiffening;  ///< when the model stiffens
+  ShapeCalibration shape;  ///< when the model stiffens or is asymmetric
 };
 
 /// Which models the GPS can represent: Kelvin-Voigt, memory variables (broadband), Fung
-/// stiffening under uniaxial loading (the GPS's energy form, B calibrated: see
-/// StiffeningCalibration); not the law's stiffening in simple shear (no isotropic solid has it).
+/// stiffening and tension/compression asymmetry under uniaxial loading (the GPS's energy form,
+/// calibrated: see ShapeCalibration); not those in simple shear (no isotropic solid has them),
+/// not first-load softening.
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why);
 
-/// `calibration`: calibrate_stiffening(m, d), if already known (it is computed otherwise).
+/// `calibration`: calibrate_elastic_shape(m, d), if already known (it is computed otherwise).
 SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t,
-                                 const StiffeningCalibration* calibration = nullptr);
+                                 const ShapeCalibration* calibration = nullptr);
 
 }  // namespace viscera::lab

@@ -44,9 +44,13 @@ TEST(Tangent, MatchesFiniteDifferencesAtLargeDeformation) {
     fung_energy.viscoelasticity.qlv_stiffening = 8.0;
     fung_energy.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
     const GpsModel qlv_energy(mesh, {test::soft_tissue()}, {}, fung_energy);
+    GpsOptions asymmetric = fung_energy;
+    asymmetric.viscoelasticity.compression_ratio = 0.4;
+    const GpsModel qlv_asymmetric(mesh, {test::soft_tissue()}, {}, asymmetric);
     for (const ForceModel* m : {static_cast<const ForceModel*>(&paper), static_cast<const ForceModel*>(&energy),
                                 static_cast<const ForceModel*>(&volume), static_cast<const ForceModel*>(&linear),
-                                static_cast<const ForceModel*>(&qlv), static_cast<const ForceModel*>(&qlv_energy)}) {
+                                static_cast<const ForceModel*>(&qlv), static_cast<const ForceModel*>(&qlv_energy),
+                                static_cast<const ForceModel*>(&qlv_asymmetric)}) {
       const Mat12 K = m->element_tangent(x, 0);
       const Mat12 Kfd = finite_difference_tangent(*m, x, 1e-7);
       EXPECT_LT((K - Kfd).norm(), 1e-6 * K.norm()) << m->name();
@@ -70,9 +74,11 @@ TEST(Tangent, EnergyConsistentForcesAreTheEnergyGradient) {
   fung.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
   const GpsModel linear(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.5});
   const GpsModel stiffening(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, fung);
+  fung.viscoelasticity.compression_ratio = 2.5;
+  const GpsModel asymmetric(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, fung);
   std::vector<Vec3> x(rest.begin(), rest.end());
   for (auto& p : x) p = 1.1 * p + 0.001 * Vec3::Random();
-  for (const GpsModel* energy : {&linear, &stiffening}) {
+  for (const GpsModel* energy : {&linear, &stiffening, &asymmetric}) {
     std::vector<Vec3> f(4, Vec3::Zero());
     energy->add_forces(x, f);
     const double h = 1e-8;

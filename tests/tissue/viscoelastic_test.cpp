@@ -343,4 +343,20 @@ TEST(Qlv, EnergyMapSatisfiesItsDefinition) {
       EXPECT_NEAR(m.d2h, fd2, 1e-5 * (B + std::abs(m.d2h))) << B << " " << e;
     }
   EXPECT_NEAR(fung_energy_map(9.0, 0.0).d2h, 3.0, 1e-12);  // h''(0) = B / 3
+  // Asymmetry: compressed edges r times as stiff, tension unchanged, away from the smooth
+  // transition of width w around 0; h' and h'' equal central differences everywhere.
+  for (const double r : {0.3, 2.5})
+    for (const double e : {-0.2, -0.1, 0.1, 0.2}) {
+      const FungEnergyMap m = edge_energy_map(6.0, r, e);
+      const double g = std::expm1(6.0 * e) / 6.0;
+      EXPECT_NEAR(m.h * m.dh, e < 0 ? r * g : g, 1e-7 * std::abs(g)) << r << " " << e;
+      EXPECT_NEAR(edge_energy_map(0.0, r, e).h * edge_energy_map(0.0, r, e).dh, e < 0 ? r * e : e, 1e-7) << r << " " << e;
+    }
+  for (const double e : {-0.02, -0.004, 0.0, 0.003, 0.02}) {
+    const FungEnergyMap m = edge_energy_map(6.0, 0.3, e);
+    const double d = 1e-7;
+    EXPECT_NEAR(m.dh, (edge_energy_map(6.0, 0.3, e + d).h - edge_energy_map(6.0, 0.3, e - d).h) / (2 * d), 1e-6) << e;
+    EXPECT_NEAR(m.d2h, (edge_energy_map(6.0, 0.3, e + d).dh - edge_energy_map(6.0, 0.3, e - d).dh) / (2 * d), 1e-4 * (1 + std::abs(m.d2h))) << e;
+    EXPECT_GT(m.dh, 0.0);
+  }
 }

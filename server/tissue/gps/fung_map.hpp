@@ -5,7 +5,11 @@
 //  - the energy map h(e) = e sqrt(phi(B e)), phi(x) = 2 (e^x - 1 - x) / x^2, chosen so that
 //    h h' = g: a bar with energy E h(e)^2 / 2 has the same stress E g(e), and a tetrahedron with
 //    energy 0.5 h^T H h has tensions t_k = h'(e_k) (H h)_k, a gradient with a symmetric tangent.
-// h is smooth and increasing (h' > 0), h(0) = 0, h'(0) = 1, h''(0) = B / 3.
+// h is smooth and increasing (h' > 0), h(0) = 0, h'(0) = 1, h''(0) = B / 3; B = 0 gives h(e) = e.
+// Tension/compression asymmetry in the same form: h scaled by c(e), from sqrt(r) in compression
+// to 1 in tension, so that h h' = r g(e) for e << 0 (compressed edges r times as stiff) and g(e)
+// for e >> 0. c changes smoothly over a strain of about kAsymmetryWidth around 0 (a kink in h'
+// would make Newton cycle on edges at zero strain); the energy stays exact.
 #include <cmath>
 
 namespace viscera::tissue {
@@ -28,6 +32,19 @@ inline FungEnergyMap fung_energy_map(double B, double e) {
   const double h = e * s;
   const double dh = em1 / (x * s);
   return {h, dh, (em1 + 1 - dh * dh) * B / (x * s)};  // h'' = (e^x - h'^2) / h, h = x s / B
+}
+
+constexpr double kAsymmetryWidth = 0.005;
+
+/// The energy map with Fung's B and the compression ratio r (r = 1: symmetric).
+inline FungEnergyMap edge_energy_map(double B, double r, double e) {
+  const FungEnergyMap f = fung_energy_map(B, e);
+  if (r == 1.0) return f;
+  const double q = std::sqrt(r) - 1.0, w = kAsymmetryWidth;
+  const double S = 1.0 / (1.0 + std::exp(e / w));  // logistic of -e/w: 1 in compression, 0 in tension
+  const double dS = -S * (1 - S) / w, d2S = S * (1 - S) * (1 - 2 * S) / (w * w);
+  const double c = 1 + q * S, dc = q * dS, d2c = q * d2S;
+  return {c * f.h, dc * f.h + c * f.dh, d2c * f.h + 2 * dc * f.dh + c * f.d2h};
 }
 
 }  // namespace viscera::tissue

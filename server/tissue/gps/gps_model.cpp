@@ -33,7 +33,9 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   if (!(ve.kelvin_voigt_time_s >= 0) || !(ve.qlv_stiffening >= 0))
     throw std::invalid_argument("GpsModel: Kelvin-Voigt time and QLV stiffening must be >= 0");
   const bool bulk_differs = !ve.bulk_weight.empty() && ve.bulk_weight != ve.shear_weight;
-  if (bulk_differs && ve.qlv_stiffening > 0 && ve.qlv_form == GpsViscoelasticity::QlvForm::energy)
+  if (!(ve.compression_ratio > 0) || (ve.compression_ratio != 1.0 && ve.qlv_form != GpsViscoelasticity::QlvForm::energy))
+    throw std::invalid_argument("GpsModel: compression_ratio must be positive, and needs the energy form");
+  if (bulk_differs && ve.energy_map())
     throw std::invalid_argument("GpsModel: Fung stiffening in energy form relaxes the whole tension: bulk and shear weights must agree");
   std::vector<double> kappa(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
@@ -130,7 +132,8 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     rate_scale = dt > 0 ? ve.kelvin_voigt_time_s / dt : 0.0;
   }
   const double qlv = ve.qlv_stiffening;
-  const bool qlv_energy = qlv > 0 && ve.qlv_form == GpsViscoelasticity::QlvForm::energy;
+  const bool qlv_energy = ve.energy_map();
+  const double ratio = ve.compression_ratio;
   for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
     const Block& b = blocks_[bi];
     // Gather: current positions, and displacements u = x - X (exact for x near X).
@@ -168,11 +171,11 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
       }
     }
     double dh[6][L];  // energy form: h'(e), which multiplies the tensions
-    if (qlv > 0) {  // Fung: elongation measure L0 g(e) or L0 h(e), e = dL / L0
+    if (qlv > 0 || qlv_energy) {  // Fung: elongation measure L0 g(e) or L0 h(e), e = dL / L0
       if (qlv_energy) {
         for (int k = 0; k < 6; ++k)
           for (int j = 0; j < L; ++j) {
-            const FungEnergyMap m = fung_energy_map(qlv, dL[k][j] * b.inv_rest_length[k][j]);
+            const FungEnergyMap m = edge_energy_map(qlv, ratio, dL[k][j] * b.inv_rest_length[k][j]);
             dL[k][j] = b.rest_length[k][j] * m.h;
             dh[k][j] = m.dh;
           }
@@ -336,7 +339,8 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, cons
 double GpsModel::energy(std::span<const Vec3> x) const {
   // The elastic energy; with the edge-map stiffening there is none (linear energy returned).
   const double qlv = options_.viscoelasticity.qlv_stiffening;
-  const bool qlv_energy = qlv > 0 && options_.viscoelasticity.qlv_form == GpsViscoelasticity::QlvForm::energy;
+  const bool qlv_energy = options_.viscoelasticity.energy_map();
+  const double ratio = options_.viscoelasticity.compression_ratio;
   double sum = 0.0;
   for (std::size_t e = 0; e < element_count(); ++e) {
     const auto p = gather(x, e);
@@ -347,7 +351,7 @@ double GpsModel::energy(std::span<const Vec3> x) const {
       const Vec3 du = (p[b] - r[b]) - (p[a] - r[a]);
       const Vec3 y = p[b] - p[a];
       dL(k) = (2.0 * y - du).dot(du) / (y.norm() + edge_length(e, k));
-      if (qlv_energy) dL(k) = edge_length(e, k) * fung_energy_map(qlv, dL(k) / edge_length(e, k)).h;
+      if (qlv_energy) dL(k) = edge_length(e, k) * edge_energy_map(qlv, ratio, dL(k) / edge_length(e, k)).h;
     }
     sum += 0.5 * dL.dot(packed_hessian(e) * dL);
     if (with_volume_) {
@@ -400,13 +404,13 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     G.block<1, 3>(k, 3 * b) = Y.col(k).transpose() / len(k);
   }
   Mat6x12 Gm = G;  // derivative of the (possibly QLV-mapped) elongation measure
-  const bool qlv_energy = qlv > 0 && options_.viscoelasticity.qlv_form == GpsViscoelasticity::QlvForm::energy;
+  const bool qlv_energy = options_.viscoelasticity.energy_map();
   Vec6 dh = Vec6::Ones(), d2h = Vec6::Zero();  // energy form: t_k = h'_k (H h)_k
-  if (qlv > 0)
+  if (qlv > 0 || qlv_energy)
     for (int k = 0; k < 6; ++k) {
       const double strain = dL(k) / edge_length(e, k);
       if (qlv_energy) {
-        const FungEnergyMap m = fung_energy_map(qlv, strain);
+        const FungEnergyMap m = edge_energy_map(qlv, options_.viscoelasticity.compression_ratio, strain);
         dh(k) = m.dh;
         d2h(k) = m.d2h / edge_length(e, k);  // d h'/d dL
         Gm.row(k) *= m.dh;

@@ -38,6 +38,11 @@ struct GpsViscoelasticity {
   /// specimen near B e = 1); or energy, the elastic energy 0.5 h^T H h of the energy map h
   /// (h h' = the edge map, so a bar responds alike), tensions t_k = h'(e_k) (H (h - memory))_k.
   enum class QlvForm { edge_map, energy } qlv_form = QlvForm::edge_map;
+  /// Tension/compression asymmetry (energy form only): compressed edges respond r times as stiff
+  /// (gps/fung_map.hpp, edge_energy_map); 1 = symmetric.
+  double compression_ratio = 1.0;
+  /// Whether the elastic energy is 0.5 h^T H h with a nonlinear edge map (energy form).
+  bool energy_map() const { return qlv_form == QlvForm::energy && (qlv_stiffening > 0 || compression_ratio != 1.0); }
 
   bool has_memory() const { return !omega_rad_s.empty() || kelvin_voigt_time_s > 0; }
 };
