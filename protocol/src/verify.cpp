@@ -95,7 +95,7 @@ std::vector<std::uint8_t> encode(const Scene& s) {
   const fb::Vec3 lo = to_fb(s.bounds_min), hi = to_fb(s.bounds_max);
   const auto& m = s.material;
   const auto material = fb::CreateMaterialState(b, b.CreateString(m.name), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q,
-                                                m.damping_per_s);
+                                                m.damping_per_s, m.added_mass_fraction);
   const auto scenes = b.CreateVectorOfStrings(s.available_scenes);
   const auto preparing = b.CreateString(s.preparing);
   std::vector<flatbuffers::Offset<fb::RequestOutcome>> outcomes;
@@ -314,9 +314,9 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
   s.generation = m->generation();
   if (const auto* mat = m->material()) {
     s.material = {mat->name() ? mat->name()->str() : "", mat->youngs_modulus_pa(), mat->poisson_ratio(), mat->density_kg_m3(), mat->shear_q(),
-                  mat->damping_per_s()};
+                  mat->damping_per_s(), mat->added_mass_fraction()};
     const auto& x = s.material;
-    if (!std::isfinite(x.youngs_modulus_pa + x.poisson_ratio + x.density_kg_m3 + x.shear_q + x.damping_per_s)) {
+    if (!std::isfinite(x.youngs_modulus_pa + x.poisson_ratio + x.density_kg_m3 + x.shear_q + x.damping_per_s + x.added_mass_fraction)) {
       *why = "material numbers not finite";
       return std::nullopt;
     }

@@ -1,5 +1,7 @@
 #include "organ.hpp"
 
+#include <cstdio>
+
 #include "common/input_error.hpp"
 #include "mesh/mesh_reader.hpp"
 #include "mesh/refinement.hpp"
@@ -35,8 +37,9 @@ void build_physics(Organ& organ) {
   const std::vector<double> density(organ.mesh->tet_count(), material.density_kg_m3);
   // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
   organ.integrator = std::make_unique<ExplicitIntegrator>(*organ.model, density, bc,
-                                                          ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step});
-  organ.compliance = std::make_unique<ContactCompliance>(*organ.model, density, bc);
+                                                          ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
+  // The compliance predicts the simulated response, so it sees the same inertia.
+  organ.compliance = std::make_unique<ContactCompliance>(*organ.model, organ.integrator->mass_scaling().density_kg_m3, bc);
 }
 
 }  // namespace
@@ -51,7 +54,22 @@ protocol::MaterialInfo Organ::material_info() const {
   m.density_kg_m3 = material.density_kg_m3;
   if (material.viscoelasticity && material.viscoelasticity->model == ViscoelasticSpec::Model::constant_q) m.shear_q = material.viscoelasticity->shear_q;
   m.damping_per_s = scene.damping_per_s;
+  m.added_mass_fraction = integrator->mass_scaling().added_mass_fraction;
   return m;
+}
+
+std::string Organ::describe_step() const {
+  char b[200];
+  std::snprintf(b, sizeof b, "explicit step %.3g s", integrator->dt_s());
+  std::string out = b;
+  const MassScaling& mass_scaling = integrator->mass_scaling();
+  if (mass_scaling.scaled_elements > 0) {
+    std::snprintf(b, sizeof b, " (mass scaling: +%.2f%% mass on %zu of %zu elements, each element's step >= %.3g s)",
+                  100 * mass_scaling.added_mass_fraction, mass_scaling.scaled_elements, model->element_count(),
+                  mass_scaling.min_element_step_s);
+    out += b;
+  }
+  return out;
 }
 
 std::unique_ptr<Organ> build_organ(const SceneSpec& scene) {

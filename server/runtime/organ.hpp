@@ -26,6 +26,8 @@ struct Organ {
 
   /// The material as the scene state shows it.
   protocol::MaterialInfo material_info() const;
+  /// One line: the explicit step and, if any, the mass scaling that lengthened it.
+  std::string describe_step() const;
 };
 
 /// Reads the scene's mesh and material and builds the organ. Throws InputError naming the file

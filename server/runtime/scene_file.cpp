@@ -54,6 +54,7 @@ SceneSpec read_scene_file(const std::string& path) {
   if (step != "element" && step != "global")
     throw InputError(path, 0, "organ.stable_step", "'" + step + "' is not element or global");
   s.global_stable_step = step == "global";
+  s.added_mass_fraction = number(o, "added_mass_fraction", "organ.", 0, 1, 0.0);
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
   s.max_tool_speed_m_s = number(j, "max_tool_speed_m_s", "", 1e-3, 100, 0.5);

@@ -25,6 +25,9 @@ struct SceneSpec {
   double gravity_m_s2 = 9.81;  ///< along -z
   int refine = 0;  ///< uniform 1:8 refinements of the mesh (0-2)
   bool global_stable_step = false;  ///< "stable_step": "global" | "element"
+  /// Mass added to the elements with the shortest critical steps, as a fraction of the organ's
+  /// mass (selective mass scaling, tissue/integrator/mass_scaling.hpp); 0: none
+  double added_mass_fraction = 0.0;
   double contact_stiffness_n_per_m = 200.0;
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
   double max_tool_speed_m_s = 0.5;  ///< simulated tools follow commands at most this fast (simulated time)

@@ -369,10 +369,8 @@ struct SimulationServer::Impl {
       conclude(done.request, false, done.what + ": " + e.what(), status);
       return;
     }
-    char dt[64];
-    std::snprintf(dt, sizeof dt, " (explicit step %.3g s)", organ->integrator->dt_s());
     if (new_scene) available_scenes = list_scenes(scene_dir);
-    conclude(done.request, true, (new_scene ? "loaded " : "changed to ") + done.what + dt, status);
+    conclude(done.request, true, (new_scene ? "loaded " : "changed to ") + done.what + " (" + organ->describe_step() + ")", status);
   }
 
   /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
@@ -587,10 +585,10 @@ SimulationServer::~SimulationServer() = default;
 
 std::string SimulationServer::describe() const {
   char b[400];
-  std::snprintf(b, sizeof b, "scene %s: %zu nodes, %zu tets, model %s, explicit step %.3g s, %zu instruments, %.0f Hz, DDS domain %u",
+  std::snprintf(b, sizeof b, "scene %s: %zu nodes, %zu tets, model %s, %zu instruments, %.0f Hz, DDS domain %u, ",
                 impl_->scene.name.c_str(), impl_->organ->mesh->node_count(), impl_->organ->mesh->tet_count(),
-                std::string(impl_->organ->model->name()).c_str(), impl_->organ->integrator->dt_s(), impl_->instruments.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
-  return b;
+                std::string(impl_->organ->model->name()).c_str(), impl_->instruments.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
+  return b + impl_->organ->describe_step();
 }
 
 ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration_s, const std::function<void(const std::string&)>& status) {

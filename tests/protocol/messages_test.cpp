@@ -215,7 +215,7 @@ TEST(Messages, SceneStateCarriesMaterialScenesAndOutcomes) {
   sc.name = "liver";
   sc.physics_rate_hz = 500;
   sc.generation = 3;
-  sc.material = {"liver", 5000, 0.45, 1060, 4.8, 2};
+  sc.material = {"liver", 5000, 0.45, 1060, 4.8, 2, 0.05};
   sc.available_scenes = {"liver", "liver-12k"};
   sc.preparing = "scene liver-12k";
   sc.recent_requests.push_back({900, 17, Action::load_scene, false, "no scene 'x'"});
@@ -226,6 +226,7 @@ TEST(Messages, SceneStateCarriesMaterialScenesAndOutcomes) {
   EXPECT_EQ(d->generation, 3u);
   EXPECT_EQ(d->material.poisson_ratio, 0.45);
   EXPECT_EQ(d->material.shear_q, 4.8);
+  EXPECT_EQ(d->material.added_mass_fraction, 0.05);  // schema 4
   EXPECT_EQ(d->available_scenes, sc.available_scenes);
   EXPECT_EQ(d->preparing, "scene liver-12k");
   ASSERT_EQ(d->recent_requests.size(), 2u);
@@ -233,6 +234,9 @@ TEST(Messages, SceneStateCarriesMaterialScenesAndOutcomes) {
   EXPECT_FALSE(d->recent_requests[0].accepted);
   EXPECT_EQ(d->recent_requests[1].action, Action::set_physics_rate);
   EXPECT_EQ(d->recent_requests[1].message, "physics rate 500 Hz");
+  sc.material.added_mass_fraction = INFINITY;
+  EXPECT_FALSE(decode_scene(encode(sc), &why));
+  sc.material.added_mass_fraction = 0;
   sc.material.youngs_modulus_pa = std::nan("");
   EXPECT_FALSE(decode_scene(encode(sc), &why));
 }

@@ -129,8 +129,10 @@ int main(int argc, char** argv) {
       std::printf(" %u (%s, %s)", i.instrument_id, i.grasper ? "grasper" : "probe",
                   i.owner_client_id ? ("client " + std::to_string(i.owner_client_id)).c_str() : "free");
     const auto& m = scene->material;
-    std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s\n", scene->generation,
+    std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s", scene->generation,
                 m.name.c_str(), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q, m.damping_per_s);
+    if (m.added_mass_fraction > 0) std::printf(", mass scaling +%.2f%% (smallest elements)", 100 * m.added_mass_fraction);
+    std::printf("\n");
     std::string list;
     for (const auto& n : scene->available_scenes) list += " " + n;
     std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene->preparing.empty() ? "" : "; preparing ",

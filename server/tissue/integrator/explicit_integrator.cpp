@@ -16,15 +16,22 @@ ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<doub
     throw std::invalid_argument("ExplicitOptions.safety_factor must lie in (0, 1]");
   if (!(options_.mass_damping_per_s >= 0))
     throw std::invalid_argument("ExplicitOptions.mass_damping_per_s must be >= 0");
-  mass_ = lumped_masses(model.rest_mesh(), density_kg_m3);
+  const std::vector<double> weight = lumped_masses(model.rest_mesh(), density_kg_m3);
+  if (options_.added_mass_fraction > 0) {
+    scaling_ = scale_small_element_masses(model, density_kg_m3, options_.added_mass_fraction);
+    mass_ = lumped_masses(model.rest_mesh(), scaling_.density_kg_m3);
+  } else {
+    scaling_.density_kg_m3 = std::move(density_kg_m3);
+    mass_ = weight;
+  }
   const auto mask = bc_.constrained_mask(mass_.size());
-  critical_ = options_.global_stable_step ? global_time_step(model, mass_, mask) : critical_time_step(model, density_kg_m3);
+  critical_ = options_.global_stable_step ? global_time_step(model, mass_, mask) : critical_time_step(model, scaling_.density_kg_m3);
   dt_ = options_.dt_s > 0 ? options_.dt_s : options_.safety_factor * critical_.dt_s;
   inv_mass_.resize(mass_.size());
   gravity_.resize(mass_.size());
   for (std::size_t i = 0; i < mass_.size(); ++i) {
     for (int k = 0; k < 3; ++k) inv_mass_[i][k] = mask[3 * i + k] ? 0.0 : 1.0 / mass_[i];
-    gravity_[i] = mass_[i] * bc_.gravity_m_s2;
+    gravity_[i] = weight[i] * bc_.gravity_m_s2;
   }
   if (!bc_.nodal_forces.empty() && bc_.nodal_forces.size() != mass_.size())
     throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");

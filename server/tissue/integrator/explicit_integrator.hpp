@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "integrator/boundary_conditions.hpp"
+#include "integrator/mass_scaling.hpp"
 #include "integrator/stable_step.hpp"
 #include "integrator/state.hpp"
 #include "model/force_model.hpp"
@@ -20,6 +21,9 @@ struct ExplicitOptions {
   double max_edge_strain = 2.0;       ///< |dL|/L0 above this means the run went unstable
   /// Critical step from the global estimate (global_time_step) instead of the element bound.
   bool global_stable_step = false;
+  /// Selective mass scaling (mass_scaling.hpp): this fraction of the organ's mass is added to the
+  /// elements with the shortest critical steps, as inertia only (weight stays m g). 0: none.
+  double added_mass_fraction = 0.0;
 };
 
 class ExplicitIntegrator {
@@ -29,7 +33,10 @@ class ExplicitIntegrator {
 
   double dt_s() const { return dt_; }
   const StableStep& critical_step() const { return critical_; }
+  /// Lumped masses of the inertia [kg] (with the added mass, if any).
   const std::vector<double>& masses() const { return mass_; }
+  /// The mass scaling applied (none: no scaled elements, densities as given).
+  const MassScaling& mass_scaling() const { return scaling_; }
 
   /// One step. On instability (edge strain above the limit, or NaN) throws SimulationError naming
   /// the element and the time, and puts `state` back to the last step that passed the check.
@@ -52,6 +59,7 @@ class ExplicitIntegrator {
   std::vector<double> mass_;
   std::vector<Vec3> inv_mass_;     // per coordinate; 0 where constrained
   std::vector<Vec3> gravity_;      // m g per node
+  MassScaling scaling_;
   StableStep critical_;
   double dt_;
   std::vector<Vec3> force_, x_prev_, v_prev_;

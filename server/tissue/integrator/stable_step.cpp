@@ -9,12 +9,11 @@
 
 namespace viscera::tissue {
 
-StableStep critical_time_step(const ForceModel& model, std::span<const double> density_kg_m3) {
+std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3) {
   if (density_kg_m3.size() != model.element_count())
-    throw std::invalid_argument("critical_time_step: one density per element expected");
+    throw std::invalid_argument("element_frequencies: one density per element expected");
   const auto& rest = model.rest_mesh().nodes;
-  double worst = 0.0;
-  std::size_t worst_element = 0;
+  std::vector<double> omega(model.element_count());
   for (std::size_t e = 0; e < model.element_count(); ++e) {
     const auto x = model.gather(rest, e);
     const double volume = signed_volume(x[0], x[1], x[2], x[3]);
@@ -22,17 +21,20 @@ StableStep critical_time_step(const ForceModel& model, std::span<const double> d
     const Mat12 Ks = 0.5 * (K + K.transpose());
     const double lambda =
         Eigen::SelfAdjointEigenSolver<Mat12>(Ks, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
-    const double omega2 = lambda / (0.25 * density_kg_m3[e] * volume);
-    if (omega2 > worst) {
-      worst = omega2;
-      worst_element = e;
-    }
+    omega[e] = std::sqrt(lambda / (0.25 * density_kg_m3[e] * volume));
   }
-  const double omega = std::sqrt(worst);
+  return omega;
+}
+
+StableStep critical_time_step(const ForceModel& model, std::span<const double> density_kg_m3) {
+  const std::vector<double> omegas = element_frequencies(model, density_kg_m3);
+  if (omegas.empty()) throw std::invalid_argument("critical_time_step: the model has no elements");
+  const auto worst = std::max_element(omegas.begin(), omegas.end());
+  const double omega = *worst;
   // Stiffness-proportional damping (Kelvin-Voigt, time tau) shortens the step of central
   // differences to (2 / omega) (sqrt(1 + xi^2) - xi), xi = tau omega / 2 (Belytschko et al.).
   const double xi = 0.5 * model.stiffness_damping_time_s() * omega;
-  return {2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi), omega, worst_element};
+  return {2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi), omega, static_cast<std::size_t>(worst - omegas.begin())};
 }
 
 StableStep global_time_step(const ForceModel& model, std::span<const double> masses, std::span<const char> constrained,

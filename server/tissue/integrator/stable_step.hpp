@@ -1,5 +1,6 @@
 #pragma once
 #include <span>
+#include <vector>
 
 #include "model/force_model.hpp"
 
@@ -16,6 +17,10 @@ struct StableStep {
 /// M_e the element's lumped mass rho_e V_e / 4 per vertex. Never larger than the true global
 /// limit; the integrator multiplies it by a safety factor for finite-strain stiffening.
 StableStep critical_time_step(const ForceModel& model, std::span<const double> density_kg_m3);
+
+/// Each element's bound on its highest natural frequency [rad/s], sqrt(lambda_max(M_e^-1 K_e)) as
+/// in critical_time_step (whose undamped step is 2 / the largest of them).
+std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3);
 
 /// Estimate of the global critical step from the highest natural frequency of the free
 /// coordinates: power iteration on M^-1/2 K M^-1/2, K applied through central differences of the

@@ -71,6 +71,7 @@ struct MaterialInfo {
   double density_kg_m3 = 0;
   double shear_q = 0;            ///< 0: elastic
   double damping_per_s = 0;
+  double added_mass_fraction = 0;  ///< mass scaling of the smallest elements / organ mass (schema 4)
 };
 
 /// What the server did with a load_scene, set_material or set_physics_rate request.
