@@ -1,5 +1,6 @@
 #include "organ.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "common/input_error.hpp"
@@ -38,6 +39,11 @@ void build_physics(Organ& organ) {
   // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
   organ.integrator = std::make_unique<ExplicitIntegrator>(*organ.model, density, bc,
                                                           ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
+  if (s.physics_threads > 1) {
+    organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, s.physics_threads);
+    organ.integrator->set_force_evaluation(
+        [p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return (*p)(x, f, m); });
+  }
   // The compliance predicts the simulated response, so it sees the same inertia.
   organ.compliance = std::make_unique<ContactCompliance>(*organ.model, organ.integrator->mass_scaling().density_kg_m3, bc);
 }
@@ -60,7 +66,8 @@ protocol::MaterialInfo Organ::material_info() const {
 
 std::string Organ::describe_step() const {
   char b[200];
-  std::snprintf(b, sizeof b, "explicit step %.3g s", integrator->dt_s());
+  std::snprintf(b, sizeof b, "explicit step %.3g s, forces on %d thread%s", integrator->dt_s(), scene.physics_threads,
+                scene.physics_threads > 1 ? "s" : "");
   std::string out = b;
   const MassScaling& mass_scaling = integrator->mass_scaling();
   if (mass_scaling.scaled_elements > 0) {

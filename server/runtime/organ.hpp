@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "contact_compliance.hpp"
+#include "parallel_forces.hpp"
 #include "integrator/explicit_integrator.hpp"
 #include "material/material_file.hpp"
 #include "mesh/boundary_surface.hpp"
@@ -21,6 +22,7 @@ struct Organ {
   tissue::Box bounds;
   tissue::BoundarySurface boundary;
   std::unique_ptr<tissue::ForceModel> model;
+  std::unique_ptr<ParallelForces> parallel_forces;  ///< scene physics_threads > 1; used by the integrator
   std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
   std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
 

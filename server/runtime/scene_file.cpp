@@ -55,6 +55,9 @@ SceneSpec read_scene_file(const std::string& path) {
     throw InputError(path, 0, "organ.stable_step", "'" + step + "' is not element or global");
   s.global_stable_step = step == "global";
   s.added_mass_fraction = number(o, "added_mass_fraction", "organ.", 0, 1, 0.0);
+  s.physics_threads = static_cast<int>(number(o, "physics_threads", "organ.", 1, 8, 1));
+  if (o.contains("physics_threads") && o["physics_threads"].get<double>() != s.physics_threads)
+    throw InputError(path, 0, "organ.physics_threads", o["physics_threads"].dump() + " is not a whole number");
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
   s.max_tool_speed_m_s = number(j, "max_tool_speed_m_s", "", 1e-3, 100, 0.5);

@@ -28,6 +28,8 @@ struct SceneSpec {
   /// Mass added to the elements with the shortest critical steps, as a fraction of the organ's
   /// mass (selective mass scaling, tissue/integrator/mass_scaling.hpp); 0: none
   double added_mass_fraction = 0.0;
+  /// Threads that evaluate the organ's internal forces (the physics thread and helpers), 1-8.
+  int physics_threads = 1;
   double contact_stiffness_n_per_m = 200.0;
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
   double max_tool_speed_m_s = 0.5;  ///< simulated tools follow commands at most this fast (simulated time)

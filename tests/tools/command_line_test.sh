@@ -37,6 +37,8 @@ expect server-no-scene 2 "--scene FILE is required" -- "$server"
 expect server-bad-scene 2 "bad_scene.json: organ.material: missing" -- "$server" --scene "$tmp/bad_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json", "added_mass_fraction": 2}, "instruments": [{"id": 1}]}' >"$tmp/heavy_scene.json"
 expect server-bad-mass-scaling 2 "heavy_scene.json: organ.added_mass_fraction: 2 is outside" -- "$server" --scene "$tmp/heavy_scene.json"
+echo '{"organ": {"mesh": "x.msh", "material": "m.json", "physics_threads": 1.5}, "instruments": [{"id": 1}]}' >"$tmp/threads_scene.json"
+expect server-bad-threads 2 "threads_scene.json: organ.physics_threads: 1.5 is not a whole number" -- "$server" --scene "$tmp/threads_scene.json"
 expect server-bad-duration 2 "'soon' is not a non-negative number" -- "$server" --scene x --duration soon
 expect server-bad-scene-dir 2 "--scene-dir: '/nonexistent' is not a directory" -- "$server" --scene x --scene-dir /nonexistent
 expect hc-help 0 "Usage: haptic-client" -- "$hc" --help

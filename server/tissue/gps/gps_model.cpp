@@ -110,7 +110,8 @@ Mat6 GpsModel::paper_constants(std::size_t e) const {
 }
 
 template <bool kEnergyConsistent, bool kVolume, bool kMemory>
-ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory) const {
+ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory,
+                                     std::size_t first_block, std::size_t end_block) const {
   const Vec3* X = mesh_->nodes.data();
   double max_strain[L] = {}, nan_probe[L] = {};
   // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l.
@@ -134,7 +135,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
   const double qlv = ve.qlv_stiffening;
   const bool qlv_energy = ve.energy_map();
   const double ratio = ve.compression_ratio;
-  for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
+  for (std::size_t bi = first_block; bi < end_block; ++bi) {
     const Block& b = blocks_[bi];
     // Gather: current positions, and displacements u = x - X (exact for x near X).
     double p[4][3][L], u[4][3][L];
@@ -319,9 +320,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
 }
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) const {
-  const bool ec = options_.variant == GpsVariant::energy_consistent;
-  if (!with_volume_) return ec ? add_forces_impl<true, false, false>(x, f, nullptr) : add_forces_impl<false, false, false>(x, f, nullptr);
-  return ec ? add_forces_impl<true, true, false>(x, f, nullptr) : add_forces_impl<false, true, false>(x, f, nullptr);
+  return add_forces(x, f, MemoryUpdate{}, ElementPart{});
 }
 
 std::size_t GpsModel::memory_size() const {
@@ -329,11 +328,21 @@ std::size_t GpsModel::memory_size() const {
 }
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
-  if (memory_size() == 0 || memory.before.size() != memory_size() || memory.after.size() != memory_size())
-    return add_forces(x, f);  // no memory attached: the unrelaxed (instantaneous) response
+  return add_forces(x, f, memory, ElementPart{});
+}
+
+ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const {
+  if (part.count == 0 || part.index >= part.count) throw std::invalid_argument("GpsModel::add_forces: part index outside the part count");
+  const std::size_t n = blocks_.size();
+  const std::size_t b0 = n * part.index / part.count, b1 = n * (part.index + 1) / part.count;
   const bool ec = options_.variant == GpsVariant::energy_consistent;
-  if (!with_volume_) return ec ? add_forces_impl<true, false, true>(x, f, &memory) : add_forces_impl<false, false, true>(x, f, &memory);
-  return ec ? add_forces_impl<true, true, true>(x, f, &memory) : add_forces_impl<false, true, true>(x, f, &memory);
+  // Without memory attached (or none to keep): the unrelaxed (instantaneous) response.
+  if (memory_size() == 0 || memory.before.size() != memory_size() || memory.after.size() != memory_size()) {
+    if (!with_volume_) return ec ? add_forces_impl<true, false, false>(x, f, nullptr, b0, b1) : add_forces_impl<false, false, false>(x, f, nullptr, b0, b1);
+    return ec ? add_forces_impl<true, true, false>(x, f, nullptr, b0, b1) : add_forces_impl<false, true, false>(x, f, nullptr, b0, b1);
+  }
+  if (!with_volume_) return ec ? add_forces_impl<true, false, true>(x, f, &memory, b0, b1) : add_forces_impl<false, false, true>(x, f, &memory, b0, b1);
+  return ec ? add_forces_impl<true, true, true>(x, f, &memory, b0, b1) : add_forces_impl<false, true, true>(x, f, &memory, b0, b1);
 }
 
 double GpsModel::energy(std::span<const Vec3> x) const {

@@ -62,6 +62,8 @@ class GpsModel final : public ForceModel {
   std::string_view name() const override;
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const override;
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const override;
+  /// Parts are contiguous ranges of blocks (kLanes elements each).
+  ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const override;
   std::size_t memory_size() const override;
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const override;
   double stiffness_damping_time_s() const override { return options_.viscoelasticity.kelvin_voigt_time_s; }
@@ -94,7 +96,8 @@ class GpsModel final : public ForceModel {
 
  private:
   template <bool kEnergyConsistent, bool kVolume, bool kMemory>
-  ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory) const;
+  ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory, std::size_t first_block,
+                             std::size_t end_block) const;
   Mat12 tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra) const;
   Mat6 packed_hessian(std::size_t e) const;
   double edge_length(std::size_t e, int k) const;

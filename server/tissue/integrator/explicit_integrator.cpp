@@ -50,7 +50,8 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   // model never writes non-finite values into it).
   const std::size_t nm = model_.memory_size();
   if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
-  const ForceStats stats = model_.add_forces(state.x, force_, {state.memory, state.memory, state.time_s - state.memory_time_s});
+  const MemoryUpdate memory{state.memory, state.memory, state.time_s - state.memory_time_s};
+  const ForceStats stats = evaluate_ ? evaluate_(state.x, force_, memory) : model_.add_forces(state.x, force_, memory);
   bool stiff_field = false;
   if (bc_.force_field) {
     std::fill(field_stiffness_.begin(), field_stiffness_.end(), 0.0);

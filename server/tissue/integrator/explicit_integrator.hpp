@@ -2,6 +2,7 @@
 // Explicit symplectic Euler (MODEL.md section 2): v += dt M^-1 (f_int + f_ext);
 // v *= exp(-alpha dt) (mass-proportional damping, integrated exactly); x += dt v.
 // The step is the computed critical step times a safety factor, never a guess.
+#include <functional>
 #include <vector>
 
 #include "integrator/boundary_conditions.hpp"
@@ -45,6 +46,12 @@ class ExplicitIntegrator {
   /// Returns the number of sub-steps.
   long advance(State& state, double duration_s);
 
+  /// How internal forces are evaluated: by default model.add_forces on the calling thread; a caller
+  /// may split them over threads (server/runtime/parallel_forces.hpp). It must add the model's
+  /// forces to f (up to rounding) and advance the memory as add_forces does. Empty: the default.
+  using ForceEvaluation = std::function<ForceStats(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory)>;
+  void set_force_evaluation(ForceEvaluation evaluation) { evaluate_ = std::move(evaluation); }
+
   /// The boundary conditions (their force field may be changed between steps).
   BoundaryConditions& boundary_conditions() { return bc_; }
   /// Kinetic energy [J] of a state.
@@ -59,6 +66,7 @@ class ExplicitIntegrator {
   std::vector<double> mass_;
   std::vector<Vec3> inv_mass_;     // per coordinate; 0 where constrained
   std::vector<Vec3> gravity_;      // m g per node
+  ForceEvaluation evaluate_;
   MassScaling scaling_;
   StableStep critical_;
   double dt_;

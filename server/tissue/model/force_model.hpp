@@ -27,6 +27,12 @@ struct ForceStats {
   double max_edge_strain = 0.0;
 };
 
+/// Part `index` of `count` of a model's elements, for evaluating forces on several threads: the
+/// parts together are all elements, and each part advances only its own elements' memory.
+struct ElementPart {
+  std::size_t index = 0, count = 1;
+};
+
 class ForceModel {
  public:
   explicit ForceModel(std::shared_ptr<const TetMesh> rest_mesh);
@@ -47,6 +53,12 @@ class ForceModel {
   virtual ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
     (void)memory;
     return add_forces(x, f);
+  }
+  /// f += the forces of one part of the elements, memory advanced for that part only. Summed over
+  /// all parts, the forces of add_forces(x, f, memory) up to rounding. Models that do not split
+  /// compute everything in part 0 and nothing in the others.
+  virtual ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const {
+    return part.index == 0 ? add_forces(x, f, memory) : ForceStats{};
   }
   /// Tangent of the forces of a step of dt_s (memory variables make the stiffness depend on dt).
   virtual Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const {
