@@ -64,6 +64,7 @@ struct SimulationServer::Impl {
     // simulated time, so a server that runs slower than real time (or a jumping device) never
     // drives the tool through the tissue within one tick.
     Vec3 proxy = Vec3::Zero();
+    Vec3 proxy_velocity = Vec3::Zero();  // its motion over the current tick [m/s]
     GraspHold grasped;  // grasper: the tissue held by the closed jaws
     ContactResult result;
     bool touching = false;    // in contact (for contact events, with hysteresis)
@@ -131,7 +132,8 @@ struct SimulationServer::Impl {
     for (const auto& spec : o.scene.instruments) {
       Instrument& inst = made[spec.id];
       inst.spec = spec;
-      inst.contact = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m);
+      inst.contact = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m,
+                                                    0.02, o.scene.contact_damping_n_s_per_m);
       inst.query = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m);
     }
     return made;
@@ -141,9 +143,7 @@ struct SimulationServer::Impl {
   /// own instruments (owners lose theirs and must claim again) and a new surface; a new material
   /// on the same mesh keeps the organ's deformation, its owners and its tools.
   void adopt(std::unique_ptr<Organ> next, bool new_scene) {
-    next->integrator->boundary_conditions().force_field = [this](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
-      apply_instruments(x, f, stiffness);
-    };
+    next->integrator->boundary_conditions().force_field = [this](const BoundaryConditions::FieldEvaluation& e) { apply_instruments(e); };
     std::map<std::uint32_t, Instrument> made;
     if (new_scene) made = make_instruments(*next);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> released;  // instrument, owner
@@ -198,14 +198,14 @@ struct SimulationServer::Impl {
 
   /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
   /// contact of each active tool, and the springs holding grasped nodes to the jaws.
-  void apply_instruments(std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
+  void apply_instruments(const BoundaryConditions::FieldEvaluation& e) {
     for (auto& [id, inst] : instruments) {
       if (!inst.active) {
         inst.result = {};
         continue;
       }
-      inst.result = inst.contact->apply(inst.proxy, x, f, stiffness);
-      add_grasp(inst.result, inst.grasped, inst.proxy, inst.tick, x, f, stiffness);
+      inst.result = inst.contact->apply(inst.proxy, e.x, e.f, e.stiffness, e.v, inst.proxy_velocity, e.damping);
+      add_grasp(inst.result, inst.grasped, inst.proxy, inst.tick, e.x, e.f, e.stiffness);
     }
   }
 
@@ -414,7 +414,10 @@ struct SimulationServer::Impl {
         continue;
       }
       inst.tick = inst.last;
-      if (!was_active) inst.proxy = Vec3(inst.tick.tip_position[0], inst.tick.tip_position[1], inst.tick.tip_position[2]);
+      if (!was_active) {
+        inst.proxy = Vec3(inst.tick.tip_position[0], inst.tick.tip_position[1], inst.tick.tip_position[2]);
+        inst.proxy_velocity = Vec3::Zero();
+      }
     }
   }
 
@@ -442,7 +445,9 @@ struct SimulationServer::Impl {
       const auto& p = inst.tick.tip_position;
       const Vec3 gap = Vec3(p[0], p[1], p[2]) - inst.proxy;
       const double d = gap.norm();
-      inst.proxy += d <= reach ? gap : (reach / d) * gap;
+      const Vec3 move = d <= reach ? gap : Vec3((reach / d) * gap);
+      inst.proxy += move;
+      inst.proxy_velocity = move / dt_s;
       update_grasp(inst);
     }
   }

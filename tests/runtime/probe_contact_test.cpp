@@ -61,3 +61,34 @@ TEST(ProbeContact, BroadPhaseFindsContactOnAStretchedSurface) {
     EXPECT_NEAR(c.force_on_tool.z(), k * 0.002, 1e-9);
   }
 }
+
+TEST(ProbeContact, DashpotAddsDampingTimesThePenetrationRateAndNeverPulls) {
+  // Closed form: a plate moving up at u into a tool moving at w: the depth grows at u - w, the
+  // normal force is k d + c (u - w), and never below zero when the surface leaves faster than the
+  // spring pushes. Each node's damping bound is sqrt(3) c share w_node (the Gershgorin row sum).
+  const double r = 0.006, k = 1000.0, c = 2.0, depth = 0.003;
+  const Plate p(20, 0.002);
+  const ProbeContact contact(p.triangles, p.x, r, k, 0.02, c);
+  const Vec3 tip(0.0003, -0.0002, r - depth);
+  for (const double u : {0.0, 0.4, -0.7, -5.0})
+    for (const double w : {0.0, -0.1}) {
+      const std::vector<Vec3> v(p.x.size(), Vec3(0.01, 0.0, u));  // sliding along the plate changes nothing
+      std::vector<Vec3> f(p.x.size(), Vec3::Zero());
+      std::vector<double> stiffness(p.x.size(), 0.0), damping(p.x.size(), 0.0);
+      const ContactResult res = contact.apply(tip, p.x, f, stiffness, v, Vec3(0.02, 0, w), damping);
+      const double expected = std::max(0.0, k * depth + c * (u - w));
+      EXPECT_NEAR(res.force_on_tool.z(), expected, 1e-9) << "u " << u << " w " << w;
+      Vec3 on_plate = Vec3::Zero();
+      for (const auto& x : f) on_plate += x;
+      EXPECT_NEAR((on_plate + res.force_on_tool).norm(), 0.0, 1e-9);
+      double bound = 0, stiff = 0;
+      for (std::size_t i = 0; i < damping.size(); ++i) {
+        bound += damping[i];
+        stiff += stiffness[i];
+      }
+      EXPECT_NEAR(bound, std::sqrt(3.0) * c, 1e-9);  // shares and barycentric weights sum to 1
+      EXPECT_NEAR(stiff, std::sqrt(3.0) * k, 1e-9);
+    }
+  // Without velocities (the command thread's query) the contact is the spring alone.
+  EXPECT_NEAR(contact.apply(tip, p.x, {}).force_on_tool.z(), k * depth, 1e-9);
+}

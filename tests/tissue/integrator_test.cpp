@@ -235,10 +235,10 @@ TEST(Explicit, StiffForceFieldSpringsAreTakenImplicitlyAndReachTheExactEquilibri
   const double k = 100.0 * m_min / (probe.dt_s() * probe.dt_s());
   const auto& rest = s.mesh->nodes;
   const auto springs = [&](bool report) {
-    return [&, report](std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness) {
-      for (std::size_t i = 0; i < x.size(); ++i) {
-        f[i] += k * (rest[i] - x[i]);
-        if (report) stiffness[i] += k;
+    return [&, report](const BoundaryConditions::FieldEvaluation& e) {
+      for (std::size_t i = 0; i < e.x.size(); ++i) {
+        e.f[i] += k * (rest[i] - e.x[i]);
+        if (report) e.stiffness[i] += k;
       }
     };
   };
@@ -267,6 +267,40 @@ TEST(Explicit, StiffForceFieldSpringsAreTakenImplicitlyAndReachTheExactEquilibri
   ExplicitIntegrator blind(fe, s.rho(), bc, o);
   State sb = State::at_rest(*s.mesh);
   EXPECT_THROW(blind.advance(sb, 0.05), SimulationError);
+}
+
+TEST(Explicit, FieldDashpotsAreTakenImplicitlyLikeBackwardEulerInTheVelocity) {
+  // Every node under a dashpot c_i = gamma m_i with dt gamma = 100, the mesh moving as a rigid
+  // body (no elastic force): reported to the integrator, each step multiplies the velocity by
+  // 1 / (1 + dt gamma), backward Euler's factor, exactly; not reported (forward Euler in the
+  // dashpot), it grows by |1 - dt gamma| = 99 per step and the run blows up.
+  Fixture s;
+  const FiniteElementModel fe(s.mesh, FeKind::linear, {test::soft_tissue()});
+  const ExplicitIntegrator probe(fe, s.rho(), {});
+  const double dt = probe.dt_s(), gamma = 100.0 / dt;
+  const auto dashpots = [&](bool report) {
+    return [&, report](const BoundaryConditions::FieldEvaluation& e) {
+      for (std::size_t i = 0; i < e.x.size(); ++i) {
+        e.f[i] -= gamma * probe.masses()[i] * e.v[i];
+        if (report) e.damping[i] += gamma * probe.masses()[i];
+      }
+    };
+  };
+  BoundaryConditions bc;
+  bc.gravity_m_s2 = Vec3::Zero();
+  bc.force_field = dashpots(true);
+  ExplicitIntegrator run(fe, s.rho(), bc);
+  State st = State::at_rest(*s.mesh);
+  for (auto& v : st.v) v = Vec3(0.01, -0.02, 0.005);
+  for (int k = 0; k < 3; ++k) run.step(st);
+  const double factor = std::pow(1.0 / (1.0 + dt * gamma), 3);
+  const Vec3 v0(0.01, -0.02, 0.005);
+  for (const auto& v : st.v) EXPECT_NEAR((v - factor * v0).norm(), 0.0, 1e-6 * factor * v0.norm());  // elastic round-off of the translation
+  bc.force_field = dashpots(false);
+  ExplicitIntegrator blind(fe, s.rho(), bc);
+  State sb = State::at_rest(*s.mesh);
+  for (auto& v : sb.v) v = Vec3(0.01, -0.02, 0.005);
+  EXPECT_THROW(blind.advance(sb, 20 * dt), SimulationError);
 }
 
 TEST(Explicit, AdvanceUsesEqualSubStepsSoTicksNotAMultipleOfTheStepStayStable) {

@@ -43,11 +43,18 @@ struct BoundaryConditions {
   std::vector<Vec3> nodal_forces;
   std::function<double(double t)> force_amplitude;
 
-  /// A position-dependent force field added at every explicit force evaluation (contact with an
-  /// instrument): f += field(x). It also adds to `stiffness` [N/m] per node a bound on its own
-  /// stiffness there (at least the Gershgorin row sum of -df/dx); the explicit integrator treats
-  /// that part implicitly, so the field never limits the step. Explicit integrator only.
-  std::function<void(std::span<const Vec3> x, std::span<Vec3> f, std::span<double> stiffness)> force_field;
+  /// A force field added at every explicit force evaluation (contact with an instrument):
+  /// f += field(x, v). It also adds per node a bound on its own stiffness there (`stiffness`
+  /// [N/m], at least the Gershgorin row sum of -df/dx) and on its damping (`damping` [N s/m], the
+  /// same for -df/dv); the explicit integrator treats those parts implicitly, so the field never
+  /// limits the step. Explicit integrator only.
+  struct FieldEvaluation {
+    std::span<const Vec3> x, v;   ///< positions [m], velocities [m/s]
+    std::span<Vec3> f;            ///< forces to add to [N]
+    std::span<double> stiffness;  ///< per node [N/m]
+    std::span<double> damping;    ///< per node [N s/m]
+  };
+  std::function<void(const FieldEvaluation&)> force_field;
 
   /// 1 for each coordinate (3 per node) that is fixed or prescribed, else 0.
   std::vector<char> constrained_mask(std::size_t node_count) const;

@@ -37,6 +37,7 @@ ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<doub
     throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");
   force_.resize(mass_.size());
   field_stiffness_.resize(mass_.size());
+  field_damping_.resize(mass_.size());
 }
 
 void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
@@ -55,8 +56,10 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   bool stiff_field = false;
   if (bc_.force_field) {
     std::fill(field_stiffness_.begin(), field_stiffness_.end(), 0.0);
-    bc_.force_field(state.x, force_, field_stiffness_);
-    stiff_field = std::any_of(field_stiffness_.begin(), field_stiffness_.end(), [](double k) { return k > 0; });
+    std::fill(field_damping_.begin(), field_damping_.end(), 0.0);
+    bc_.force_field({state.x, state.v, force_, field_stiffness_, field_damping_});
+    stiff_field = std::any_of(field_stiffness_.begin(), field_stiffness_.end(), [](double k) { return k > 0; }) ||
+                  std::any_of(field_damping_.begin(), field_damping_.end(), [](double c) { return c > 0; });
   }
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
@@ -81,7 +84,9 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
     // A node under the field's springs moves with the mass m + dt^2 k (the springs taken
     // implicitly): by Weyl's inequality dt^2 omega^2 <= dt^2 omega_model^2 + 1 <= 4 while
     // dt <= sqrt(3) / omega_model, so stiff instrument springs on light nodes never destabilise.
-    const double scale = stiff_field ? mass_[i] / (mass_[i] + dt * dt * field_stiffness_[i]) : 1.0;
+    // A dashpot c adds dt c (backward Euler in the velocity: a heavy dashpot stops the node, it
+    // never reverses it).
+    const double scale = stiff_field ? mass_[i] / (mass_[i] + dt * field_damping_[i] + dt * dt * field_stiffness_[i]) : 1.0;
     state.v[i] = (state.v[i] + (scale * dt) * inv_mass_[i].cwiseProduct(force_[i])) * damping;
     for (int k = 0; k < 3; ++k)
       if (inv_mass_[i][k] == 0.0) state.v[i][k] = 0.0;

@@ -71,7 +71,7 @@ class ExplicitIntegrator {
   StableStep critical_;
   double dt_;
   std::vector<Vec3> force_, x_prev_, v_prev_;
-  std::vector<double> field_stiffness_;
+  std::vector<double> field_stiffness_, field_damping_;
   double t_prev_ = 0.0;
 };
 
