@@ -35,8 +35,8 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 }
 
 ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
-                           double max_depth_m, double damping_n_s_per_m)
-    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m), damping_(damping_n_s_per_m) {
+                           double max_depth_m, double damping_s_per_m)
+    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m), damping_(damping_s_per_m) {
   reach2_.reserve(surface_.size());
   for (const auto& t : surface_) {
     const Vec3 &a = rest[t[0]], &b = rest[t[1]], &c = rest[t[2]];
@@ -81,30 +81,32 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
   // Second pass: one contact of stiffness k at the deepest penetration, shared among the touched
   // triangles by depth, so the force does not grow with the number of triangles under the tip
   // (a finer mesh would otherwise push harder for the same indentation).
-  // The normal force: spring at the deepest penetration, plus the dashpot on its rate (the deepest
-  // contact point's velocity relative to the tool along its normal), never pulling.
-  double normal_force = stiffness_ * r.depth_m;
+  // Each touched triangle carries its share of the spring at the deepest penetration, plus a
+  // dashpot on its own rate of penetration (its contact point's velocity relative to the tool,
+  // along its normal), never pulling. Per triangle, so the damping is symmetric and only removes
+  // energy (one rate applied to every triangle can feed a triangle moving against it). The
+  // dashpot grows with the depth (Hunt and Crossley 1975: k d (1 + alpha rate)), so the force is
+  // continuous when contact begins: a dashpot of fixed strength jumps at the first touch.
   const bool damped = damping_ > 0 && !v.empty();
-  if (damped) {
-    const Touch* deepest = &touching_.front();
-    for (const auto& c : touching_)
-      if (c.depth > deepest->depth) deepest = &c;
-    const auto& t = surface_[deepest->triangle];
-    const Vec3 vq = deepest->weights[0] * v[t[0]] + deepest->weights[1] * v[t[1]] + deepest->weights[2] * v[t[2]];
-    normal_force = std::max(0.0, normal_force + damping_ * (vq - tool_velocity).dot(deepest->normal));
-  }
+  const double dashpot = damping_ * stiffness_ * r.depth_m;  // [N s/m]
   Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
   Vec3 weighted_point = Vec3::Zero();
   for (const auto& c : touching_) {
     const double share = c.depth / total;
-    const Vec3 push = normal_force * share * c.normal;  // on the tool, out of the tissue
+    double normal_force = stiffness_ * r.depth_m * share;
+    if (damped) {
+      const auto& t = surface_[c.triangle];
+      const Vec3 vq = c.weights[0] * v[t[0]] + c.weights[1] * v[t[1]] + c.weights[2] * v[t[2]];
+      normal_force = std::max(0.0, normal_force + dashpot * share * (vq - tool_velocity).dot(c.normal));
+    }
+    const Vec3 push = normal_force * c.normal;  // on the tool, out of the tissue
     const auto& t = surface_[c.triangle];
     if (!f.empty())
       for (int k = 0; k < 3; ++k) f[t[k]] -= c.weights[k] * push;
     if (!node_stiffness.empty())
       for (int k = 0; k < 3; ++k) node_stiffness[t[k]] += std::sqrt(3.0) * stiffness_ * share * c.weights[k];
     if (damped && !node_damping.empty())
-      for (int k = 0; k < 3; ++k) node_damping[t[k]] += std::sqrt(3.0) * damping_ * share * c.weights[k];
+      for (int k = 0; k < 3; ++k) node_damping[t[k]] += std::sqrt(3.0) * dashpot * share * c.weights[k];
     r.force_on_tool += push;
     K += stiffness_ * share * c.normal * c.normal.transpose();
     weighted_point += share * c.point;

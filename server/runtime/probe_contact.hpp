@@ -4,9 +4,9 @@
 // s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r.
 // The contact is one penalty spring k at the deepest penetration d, its force k d shared among
 // the touched triangles in proportion to their depths, so it does not depend on how finely the
-// surface is meshed. A normal dashpot c adds c times the rate of penetration (the velocity of the
-// deepest contact point on the surface relative to the tool, along its normal) to that force, never
-// pulling: without it the penalty spring and the surface's own mass ring at a few hundred Hz,
+// surface is meshed. A normal dashpot (Hunt-Crossley: k d (1 + alpha rate)) adds, for each touched
+// triangle, alpha k d times its share times its rate of penetration (its contact point's velocity
+// relative to the tool, along its normal), never pulling: without it the penalty spring and the surface's own mass ring at a few hundred Hz,
 // above the tissue's viscoelastic band, and the tool feels it as buzz.
 // Because s keeps decreasing (and goes negative) when the centre passes below the surface, a tip
 // that moved deeper than its radius within one step is still pushed out along the normal: it does
@@ -43,11 +43,11 @@ class ProbeContact {
   /// vertex is farther from the tip than the tip radius, the depth limit and three times its
   /// longest rest edge: an edge stretched beyond 3x fails the integration's strain check first).
   ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
-               double max_depth_m = 0.02, double damping_n_s_per_m = 0.0);
+               double max_depth_m = 0.02, double damping_s_per_m = 0.0);
   /// Adds the penalty forces on the organ to f for the tip at `centre`, and to `node_stiffness`
   /// (if not empty) a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row
   /// sum); returns the reaction. With node velocities v (and the tool's), the dashpot acts too and
-  /// `node_damping` gets sqrt(3) c share w. With an empty f it only queries the reaction (the state
+  /// `node_damping` gets sqrt(3) alpha k d share w. With an empty f it only queries the reaction (the state
   /// is not changed). Not for concurrent calls on one object (it reuses a scratch list).
   ContactResult apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f, std::span<double> node_stiffness = {},
                       std::span<const Vec3> v = {}, const Vec3& tool_velocity = Vec3::Zero(), std::span<double> node_damping = {}) const;

@@ -60,7 +60,7 @@ SceneSpec read_scene_file(const std::string& path) {
     throw InputError(path, 0, "organ.physics_threads", o["physics_threads"].dump() + " is not a whole number");
   s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
-  s.contact_damping_n_s_per_m = number(o, "contact_damping_n_s_per_m", "organ.", 0, 1e4, 1.0);
+  s.contact_damping_s_per_m = number(o, "contact_damping_s_per_m", "organ.", 0, 1e4, 0.0);
   s.max_tool_speed_m_s = number(j, "max_tool_speed_m_s", "", 1e-3, 100, 0.5);
   if (o.contains("fix_slab")) {
     const json& f = o["fix_slab"];

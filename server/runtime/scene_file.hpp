@@ -31,7 +31,7 @@ struct SceneSpec {
   /// Threads that evaluate the organ's internal forces (the physics thread and helpers), 1-8.
   int physics_threads = 1;
   double contact_stiffness_n_per_m = 200.0;
-  double contact_damping_n_s_per_m = 1.0;  ///< probe contact's normal dashpot
+  double contact_damping_s_per_m = 0.0;  ///< probe contact's Hunt-Crossley dashpot alpha (0: none)
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
   double max_tool_speed_m_s = 0.5;  ///< simulated tools follow commands at most this fast (simulated time)
   std::string fix_axis = "z", fix_side = "max";

@@ -133,7 +133,7 @@ struct SimulationServer::Impl {
       Instrument& inst = made[spec.id];
       inst.spec = spec;
       inst.contact = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m,
-                                                    0.02, o.scene.contact_damping_n_s_per_m);
+                                                    0.02, o.scene.contact_damping_s_per_m);
       inst.query = std::make_unique<ProbeContact>(o.boundary.triangles, o.mesh->nodes, spec.tip_radius_m, o.scene.contact_stiffness_n_per_m);
     }
     return made;

@@ -62,13 +62,14 @@ TEST(ProbeContact, BroadPhaseFindsContactOnAStretchedSurface) {
   }
 }
 
-TEST(ProbeContact, DashpotAddsDampingTimesThePenetrationRateAndNeverPulls) {
+TEST(ProbeContact, HuntCrossleyDashpotGrowsWithDepthAndRateAndNeverPulls) {
   // Closed form: a plate moving up at u into a tool moving at w: the depth grows at u - w, the
-  // normal force is k d + c (u - w), and never below zero when the surface leaves faster than the
-  // spring pushes. Each node's damping bound is sqrt(3) c share w_node (the Gershgorin row sum).
-  const double r = 0.006, k = 1000.0, c = 2.0, depth = 0.003;
+  // normal force is k d (1 + alpha (u - w)), and never below zero when the surface leaves faster
+  // than the spring pushes. Each node's damping bound is sqrt(3) alpha k d share w_node (the
+  // Gershgorin row sum).
+  const double r = 0.006, k = 1000.0, alpha = 2.0, depth = 0.003, c = alpha * k * depth;
   const Plate p(20, 0.002);
-  const ProbeContact contact(p.triangles, p.x, r, k, 0.02, c);
+  const ProbeContact contact(p.triangles, p.x, r, k, 0.02, alpha);
   const Vec3 tip(0.0003, -0.0002, r - depth);
   for (const double u : {0.0, 0.4, -0.7, -5.0})
     for (const double w : {0.0, -0.1}) {

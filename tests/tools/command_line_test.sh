@@ -39,8 +39,8 @@ echo '{"organ": {"mesh": "x.msh", "material": "m.json", "added_mass_fraction": 2
 expect server-bad-mass-scaling 2 "heavy_scene.json: organ.added_mass_fraction: 2 is outside" -- "$server" --scene "$tmp/heavy_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json", "physics_threads": 1.5}, "instruments": [{"id": 1}]}' >"$tmp/threads_scene.json"
 expect server-bad-threads 2 "threads_scene.json: organ.physics_threads: 1.5 is not a whole number" -- "$server" --scene "$tmp/threads_scene.json"
-echo '{"organ": {"mesh": "x.msh", "material": "m.json", "contact_damping_n_s_per_m": -1}, "instruments": [{"id": 1}]}' >"$tmp/damping_scene.json"
-expect server-bad-damping 2 "damping_scene.json: organ.contact_damping_n_s_per_m: -1 is outside" -- "$server" --scene "$tmp/damping_scene.json"
+echo '{"organ": {"mesh": "x.msh", "material": "m.json", "contact_damping_s_per_m": -1}, "instruments": [{"id": 1}]}' >"$tmp/damping_scene.json"
+expect server-bad-damping 2 "damping_scene.json: organ.contact_damping_s_per_m: -1 is outside" -- "$server" --scene "$tmp/damping_scene.json"
 expect server-bad-duration 2 "'soon' is not a non-negative number" -- "$server" --scene x --duration soon
 expect server-bad-scene-dir 2 "--scene-dir: '/nonexistent' is not a directory" -- "$server" --scene x --scene-dir /nonexistent
 expect hc-help 0 "Usage: haptic-client" -- "$hc" --help
