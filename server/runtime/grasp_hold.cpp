@@ -10,15 +10,18 @@ GraspHold::GraspHold(const Vec3& tip, const Eigen::Quaterniond& tool, std::span<
     if ((x[n] - tip).norm() < radius_m) held_.emplace_back(n, to_tool * (x[n] - tip));
 }
 
-GraspHold::Reaction GraspHold::apply(const Vec3& tip, const Eigen::Quaterniond& tool, std::span<const Vec3> x, std::span<Vec3> f,
-                                     std::span<double> node_stiffness) const {
+GraspHold::Reaction GraspHold::apply(const Vec3& tip, const Eigen::Quaterniond& tool, const Vec3& tool_velocity,
+                                     const tissue::BoundaryConditions::FieldEvaluation& field) const {
   const Eigen::Matrix3d R = tool.toRotationMatrix();
+  const bool moving = !field.v.empty();
   Reaction r;
   for (const auto& [node, local] : held_) {
-    const Vec3 arm = R * local;                              // from the tip to the node's anchor
-    const Vec3 pull = stiffness_ * (tip + arm - x[node]);   // on the node
-    if (!f.empty()) f[node] += pull;
-    if (!node_stiffness.empty()) node_stiffness[node] += stiffness_;
+    const Vec3 arm = R * local;  // from the tip to the node's anchor
+    Vec3 stretch = tip + arm - field.x[node];
+    if (moving) stretch += field.dt_s * (tool_velocity - field.v[node]);  // at the end of the step
+    const Vec3 pull = stiffness_ * stretch;  // on the node
+    if (!field.f.empty()) field.f[node] += pull;
+    if (!field.stiffness.empty()) field.stiffness[node] += stiffness_;
     r.force_on_tool -= pull;
     r.torque_on_tool -= arm.cross(pull);
   }

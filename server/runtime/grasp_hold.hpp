@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "integrator/boundary_conditions.hpp"
 #include "mesh/tet_mesh.hpp"
 
 namespace viscera::runtime {
@@ -31,10 +32,17 @@ class GraspHold {
     Vec3 force_on_tool = Vec3::Zero();   ///< [N]
     Vec3 torque_on_tool = Vec3::Zero();  ///< about the tip [N m]
   };
-  /// The springs for the tool at (tip, tool): adds their forces on the nodes to f and their
-  /// stiffness to node_stiffness (either may be empty: a query), returns the reaction on the tool.
-  Reaction apply(const Vec3& tip, const Eigen::Quaterniond& tool, std::span<const Vec3> x, std::span<Vec3> f = {},
-                 std::span<double> node_stiffness = {}) const;
+  /// The springs' forces on the organ during one explicit step (the integrator's force field,
+  /// tissue::BoundaryConditions::FieldEvaluation) for the tool at (tip, tool) moving at
+  /// tool_velocity: each spring at the extension predicted for the end of the step (backward Euler;
+  /// its anchor moves with the tip, the tool's turn within one step neglected), added to field.f,
+  /// k to field.stiffness. Returns the reaction on the tool.
+  Reaction apply(const Vec3& tip, const Eigen::Quaterniond& tool, const Vec3& tool_velocity,
+                 const tissue::BoundaryConditions::FieldEvaluation& field) const;
+  /// The reaction for the tool at (tip, tool) on the organ at x, changing nothing.
+  Reaction query(const Vec3& tip, const Eigen::Quaterniond& tool, std::span<const Vec3> x) const {
+    return apply(tip, tool, Vec3::Zero(), {x, {}, {}, {}, {}, 0.0});
+  }
 
  private:
   std::vector<std::pair<std::int32_t, Vec3>> held_;  // node, its point in the tool frame

@@ -46,8 +46,10 @@ ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, std::span<cons
   }
 }
 
-ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f, std::span<double> node_stiffness,
-                                  std::span<const Vec3> v, const Vec3& tool_velocity, std::span<double> node_damping) const {
+ContactResult ProbeContact::apply(const Vec3& centre, const Vec3& tool_velocity, const tissue::BoundaryConditions::FieldEvaluation& field) const {
+  const auto x = field.x, v = field.v;
+  const auto f = field.f;
+  const auto node_stiffness = field.stiffness, node_damping = field.damping;
   ContactResult r;
   // First pass: the triangles the tip sphere touches, with their depths.
   touching_.clear();
@@ -86,18 +88,21 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
   // along its normal), never pulling. Per triangle, so the damping is symmetric and only removes
   // energy (one rate applied to every triangle can feed a triangle moving against it). The
   // dashpot grows with the depth (Hunt and Crossley 1975: k d (1 + alpha rate)), so the force is
-  // continuous when contact begins: a dashpot of fixed strength jumps at the first touch.
-  const bool damped = damping_ > 0 && !v.empty();
+  // continuous when contact begins: a dashpot of fixed strength jumps at the first touch. The
+  // spring's own part, k dt rate, is the depth it will have at the end of the step (backward
+  // Euler); it changes the force at the first touch by k dt rate only.
+  const bool moving = !v.empty();
   const double dashpot = damping_ * stiffness_ * r.depth_m;  // [N s/m]
+  const double rate_gain = moving ? dashpot + stiffness_ * field.dt_s : 0.0;  // [N s/m]
   Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
   Vec3 weighted_point = Vec3::Zero();
   for (const auto& c : touching_) {
     const double share = c.depth / total;
     double normal_force = stiffness_ * r.depth_m * share;
-    if (damped) {
+    if (rate_gain > 0) {
       const auto& t = surface_[c.triangle];
       const Vec3 vq = c.weights[0] * v[t[0]] + c.weights[1] * v[t[1]] + c.weights[2] * v[t[2]];
-      normal_force = std::max(0.0, normal_force + dashpot * share * (vq - tool_velocity).dot(c.normal));
+      normal_force = std::max(0.0, normal_force + rate_gain * share * (vq - tool_velocity).dot(c.normal));
     }
     const Vec3 push = normal_force * c.normal;  // on the tool, out of the tissue
     const auto& t = surface_[c.triangle];
@@ -105,7 +110,7 @@ ContactResult ProbeContact::apply(const Vec3& centre, std::span<const Vec3> x, s
       for (int k = 0; k < 3; ++k) f[t[k]] -= c.weights[k] * push;
     if (!node_stiffness.empty())
       for (int k = 0; k < 3; ++k) node_stiffness[t[k]] += std::sqrt(3.0) * stiffness_ * share * c.weights[k];
-    if (damped && !node_damping.empty())
+    if (moving && dashpot > 0 && !node_damping.empty())
       for (int k = 0; k < 3; ++k) node_damping[t[k]] += std::sqrt(3.0) * dashpot * share * c.weights[k];
     r.force_on_tool += push;
     K += stiffness_ * share * c.normal * c.normal.transpose();

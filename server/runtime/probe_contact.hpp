@@ -6,8 +6,10 @@
 // the touched triangles in proportion to their depths, so it does not depend on how finely the
 // surface is meshed. A normal dashpot (Hunt-Crossley: k d (1 + alpha rate)) adds, for each touched
 // triangle, alpha k d times its share times its rate of penetration (its contact point's velocity
-// relative to the tool, along its normal), never pulling: without it the penalty spring and the surface's own mass ring at a few hundred Hz,
-// above the tissue's viscoelastic band, and the tool feels it as buzz.
+// relative to the tool, along its normal), never pulling: without it the penalty spring and the
+// surface's own mass ring at a few hundred Hz, above the tissue's viscoelastic band, and the tool
+// feels it as buzz. During a step each triangle's spring acts at the depth predicted for the end of
+// the step (its depth plus dt times its rate), so the integrator takes it by backward Euler.
 // Because s keeps decreasing (and goes negative) when the centre passes below the surface, a tip
 // that moved deeper than its radius within one step is still pushed out along the normal: it does
 // not tunnel (triangles whose plane is more than `max_depth` behind the tip are ignored, so the
@@ -17,6 +19,7 @@
 #include <span>
 #include <vector>
 
+#include "integrator/boundary_conditions.hpp"
 #include "mesh/boundary_surface.hpp"
 
 namespace viscera::runtime {
@@ -44,13 +47,17 @@ class ProbeContact {
   /// longest rest edge: an edge stretched beyond 3x fails the integration's strain check first).
   ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
                double max_depth_m = 0.02, double damping_s_per_m = 0.0);
-  /// Adds the penalty forces on the organ to f for the tip at `centre`, and to `node_stiffness`
-  /// (if not empty) a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row
-  /// sum); returns the reaction. With node velocities v (and the tool's), the dashpot acts too and
-  /// `node_damping` gets sqrt(3) alpha k d share w. With an empty f it only queries the reaction (the state
-  /// is not changed). Not for concurrent calls on one object (it reuses a scratch list).
-  ContactResult apply(const Vec3& centre, std::span<const Vec3> x, std::span<Vec3> f, std::span<double> node_stiffness = {},
-                      std::span<const Vec3> v = {}, const Vec3& tool_velocity = Vec3::Zero(), std::span<double> node_damping = {}) const;
+  /// The contact's forces on the organ during one explicit step (the integrator's force field,
+  /// tissue::BoundaryConditions::FieldEvaluation): adds the penalty forces to field.f and to
+  /// field.stiffness a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row
+  /// sum); with velocities, the dashpot acts too and field.damping gets sqrt(3) alpha k d share w.
+  /// Each triangle's spring is taken at the depth predicted for the end of the step,
+  /// d + dt_s rate (backward Euler in the spring, as FieldEvaluation asks). Returns the reaction.
+  /// Not for concurrent calls on one object (it reuses a scratch list).
+  ContactResult apply(const Vec3& centre, const Vec3& tool_velocity, const tissue::BoundaryConditions::FieldEvaluation& field) const;
+  /// The reaction for the tip at `centre` on the organ at x, changing nothing: the spring alone
+  /// (no velocities, so no dashpot).
+  ContactResult query(const Vec3& centre, std::span<const Vec3> x) const { return apply(centre, Vec3::Zero(), {x, {}, {}, {}, {}, 0.0}); }
 
  private:
   struct Touch {

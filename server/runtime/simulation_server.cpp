@@ -187,10 +187,7 @@ struct SimulationServer::Impl {
   }
 
   /// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.
-  static void add_grasp(ContactResult& result, const GraspHold& hold, const Vec3& tip, const proto::Command& command, std::span<const Vec3> x,
-                        std::span<Vec3> f = {}, std::span<double> stiffness = {}) {
-    if (hold.empty()) return;
-    const auto r = hold.apply(tip, orientation(command), x, f, stiffness);
+  static void add_grasp(ContactResult& result, const GraspHold::Reaction& r) {
     result.force_on_tool += r.force_on_tool;
     result.torque_on_tool += r.torque_on_tool;
     result.in_contact = true;
@@ -204,8 +201,8 @@ struct SimulationServer::Impl {
         inst.result = {};
         continue;
       }
-      inst.result = inst.contact->apply(inst.proxy, e.x, e.f, e.stiffness, e.v, inst.proxy_velocity, e.damping);
-      add_grasp(inst.result, inst.grasped, inst.proxy, inst.tick, e.x, e.f, e.stiffness);
+      inst.result = inst.contact->apply(inst.proxy, inst.proxy_velocity, e);
+      if (!inst.grasped.empty()) add_grasp(inst.result, inst.grasped.apply(inst.proxy, orientation(inst.tick), inst.proxy_velocity, e));
     }
   }
 
@@ -509,8 +506,9 @@ struct SimulationServer::Impl {
     for (const auto& u : updated) {
       const auto& p = u.command.tip_position;
       const Vec3 tip(p[0], p[1], p[2]);
-      ContactResult result = instruments.at(u.id).query->apply(tip, snap->x, {});
-      if (const auto g = snap->grasped.find(u.id); g != snap->grasped.end()) add_grasp(result, g->second, tip, u.command, snap->x);
+      ContactResult result = instruments.at(u.id).query->query(tip, snap->x);
+      if (const auto g = snap->grasped.find(u.id); g != snap->grasped.end() && !g->second.empty())
+        add_grasp(result, g->second.query(tip, orientation(u.command), snap->x));
       publish_force(u.id, u.owner, u.command, result, 0);
     }
   }

@@ -35,7 +35,7 @@ TEST(ProbeContact, OneSpringAtTheDeepestPenetrationWhateverTheMeshing) {
     std::vector<Vec3> f(p.x.size(), Vec3::Zero());
     for (const double depth : {0.001, 0.004, 0.009, 0.015}) {  // the last two: centre below the surface
       std::fill(f.begin(), f.end(), Vec3::Zero());
-      const ContactResult c = contact.apply(Vec3(0.0003, -0.0002, r - depth), p.x, f);
+      const ContactResult c = contact.apply(Vec3(0.0003, -0.0002, r - depth), Vec3::Zero(), {p.x, {}, f, {}, {}, 0.0});
       ASSERT_TRUE(c.in_contact) << "h " << h << " depth " << depth;
       EXPECT_NEAR(c.force_on_tool.z(), k * depth, 1e-9) << "h " << h << " depth " << depth;
       EXPECT_NEAR(c.force_on_tool.head<2>().norm(), 0.0, 1e-12);
@@ -44,8 +44,8 @@ TEST(ProbeContact, OneSpringAtTheDeepestPenetrationWhateverTheMeshing) {
       for (const auto& v : f) on_plate += v;
       EXPECT_NEAR((on_plate + c.force_on_tool).norm(), 0.0, 1e-9) << "action and reaction";
     }
-    EXPECT_FALSE(contact.apply(Vec3(0, 0, r + 1e-4), p.x, {}).in_contact);     // just above
-    EXPECT_FALSE(contact.apply(Vec3(0, 0, -0.0201), p.x, {}).in_contact);  // centre beyond the 2 cm depth limit
+    EXPECT_FALSE(contact.query(Vec3(0, 0, r + 1e-4), p.x).in_contact);     // just above
+    EXPECT_FALSE(contact.query(Vec3(0, 0, -0.0201), p.x).in_contact);  // centre beyond the 2 cm depth limit
   }
 }
 
@@ -56,7 +56,7 @@ TEST(ProbeContact, BroadPhaseFindsContactOnAStretchedSurface) {
   std::vector<Vec3> stretched = rest.x;
   for (auto& v : stretched) v.head<2>() *= 2.5;  // every edge 2.5x its rest length
   for (const double xy : {0.0, 0.013, 0.041, 0.087}) {
-    const ContactResult c = contact.apply(Vec3(xy, -0.6 * xy, r - 0.002), stretched, {});
+    const ContactResult c = contact.query(Vec3(xy, -0.6 * xy, r - 0.002), stretched);
     ASSERT_TRUE(c.in_contact) << "tip over (" << xy << ", " << -0.6 * xy << ")";
     EXPECT_NEAR(c.force_on_tool.z(), k * 0.002, 1e-9);
   }
@@ -64,21 +64,23 @@ TEST(ProbeContact, BroadPhaseFindsContactOnAStretchedSurface) {
 
 TEST(ProbeContact, HuntCrossleyDashpotGrowsWithDepthAndRateAndNeverPulls) {
   // Closed form: a plate moving up at u into a tool moving at w: the depth grows at u - w, the
-  // normal force is k d (1 + alpha (u - w)), and never below zero when the surface leaves faster
-  // than the spring pushes. Each node's damping bound is sqrt(3) alpha k d share w_node (the
-  // Gershgorin row sum).
+  // normal force is k (d + dt (u - w)) + alpha k d (u - w) (the spring at the depth the step will
+  // end at, and the dashpot), and never below zero when the surface leaves faster than the spring
+  // pushes. Each node's damping bound is sqrt(3) alpha k d share w_node (the Gershgorin row sum):
+  // the spring's predicted part is not a damping the integrator adds, it is backward Euler's.
   const double r = 0.006, k = 1000.0, alpha = 2.0, depth = 0.003, c = alpha * k * depth;
   const Plate p(20, 0.002);
   const ProbeContact contact(p.triangles, p.x, r, k, 0.02, alpha);
   const Vec3 tip(0.0003, -0.0002, r - depth);
+  for (const double dt : {0.0, 4e-4})
   for (const double u : {0.0, 0.4, -0.7, -5.0})
     for (const double w : {0.0, -0.1}) {
       const std::vector<Vec3> v(p.x.size(), Vec3(0.01, 0.0, u));  // sliding along the plate changes nothing
       std::vector<Vec3> f(p.x.size(), Vec3::Zero());
       std::vector<double> stiffness(p.x.size(), 0.0), damping(p.x.size(), 0.0);
-      const ContactResult res = contact.apply(tip, p.x, f, stiffness, v, Vec3(0.02, 0, w), damping);
-      const double expected = std::max(0.0, k * depth + c * (u - w));
-      EXPECT_NEAR(res.force_on_tool.z(), expected, 1e-9) << "u " << u << " w " << w;
+      const ContactResult res = contact.apply(tip, Vec3(0.02, 0, w), {p.x, v, f, stiffness, damping, dt});
+      const double expected = std::max(0.0, k * (depth + dt * (u - w)) + c * (u - w));
+      EXPECT_NEAR(res.force_on_tool.z(), expected, 1e-9) << "u " << u << " w " << w << " dt " << dt;
       Vec3 on_plate = Vec3::Zero();
       for (const auto& x : f) on_plate += x;
       EXPECT_NEAR((on_plate + res.force_on_tool).norm(), 0.0, 1e-9);
@@ -91,5 +93,5 @@ TEST(ProbeContact, HuntCrossleyDashpotGrowsWithDepthAndRateAndNeverPulls) {
       EXPECT_NEAR(stiff, std::sqrt(3.0) * k, 1e-9);
     }
   // Without velocities (the command thread's query) the contact is the spring alone.
-  EXPECT_NEAR(contact.apply(tip, p.x, {}).force_on_tool.z(), k * depth, 1e-9);
+  EXPECT_NEAR(contact.query(tip, p.x).force_on_tool.z(), k * depth, 1e-9);
 }

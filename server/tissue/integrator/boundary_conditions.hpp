@@ -48,11 +48,21 @@ struct BoundaryConditions {
   /// [N/m], at least the Gershgorin row sum of -df/dx) and on its damping (`damping` [N s/m], the
   /// same for -df/dv); the explicit integrator treats those parts implicitly, so the field never
   /// limits the step. Explicit integrator only.
+  ///
+  /// Springs: a field evaluates each spring at the extension predicted for the end of the step,
+  /// k (e + dt_s de/dt) with the rate from v (relative to whatever the spring is anchored to), and
+  /// reports k in `stiffness`. The integrator's update (m + dt^2 k) v' = (m + dt^2 k) v + dt f
+  /// then reads (m + dt^2 k) v' = m v + dt (f_other - k e): backward Euler in the spring, which
+  /// only removes energy, also when springs come and go from one step to the next (contact). A
+  /// spring taken at its current extension alone is integrated with the added mass dt^2 k only:
+  /// stable while it stays, but when contact switches on and off at the step's time scale the
+  /// changing mass pumps energy into the surface (seen on the 12k liver with mass scaling).
   struct FieldEvaluation {
     std::span<const Vec3> x, v;   ///< positions [m], velocities [m/s]
     std::span<Vec3> f;            ///< forces to add to [N]
     std::span<double> stiffness;  ///< per node [N/m]
     std::span<double> damping;    ///< per node [N s/m]
+    double dt_s = 0.0;            ///< the step these forces will be integrated over [s]
   };
   std::function<void(const FieldEvaluation&)> force_field;
 

@@ -57,7 +57,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   if (bc_.force_field) {
     std::fill(field_stiffness_.begin(), field_stiffness_.end(), 0.0);
     std::fill(field_damping_.begin(), field_damping_.end(), 0.0);
-    bc_.force_field({state.x, state.v, force_, field_stiffness_, field_damping_});
+    bc_.force_field({state.x, state.v, force_, field_stiffness_, field_damping_, dt});
     stiff_field = std::any_of(field_stiffness_.begin(), field_stiffness_.end(), [](double k) { return k > 0; }) ||
                   std::any_of(field_damping_.begin(), field_damping_.end(), [](double c) { return c > 0; });
   }
