@@ -6,10 +6,11 @@
 // the touched triangles in proportion to their depths, so it does not depend on how finely the
 // surface is meshed. A normal dashpot (Hunt-Crossley: k d (1 + alpha rate)) adds, for each touched
 // triangle, alpha k d times its share times its rate of penetration (its contact point's velocity
-// relative to the tool, along its normal), never pulling: without it the penalty spring and the
-// surface's own mass ring at a few hundred Hz, above the tissue's viscoelastic band, and the tool
-// feels it as buzz. During a step each triangle's spring acts at the depth predicted for the end of
-// the step (its depth plus dt times its rate), so the integrator takes it by backward Euler.
+// relative to the tool, along its normal), never pulling: it damps what the penalty spring and
+// the surface's own mass still ring at, above the tissue's viscoelastic band. During a step each
+// triangle's spring acts at the depth predicted for the end of the step (its depth plus dt times
+// its rate), so the integrator takes it by backward Euler (BoundaryConditions::FieldEvaluation):
+// taken at the current depth, contact switching on and off pumped energy into the surface.
 // Because s keeps decreasing (and goes negative) when the centre passes below the surface, a tip
 // that moved deeper than its radius within one step is still pushed out along the normal: it does
 // not tunnel (triangles whose plane is more than `max_depth` behind the tip are ignored, so the
