@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "common/input_error.hpp"
 #include "gps/fung_map.hpp"
 #include "gps/gps_model.hpp"
 #include "integrator/implicit_integrator.hpp"
 #include "mesh/box_mesh.hpp"
+#include "model/model_factory.hpp"
 #include "integrator/explicit_integrator.hpp"
 #include "material/material_file.hpp"
 #include "test_support.hpp"
@@ -273,9 +275,41 @@ TEST(MaterialFile, ViscoelasticFieldsAreCheckedByName) {
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "mechanisms": 9}})").find("viscoelasticity.mechanisms"), std::string::npos);
   EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": -3000, "poisson_ratio": 0.3}})").find("youngs_modulus_pa"), std::string::npos);
   EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 3000, "poisson_ratio": 0.5}})").find("poisson_ratio"), std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energetic"}})").find("tissue.json: viscoelasticity.qlv_form"), std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energy", "compression_ratio": 0}})").find("viscoelasticity.compression_ratio"), std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "compression_ratio": 2}})").find("viscoelasticity.compression_ratio: 2 needs \"qlv_form\": \"energy\""), std::string::npos);
   const Material m = parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "bulk_q": 20, "band_hz": [0.01, 10], "mechanisms": 3, "reference_frequency_hz": 2}})", "ok.json");
   ASSERT_TRUE(m.viscoelasticity.has_value());
   EXPECT_EQ(m.viscoelasticity->mechanisms, 3);
+}
+
+TEST(MaterialFile, FungStiffeningInItsEnergyFormReachesTheModelAsAConservativeResponse) {
+  // "qlv_form": "energy" (and an asymmetry) from the file to the organ's GPS: stretched 15% along x
+  // and 5% shortened along z, its tangent is symmetric (the forces are an energy's gradient); the
+  // published edge map's is not (its edges stiffen by different factors).
+  const std::string head = R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 3000, "poisson_ratio": 0.3}, )";
+  std::mt19937_64 rng(5);
+  const auto rest = test::random_tet(rng);
+  std::vector<Vec3> x(rest.begin(), rest.end());
+  for (auto& p : x) p = Vec3(1.15 * p.x(), p.y(), 0.95 * p.z());
+  const auto asymmetry = [&](const std::string& form) {
+    const Material m = parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "bulk_q": 4.8, "qlv_stiffening": 8)" + form + "}}", "fung.json");
+    const ViscoelasticSetup ve = make_viscoelastic(m.elasticity, *m.viscoelasticity);
+    const auto model = make_force_model("gps_energy", test::single_tet_mesh(rest), {ve.unrelaxed_elasticity}, 0.5, ve.gps);
+    const Mat12 K = model->element_tangent(x, 0);
+    return (K - K.transpose()).norm() / K.norm();
+  };
+  EXPECT_LT(asymmetry(R"(, "qlv_form": "energy", "compression_ratio": 2)"), 1e-12);
+  EXPECT_LT(asymmetry(R"(, "qlv_form": "energy")"), 1e-12);
+  EXPECT_GT(asymmetry(""), 1e-4);  // the default: the published edge map
+  // The energy form relaxes the whole tension: a bulk that does not relax as the shear is refused.
+  const Material elastic_bulk = parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_stiffening": 8, "qlv_form": "energy"}})", "fung.json");
+  try {
+    make_viscoelastic(elastic_bulk.elasticity, *elastic_bulk.viscoelasticity, "fung.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fung.json: qlv_form"), std::string::npos) << e.what();
+  }
 }
 
 TEST(GpsMemoryVariables, ImplicitIntegratorCarriesTheMemoryAsTheExplicitOneDoes) {

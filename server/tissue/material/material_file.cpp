@@ -95,6 +95,19 @@ Material parse_material(const std::string& text, const std::string& source) {
       if (!(spec.qlv_stiffening >= 0))
         throw InputError(source, 0, "viscoelasticity.qlv_stiffening", v["qlv_stiffening"].dump() + " must be >= 0");
     }
+    if (v.contains("qlv_form")) {
+      const json& f = v["qlv_form"];
+      if (f == "energy") spec.qlv_form = GpsViscoelasticity::QlvForm::energy;
+      else if (f != "edge_map")
+        throw InputError(source, 0, "viscoelasticity.qlv_form", f.dump() + " is not \"edge_map\" or \"energy\"");
+    }
+    if (v.contains("compression_ratio")) {
+      spec.compression_ratio = number(v, "compression_ratio", source, "viscoelasticity.");
+      if (!(spec.compression_ratio > 0))
+        throw InputError(source, 0, "viscoelasticity.compression_ratio", v["compression_ratio"].dump() + " must be positive");
+      if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsViscoelasticity::QlvForm::energy)
+        throw InputError(source, 0, "viscoelasticity.compression_ratio", v["compression_ratio"].dump() + " needs \"qlv_form\": \"energy\"");
+    }
     m.viscoelasticity = spec;
   }
   return m;

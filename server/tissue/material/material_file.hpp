@@ -6,8 +6,8 @@
 // fibre_youngs_modulus_pa, fibre_plane_poisson_ratio, fibre_shear_modulus_pa, fibre_direction [x,y,z].
 // Optional "viscoelasticity": { "model": "constant_q" | "kelvin_voigt", "shear_q": 4.8,
 //   "bulk_q": 20 (absent: no bulk relaxation), "band_hz": [0.01, 10], "mechanisms": 3,
-//   "reference_frequency_hz": 2, "qlv_stiffening": 0 } -- the elastic constants are then the
-// moduli at the reference frequency.
+//   "reference_frequency_hz": 2, "qlv_stiffening": 0, "qlv_form": "edge_map" | "energy",
+//   "compression_ratio": 1 } -- the elastic constants are then the moduli at the reference frequency.
 #include <optional>
 #include <string>
 

@@ -25,8 +25,19 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
     throw InputError(source, 0, "qlv_stiffening", std::to_string(spec.qlv_stiffening) + " must be >= 0");
   if (!(spec.reference_frequency_hz > 0))
     throw InputError(source, 0, "reference_frequency_hz", std::to_string(spec.reference_frequency_hz) + " must be positive");
+  if (!(spec.compression_ratio > 0) || !std::isfinite(spec.compression_ratio))
+    throw InputError(source, 0, "compression_ratio", std::to_string(spec.compression_ratio) + " must be a positive number");
+  if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsViscoelasticity::QlvForm::energy)
+    throw InputError(source, 0, "compression_ratio", std::to_string(spec.compression_ratio) + " needs \"qlv_form\": \"energy\"");
+  if (spec.qlv_form == GpsViscoelasticity::QlvForm::energy && spec.model == ViscoelasticSpec::Model::constant_q &&
+      (spec.qlv_stiffening > 0 || spec.compression_ratio != 1.0) && spec.bulk_q != spec.shear_q)
+    throw InputError(source, 0, "qlv_form",
+                     "\"energy\" relaxes the whole elastic tension, so it needs bulk_q equal to shear_q (" +
+                         (spec.bulk_q ? std::to_string(*spec.bulk_q) : std::string("absent")) + " against " + std::to_string(spec.shear_q) + ")");
   ViscoelasticSetup out;
   out.gps.qlv_stiffening = spec.qlv_stiffening;
+  out.gps.qlv_form = spec.qlv_form;
+  out.gps.compression_ratio = spec.compression_ratio;
   const Mat6 D_vol = volumetric_part(D), D_dev = D - D_vol;
   const double w_ref = 2 * M_PI * spec.reference_frequency_hz;
   if (spec.model == ViscoelasticSpec::Model::kelvin_voigt) {
@@ -47,7 +58,11 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
   out.gps.omega_rad_s = out.shear_fit.solids.omega_rad_s;
   out.gps.shear_weight = out.shear_fit.solids.weight;
   double bulk_factor = 1.0;
-  if (spec.bulk_q) {
+  const bool bulk_as_shear = spec.bulk_q && *spec.bulk_q == spec.shear_q;
+  if (bulk_as_shear) {  // the same dimensionless fit: the weights are the shear's exactly
+    out.gps.bulk_weight = out.gps.shear_weight;
+    bulk_factor = shear_factor;
+  } else if (spec.bulk_q) {
     ConstantQTarget bulk = shear;
     bulk.q = *spec.bulk_q;
     bulk.modulus_pa = reuss_bulk_modulus(D);
@@ -60,7 +75,9 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
   }
   out.unrelaxed_elasticity = shear_factor * D_dev + bulk_factor * D_vol;
   out.table = "shear: " + describe(out.shear_fit, shear);
-  if (out.bulk_fit) {
+  if (bulk_as_shear) {
+    out.table += "bulk: relaxes as the shear (the same Q, frequencies and weights)\n";
+  } else if (out.bulk_fit) {
     ConstantQTarget bulk = shear;
     bulk.q = *spec.bulk_q;
     bulk.modulus_pa = reuss_bulk_modulus(D);
