@@ -16,10 +16,6 @@ namespace viscera::lab {
 using namespace viscera::tissue;
 
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
-  if (m.has(Mechanism::first_load_softening)) {
-    *why = "the GPS has no first-load softening yet (it needs the strain history per edge): not simulated on the specimen";
-    return false;
-  }
   const bool shaped = m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry);
   if (shaped && mode == Mode::simple_shear) {
     *why = "the law's elastic shape differs between positive and negative shear (exp(B gamma), or a compression ratio); an "
@@ -216,6 +212,8 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
       }
   ve.bulk_weight = ve.shear_weight;
   ve.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
+  // Per edge, as the law per specimen: under the mode's proportional loading the same factor.
+  if (m.has(Mechanism::first_load_softening)) ve.first_load_softening = m.softening_d;
   if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
     // Conservative (energy) form, with its constants calibrated to the law's elastic curve.
     r.shape = calibration ? *calibration : calibrate_elastic_shape(m, d);

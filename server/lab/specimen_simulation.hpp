@@ -40,10 +40,10 @@ struct SpecimenResult {
   ShapeCalibration shape;  ///< when the model stiffens or is asymmetric
 };
 
-/// Which models the GPS can represent: Kelvin-Voigt, memory variables (broadband), Fung
-/// stiffening and tension/compression asymmetry under uniaxial loading (the GPS's energy form,
-/// calibrated: see ShapeCalibration); not those in simple shear (no isotropic solid has them),
-/// not first-load softening.
+/// Which models the GPS can represent: Kelvin-Voigt, memory variables (broadband), first-load
+/// softening (per edge, GpsViscoelasticity::first_load_softening), Fung stiffening and
+/// tension/compression asymmetry under uniaxial loading (the GPS's energy form, calibrated: see
+/// ShapeCalibration); not those two in simple shear (no isotropic solid has them).
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why);
 
 /// `calibration`: calibrate_elastic_shape(m, d), if already known (it is computed otherwise).

@@ -173,6 +173,92 @@ TEST(GpsMemoryVariables, StepStressCreepsAsTheClosedForm) {
   EXPECT_LT(worst, 1e-6);
 }
 
+TEST(FirstLoadSoftening, AnElementUnderProportionalLoadingSoftensAsTheLaw) {
+  // A tetrahedron under a homogeneous deformation a G (every edge strain proportional to a): its
+  // generalised force against the unsoftened element's at the same a must be the law's factor,
+  // 1 - d (1 - |a| / m) below the largest |a| seen in the same sense, 1 on the virgin curve, with
+  // separate extremes in tension and compression. Loading 0 -> A -> 0 -> A/2 -> A -> 1.5 A, then
+  // the same in compression (the tension extreme stays).
+  const double d = 0.4, A = 1e-4;
+  const std::array<Vec3, 4> rest{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0), Vec3(0.005, 0.00289, 0.00816)};
+  GpsOptions soft;
+  soft.viscoelasticity.first_load_softening = d;
+  const GpsModel softened(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, soft);
+  const GpsModel virgin(test::single_tet_mesh(rest), {test::soft_tissue()});
+  Mat3 G = Mat3::Zero();
+  G(0, 0) = 1.0;
+  G(1, 1) = G(2, 2) = -0.3;  // uniaxial stretch with lateral contraction
+  const auto mode_force = [&](const ForceModel& m, double a, std::vector<double>* memory) {
+    std::vector<Vec3> x, f(4, Vec3::Zero());
+    for (const auto& p : rest) x.push_back(p + a * G * p);
+    if (memory) m.add_forces(x, f, {*memory, *memory, 1e-3});
+    else m.add_forces(x, f);
+    double s = 0;
+    for (int i = 0; i < 4; ++i) s += f[i].dot(G * rest[i]);
+    return s;
+  };
+  std::vector<double> memory(softened.memory_size(), 0.0);
+  ASSERT_EQ(memory.size(), static_cast<std::size_t>(3 * 6 * GpsModel::kLanes));  // previous elongations and two extremes
+  double peak_t = 0, peak_c = 0, worst = 0;
+  int softened_samples = 0;
+  const auto go = [&](double from, double to) {
+    for (int k = 1; k <= 50; ++k) {
+      const double a = from + (to - from) * k / 50.0;
+      const double ratio = mode_force(softened, a, &memory) / mode_force(virgin, a, nullptr);
+      const double peak = a >= 0 ? peak_t : peak_c;
+      const double expected = std::abs(a) < peak ? 1.0 - d * (1.0 - std::abs(a) / peak) : 1.0;
+      if (expected < 1.0) ++softened_samples;
+      worst = std::max(worst, std::abs(ratio - expected));
+      (a >= 0 ? peak_t : peak_c) = std::max(peak, std::abs(a));
+    }
+  };
+  go(0, A);
+  go(A, 0);
+  go(0, A / 2);
+  go(A / 2, 1.5 * A);
+  go(1.5 * A, -A);
+  go(-A, -0.3 * A);
+  go(-0.3 * A, 1.2 * A);
+  std::cout << "[ figure ] first-load softening d = " << d << " on one element, " << softened_samples
+            << " softened samples: largest difference from the law's factor " << worst << "\n";
+  EXPECT_GT(softened_samples, 100);
+  EXPECT_LT(worst, 1e-3);  // edge strains are proportional to a up to O(a)
+}
+
+TEST(FirstLoadSoftening, TangentIsTheDerivativeOfTheForcesAtTheExtremesTheStepStartedWith) {
+  // Central differences of the forces (memory advanced from the same `before` each time) against
+  // element_tangent(x, e, dt, before), for the paper-form map and the energy form with stiffening.
+  std::mt19937_64 rng(31);
+  const auto rest = test::random_tet(rng);
+  for (const bool energy : {false, true}) {
+    GpsOptions o{GpsVariant::energy_consistent, 0.0};
+    o.viscoelasticity.first_load_softening = 0.5;
+    o.viscoelasticity.qlv_stiffening = 6.0;
+    if (energy) o.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+    const GpsModel model(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, o);
+    std::vector<double> before(model.memory_size(), 0.0);
+    std::vector<Vec3> x(rest.begin(), rest.end()), f(4);
+    for (auto& p : x) p = 1.06 * p + 0.002 * Vec3::Random();  // the extremes: a larger deformation first
+    model.add_forces(x, f, {before, before, 1e-3});
+    for (int i = 0; i < 4; ++i) x[i] = rest[i] + 0.4 * (x[i] - rest[i]) + 0.0005 * Vec3::Random();  // below them
+    const Mat12 K = model.element_tangent(x, 0, 1e-3, before);
+    Mat12 fd;
+    const double h = 1e-8;
+    std::vector<double> scratch(before.size());
+    for (int c = 0; c < 12; ++c) {
+      std::vector<Vec3> xp = x, xm = x, fp(4, Vec3::Zero()), fm(4, Vec3::Zero());
+      xp[c / 3][c % 3] += h;
+      xm[c / 3][c % 3] -= h;
+      model.add_forces(xp, fp, {before, scratch, 1e-3});
+      model.add_forces(xm, fm, {before, scratch, 1e-3});
+      for (int r = 0; r < 12; ++r) fd(r, c) = -(fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h);
+    }
+    const Mat12 unsoftened = model.element_tangent(x, 0, 1e-3);
+    EXPECT_LT((K - fd).norm(), 1e-5 * fd.norm()) << (energy ? "energy" : "edge map");
+    EXPECT_GT((unsoftened - fd).norm(), 1e-2 * fd.norm()) << "the softening matters here";
+  }
+}
+
 TEST(GpsMemoryVariables, HysteresisLoopsGiveOneOverQAcrossTheBand) {
   const Element el(4, std::nullopt);
   const Mat3 G = pure_shear();

@@ -35,6 +35,8 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   const bool bulk_differs = !ve.bulk_weight.empty() && ve.bulk_weight != ve.shear_weight;
   if (!(ve.compression_ratio > 0) || (ve.compression_ratio != 1.0 && ve.qlv_form != GpsViscoelasticity::QlvForm::energy))
     throw std::invalid_argument("GpsModel: compression_ratio must be positive, and needs the energy form");
+  if (!(ve.first_load_softening >= 0 && ve.first_load_softening < 1))
+    throw std::invalid_argument("GpsModel: first-load softening must lie in [0, 1)");
   if (bulk_differs && ve.energy_map())
     throw std::invalid_argument("GpsModel: Fung stiffening in energy form relaxes the whole tension: bulk and shear weights must agree");
   std::vector<double> kappa(materials.size());
@@ -117,7 +119,9 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
   // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l.
   const GpsViscoelasticity& ve = options_.viscoelasticity;
   const std::size_t nm = mechanisms_;
-  const std::size_t stride = (1 + nm) * 6 * L;
+  const std::size_t stride = memory_stride();
+  const double softening = ve.first_load_softening;
+  const std::size_t soft_at = softening_offset();
   double me[8], ma[8], mc[8], ys[8], yb[8];
   double rate_scale = 0.0;
   const double dt = memory ? memory->dt_s : 0.0;
@@ -171,6 +175,12 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         nan_probe[j] += dL[k][j];  // a NaN anywhere survives in the sum; max() would drop it
       }
     }
+    double strain[6][L];  // first-load softening: the edge strains before any map
+    if constexpr (kMemory)
+      if (softening > 0)
+        for (int k = 0; k < 6; ++k)
+#pragma omp simd
+          for (int j = 0; j < L; ++j) strain[k][j] = dL[k][j] * b.inv_rest_length[k][j];
     double dh[6][L];  // energy form: h'(e), which multiplies the tensions
     if (qlv > 0 || qlv_energy) {  // Fung: elongation measure L0 g(e) or L0 h(e), e = dL / L0
       if (qlv_energy) {
@@ -230,8 +240,24 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
       const double* in = memory->before.data() + bi * stride;
       // A block with a non-finite elongation leaves its memory untouched (it is reported as an
       // instability by the caller); its new values go to a local scratch instead.
-      double scratch[(1 + 8) * 6 * L];
+      double scratch[(1 + 8 + 2) * 6 * L];
       double* out = block_probe == 0.0 ? memory->after.data() + bi * stride : scratch;
+      if (softening > 0) {
+        // Below the largest strain seen in the same sense, the elastic response is softened; the
+        // extremes then take this evaluation's strain (read before written: in place is fine).
+        const double* peak_in = in + soft_at;
+        double* peak_out = out + soft_at;
+        for (int k = 0; k < 6; ++k)
+#pragma omp simd
+          for (int j = 0; j < L; ++j) {
+            const double e = strain[k][j], a = std::fabs(e);
+            const double tension = peak_in[k * L + j], compression = peak_in[(6 + k) * L + j];
+            const double peak = e >= 0 ? tension : compression;
+            filtered[k][j] *= a < peak ? 1.0 - softening * (1.0 - a / peak) : 1.0;
+            peak_out[k * L + j] = e >= 0 ? std::max(tension, a) : tension;
+            peak_out[(6 + k) * L + j] = e < 0 ? std::max(compression, a) : compression;
+          }
+      }
       for (int k = 0; k < 6; ++k) {
         double zs[L] = {}, zb[L] = {};
         const double* prev = in + k * L;
@@ -329,7 +355,7 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) cons
 }
 
 std::size_t GpsModel::memory_size() const {
-  return options_.viscoelasticity.has_memory() ? blocks_.size() * (1 + mechanisms_) * 6 * L : 0;
+  return options_.viscoelasticity.has_memory() ? blocks_.size() * memory_stride() : 0;
 }
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
@@ -380,7 +406,9 @@ double GpsModel::energy(std::span<const Vec3> x) const {
 
 Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const { return tangent(x, e, 1.0, 0.0); }
 
-Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const {
+Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const { return element_tangent(x, e, dt_s, {}); }
+
+Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, std::span<const double> memory) const {
   // d(relaxed elongation)/d(dL) over a step of dt: 1 - sum Y_l c_l (+ tau / dt for Kelvin-Voigt).
   const GpsViscoelasticity& ve = options_.viscoelasticity;
   if (!ve.has_memory()) return tangent(x, e, 1.0, 0.0);
@@ -391,10 +419,26 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double d
     bulk -= (ve.bulk_weight.empty() ? ve.shear_weight[l] : ve.bulk_weight[l]) * c;
   }
   const double kv = dt_s > 0 ? ve.kelvin_voigt_time_s / dt_s : 0.0;
-  return tangent(x, e, shear + kv, bulk - shear);
+  const double d = ve.first_load_softening;
+  if (!(d > 0) || memory.size() != memory_size()) return tangent(x, e, shear + kv, bulk - shear);
+  // First-load softening: the factors at x for the extremes the step started with.
+  const auto p = gather(x, e);
+  const double* peaks = memory.data() + (e / L) * memory_stride() + softening_offset();
+  Vec6 phi = Vec6::Ones(), dphi = Vec6::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const int a = kTetEdges[k][0], b = kTetEdges[k][1];
+    const double strain = ((p[b] - p[a]).norm() - edge_length(e, k)) / edge_length(e, k);
+    const double peak = strain >= 0 ? peaks[k * L + e % L] : peaks[(6 + k) * L + e % L];
+    if (std::abs(strain) < peak) {
+      phi(k) = 1.0 - d * (1.0 - std::abs(strain) / peak);
+      dphi(k) = d * (strain >= 0 ? 1.0 : -1.0) / peak;
+    }
+  }
+  return tangent(x, e, shear + kv, bulk - shear, &phi, &dphi);
 }
 
-Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra) const {
+Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi,
+                        const Vec6* dphi_de) const {
   // f = P t with P_e = (+Y_e at a, -Y_e at b), t = S h, h = H dL, dL = G dx,
   // G_e = (-y_e at a, +y_e at b), y_e = Y_e / L_e. K = -df/dx (see MODEL.md section 1).
   const auto p = gather(x, e);
@@ -434,8 +478,22 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
         dL(k) = edge_length(e, k) * std::expm1(qlv * strain) / qlv;
       }
     }
+  // First-load softening scales each edge's response by phi(e): the mapped elongation (edge map)
+  // or the elastic tension (energy form); d phi / dx = phi'(e) G / L0.
+  const bool softened = phi != nullptr && !qlv_energy;
+  if (softened)
+    for (int k = 0; k < 6; ++k) {
+      Gm.row(k) = (*phi)(k) * Gm.row(k) + dL(k) * (*dphi_de)(k) / edge_length(e, k) * G.row(k);
+      dL(k) *= (*phi)(k);
+    }
   const Vec6 Hh = H * dL;
-  const Vec6 h = dh.cwiseProduct(Hh);
+  Vec6 h = dh.cwiseProduct(Hh);
+  Vec6 soft = Vec6::Ones(), dsoft = Vec6::Zero();  // energy form: t_k = phi_k h'_k (H h)_k
+  if (phi != nullptr && qlv_energy) {
+    soft = *phi;
+    for (int k = 0; k < 6; ++k) dsoft(k) = (*dphi_de)(k) / edge_length(e, k);
+    h = h.cwiseProduct(soft);
+  }
   const bool ec = options_.variant == GpsVariant::energy_consistent;
   Mat12 K = Mat12::Zero();
   for (int k = 0; k < 6; ++k) {
@@ -443,8 +501,8 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     const double s = ec ? 1.0 / len(k) : 1.0 / edge_length(e, k);
     const double tk = s * h(k);
     // Material part: -P_k dt_k/dx with dt_k/dx = s (H G)_k [- h_k / L_k^2 G_k for EC].
-    Eigen::Matrix<double, 1, 12> dt = s * dh(k) * (H.row(k) * Gm);
-    if (qlv_energy) dt += s * d2h(k) * Hh(k) * G.row(k);
+    Eigen::Matrix<double, 1, 12> dt = s * soft(k) * dh(k) * (H.row(k) * Gm);
+    if (qlv_energy) dt += s * soft(k) * d2h(k) * Hh(k) * G.row(k) + s * dsoft(k) * dh(k) * Hh(k) * G.row(k);
     if (ec) dt -= h(k) / (len(k) * len(k)) * G.row(k);
     K.block<3, 12>(3 * a, 0) -= Y.col(k) * dt;
     K.block<3, 12>(3 * b, 0) += Y.col(k) * dt;

@@ -43,8 +43,15 @@ struct GpsViscoelasticity {
   double compression_ratio = 1.0;
   /// Whether the elastic energy is 0.5 h^T H h with a nonlinear edge map (energy form).
   bool energy_map() const { return qlv_form == QlvForm::energy && (qlv_stiffening > 0 || compression_ratio != 1.0); }
+  /// First-load softening d in [0, 1) (Ogden-Roxburgh-like, per edge): below the largest strain an
+  /// edge has seen in the same sense (tension or compression), m, its elastic response (the mapped
+  /// elongation, or in the energy form its elastic tension) is scaled by 1 - d (1 - |e| / m); at or
+  /// beyond m it is the virgin response. The two extremes per edge are kept with the memory.
+  /// Under proportional loading every edge's |e| / m is the specimen's, so a homogeneous specimen
+  /// softens exactly as the lab's 1D law.
+  double first_load_softening = 0.0;
 
-  bool has_memory() const { return !omega_rad_s.empty() || kelvin_voigt_time_s > 0; }
+  bool has_memory() const { return !omega_rad_s.empty() || kelvin_voigt_time_s > 0 || first_load_softening > 0; }
 };
 
 struct GpsOptions {
@@ -66,6 +73,8 @@ class GpsModel final : public ForceModel {
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const override;
   std::size_t memory_size() const override;
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const override;
+  /// With first-load softening the tangent depends on each edge's extremes in `memory`.
+  Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, std::span<const double> memory) const override;
   double stiffness_damping_time_s() const override { return options_.viscoelasticity.kelvin_voigt_time_s; }
   double energy(std::span<const Vec3> x) const override;
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e) const override;
@@ -98,7 +107,12 @@ class GpsModel final : public ForceModel {
   template <bool kEnergyConsistent, bool kVolume, bool kMemory>
   ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory, std::size_t first_block,
                              std::size_t end_block) const;
-  Mat12 tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra) const;
+  /// phi, dphi_de: first-load softening factors per edge and their derivatives in the edge strain.
+  Mat12 tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi = nullptr,
+                const Vec6* dphi_de = nullptr) const;
+  /// Offset of the softening extremes in a block's memory (tension extremes, then compression).
+  std::size_t softening_offset() const { return (1 + mechanisms_) * 6 * kLanes; }
+  std::size_t memory_stride() const { return (1 + mechanisms_ + (options_.viscoelasticity.first_load_softening > 0 ? 2 : 0)) * 6 * kLanes; }
   Mat6 packed_hessian(std::size_t e) const;
   double edge_length(std::size_t e, int k) const;
 

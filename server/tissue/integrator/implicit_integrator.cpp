@@ -109,7 +109,9 @@ void ImplicitIntegrator::assemble(const std::vector<Vec3>& x, double mass_scale,
   std::span<double> values = solver_->values();
   std::fill(values.begin(), values.end(), 0.0);
   for (std::size_t e = 0; e < model_.element_count(); ++e) {
-    const Mat12 K = mass_scale > 0 ? model_.element_tangent(x, e, options_.dt_s) : model_.element_tangent(x, e);
+    const Mat12 K = mass_scale <= 0   ? model_.element_tangent(x, e)
+                    : memory_before_ ? model_.element_tangent(x, e, options_.dt_s, *memory_before_)
+                                     : model_.element_tangent(x, e, options_.dt_s);
     const long* slots = &element_slots_[144 * e];
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 12; ++q)

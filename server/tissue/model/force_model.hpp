@@ -65,6 +65,12 @@ class ForceModel {
     (void)dt_s;
     return element_tangent(x, e);
   }
+  /// The same with the memory at the start of the step, for models whose elasticity depends on
+  /// their history (first-load softening); the others ignore it.
+  virtual Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, std::span<const double> memory) const {
+    (void)memory;
+    return element_tangent(x, e, dt_s);
+  }
   /// Stiffness-proportional (Kelvin-Voigt) damping time [s], which shortens the explicit step.
   virtual double stiffness_damping_time_s() const { return 0.0; }
 
