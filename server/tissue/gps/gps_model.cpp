@@ -116,7 +116,8 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
                                      std::size_t first_block, std::size_t end_block) const {
   const Vec3* X = mesh_->nodes.data();
   double max_strain[L] = {}, nan_probe[L] = {};
-  // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l.
+  // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l; with
+  // first-load softening 2 x 6 x L more: each edge's largest strain in tension, then in compression.
   const GpsViscoelasticity& ve = options_.viscoelasticity;
   const std::size_t nm = mechanisms_;
   const std::size_t stride = memory_stride();
