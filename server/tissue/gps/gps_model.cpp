@@ -14,6 +14,7 @@ namespace viscera::tissue {
 
 namespace {
 constexpr int L = GpsModel::kLanes;
+constexpr std::size_t kPrefetchAhead = 2;  // blocks (1, 2 and 4 measured at 96k: 2 best)
 }  // namespace
 
 GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
@@ -142,6 +143,16 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
   const double ratio = ve.compression_ratio;
   for (std::size_t bi = first_block; bi < end_block; ++bi) {
     const Block& b = blocks_[bi];
+    if (bi + kPrefetchAhead < end_block) {
+      // The hardware prefetcher does not keep the two streams (elements, memory) ahead: at 96k
+      // tets, where they come from DRAM, asking for them two blocks early makes a step 25% faster.
+      const char* next = reinterpret_cast<const char*>(&blocks_[bi + kPrefetchAhead]);
+      for (std::size_t o = 0; o < sizeof(Block); o += 64) __builtin_prefetch(next + o, 0, 0);
+      if constexpr (kMemory) {
+        const char* mem = reinterpret_cast<const char*>(memory->before.data() + (bi + kPrefetchAhead) * stride);
+        for (std::size_t o = 0; o < stride * sizeof(double); o += 64) __builtin_prefetch(mem + o, 1, 0);
+      }
+    }
     // Gather: current positions, and displacements u = x - X (exact for x near X).
     double p[4][3][L], u[4][3][L];
     for (int i = 0; i < 4; ++i)
