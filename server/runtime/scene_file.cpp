@@ -8,11 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
+#include "common/known_fields.hpp"
 
 namespace viscera::runtime {
 
 using nlohmann::json;
 using tissue::InputError;
+using tissue::require_known_fields;
 
 SceneSpec read_scene_file(const std::string& path) {
   std::ifstream in(path);
@@ -32,6 +34,8 @@ SceneSpec read_scene_file(const std::string& path) {
       throw InputError(path, 0, prefix + key, o[key].dump() + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v;
   };
+  if (!j.is_object()) throw InputError(path, 0, "JSON", "the scene must be an object");
+  require_known_fields(j, path, "", {"name", "domain_id", "physics_rate_hz", "mesh_rate_hz", "max_tool_speed_m_s", "organ", "instruments"});
   SceneSpec s;
   s.source = path;
   s.name = j.value("name", std::filesystem::path(path).stem().string());
@@ -40,6 +44,9 @@ SceneSpec read_scene_file(const std::string& path) {
   s.mesh_rate_hz = number(j, "mesh_rate_hz", "", 0, 240, 60);
   if (!j.contains("organ") || !j["organ"].is_object()) throw InputError(path, 0, "organ", "missing or not an object");
   const json& o = j["organ"];
+  require_known_fields(o, path, "organ.", {"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction",
+                           "physics_threads", "volume_term", "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m",
+                           "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab"});
   for (const char* key : {"mesh", "material"})
     if (!o.contains(key) || !o[key].is_string()) throw InputError(path, 0, std::string("organ.") + key, "missing (a path)");
   s.mesh = (dir / o["mesh"].get<std::string>()).string();
@@ -79,6 +86,8 @@ SceneSpec read_scene_file(const std::string& path) {
   for (std::size_t k = 0; k < j["instruments"].size(); ++k) {
     const json& i = j["instruments"][k];
     const std::string prefix = "instruments[" + std::to_string(k) + "].";
+    if (!i.is_object()) throw InputError(path, 0, prefix.substr(0, prefix.size() - 1), "not an object");
+    require_known_fields(i, path, prefix, {"id", "kind", "tip_radius_m", "grasp_radius_m"});
     InstrumentSpec spec;
     spec.id = static_cast<std::uint32_t>(number(i, "id", prefix, 1, 1e6, 0));
     if (spec.id == 0) throw InputError(path, 0, prefix + "id", "missing");

@@ -362,6 +362,8 @@ TEST(MaterialFile, ViscoelasticFieldsAreCheckedByName) {
   EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": -3000, "poisson_ratio": 0.3}})").find("youngs_modulus_pa"), std::string::npos);
   EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 3000, "poisson_ratio": 0.5}})").find("poisson_ratio"), std::string::npos);
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energetic"}})").find("tissue.json: viscoelasticity.qlv_form"), std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "band": [0.01, 10]}})").find("tissue.json: viscoelasticity.band: unknown field"), std::string::npos);
+  EXPECT_NE(message(head + R"("viscosity": {"shear_q": 4.8}})").find("tissue.json: viscosity: unknown field"), std::string::npos);
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energy", "compression_ratio": 0}})").find("viscoelasticity.compression_ratio"), std::string::npos);
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "compression_ratio": 2}})").find("viscoelasticity.compression_ratio: 2 needs \"qlv_form\": \"energy\""), std::string::npos);
   const Material m = parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "bulk_q": 20, "band_hz": [0.01, 10], "mechanisms": 3, "reference_frequency_hz": 2}})", "ok.json");

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
+#include "common/known_fields.hpp"
 #include "material/elasticity.hpp"
 
 namespace viscera::tissue {
@@ -32,6 +33,7 @@ Material parse_material(const std::string& text, const std::string& source) {
     throw InputError(source, 0, "JSON", e.what());
   }
   if (!j.is_object()) throw InputError(source, 0, "", "expected a JSON object");
+  require_known_fields(j, source, "", {"name", "density_kg_m3", "elasticity", "viscoelasticity"});
   Material m;
   m.name = j.value("name", source);
   m.density_kg_m3 = number(j, "density_kg_m3", source, "");
@@ -41,9 +43,12 @@ Material parse_material(const std::string& text, const std::string& source) {
   const std::string type = e.value("type", "");
   const std::string where = source;
   if (type == "isotropic") {
+    require_known_fields(e, source, "elasticity.", {"type", "youngs_modulus_pa", "poisson_ratio"});
     m.isotropic = IsotropicElasticity{number(e, "youngs_modulus_pa", source, "elasticity."), number(e, "poisson_ratio", source, "elasticity.")};
     m.elasticity = elasticity_matrix(*m.isotropic, where);
   } else if (type == "transversely_isotropic") {
+    require_known_fields(e, source, "elasticity.", {"type", "plane_youngs_modulus_pa", "plane_poisson_ratio", "fibre_youngs_modulus_pa",
+                                                    "fibre_plane_poisson_ratio", "fibre_shear_modulus_pa", "fibre_direction"});
     TransverselyIsotropicElasticity t;
     t.plane_youngs_modulus_pa = number(e, "plane_youngs_modulus_pa", source, "elasticity.");
     t.plane_poisson_ratio = number(e, "plane_poisson_ratio", source, "elasticity.");
@@ -60,6 +65,8 @@ Material parse_material(const std::string& text, const std::string& source) {
   if (j.contains("viscoelasticity")) {
     const json& v = j["viscoelasticity"];
     if (!v.is_object()) throw InputError(source, 0, "viscoelasticity", "must be an object");
+    require_known_fields(v, source, "viscoelasticity.", {"model", "shear_q", "bulk_q", "band_hz", "mechanisms", "reference_frequency_hz",
+                                                         "qlv_stiffening", "qlv_form", "compression_ratio"});
     ViscoelasticSpec spec;
     const std::string model = v.value("model", "constant_q");
     if (model == "kelvin_voigt") spec.model = ViscoelasticSpec::Model::kelvin_voigt;
