@@ -5,7 +5,8 @@
 // buffers are added after in chunk order, so the forces are the same bit for bit whichever thread
 // computed which chunk (deterministic; they differ from one-thread evaluation only by rounding).
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
-// calling thread then takes its chunks. Helpers sleep between evaluations (no spinning).
+// calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
+// caller, waiting for a helper's chunk, spins briefly and then sleeps.
 #include <atomic>
 #include <cstdint>
 #include <thread>
