@@ -38,12 +38,15 @@ def main(path):
             ratio = ns["corotational"] / ns["gps"] if "gps" in ns and "corotational" in ns else float("nan")
             print(f"| {m} | {tets} | " + " | ".join(row) + f" | {ratio:.1f}x |")
     print("\nViscoelastic step (3 memory variables) / elastic step, same mesh:")
-    print("| mesh | gps step | gps_visco3 step | ratio |")
-    print("|---|---|---|---|")
+    print("The last column: the model the bundled scenes run (energy form, volume term 0.5, the same")
+    print("memory), the explicit sub-step a server tick repeats (data/scenes, docs/SCENE.md).")
+    print("| mesh | gps step | gps_visco3 step | ratio | scene model step |")
+    print("|---|---|---|---|---|")
     for m in meshes:
-        a, b = med.get(f"Step/gps/{m}"), med.get(f"Step/gps_visco3/{m}")
+        a, b, c = med.get(f"Step/gps/{m}"), med.get(f"Step/gps_visco3/{m}"), med.get(f"Step/scene/{m}")
         if a and b:
-            print(f"| {m} | {a['real_time']:.1f} us | {b['real_time']:.1f} us | {b['real_time']/a['real_time']:.2f}x |")
+            scene = f"{c['real_time']:.1f} us" if c else "-"
+            print(f"| {m} | {a['real_time']:.1f} us | {b['real_time']:.1f} us | {b['real_time']/a['real_time']:.2f}x | {scene} |")
     print("\nMemory limit for the GPS force loop (296 bytes streamed per tet):")
     print("| working set | read bandwidth | limit ns/tet | gps ns/tet | gps / limit |")
     print("|---|---|---|---|---|")

@@ -1,5 +1,7 @@
 #include "contact_compliance.hpp"
 
+#include <pthread.h>
+
 #include "integrator/implicit_integrator.hpp"
 
 namespace viscera::runtime {
@@ -51,6 +53,7 @@ Eigen::Matrix3d ContactCompliance::wait_node(std::int32_t n) {
 }
 
 void ContactCompliance::work(const ForceModel& model, std::vector<double> density, BoundaryConditions bc) {
+  pthread_setname_np(pthread_self(), "compliance");
   const auto& rest = model.rest_mesh().nodes;
   // dt is irrelevant to the static stiffness; the integrator only needs a valid one.
   ImplicitIntegrator system(model, std::move(density), std::move(bc), ImplicitOptions{1e-3});

@@ -1,5 +1,7 @@
 #include "mesh_publisher.hpp"
 
+#include <pthread.h>
+
 namespace viscera::runtime {
 
 namespace proto = viscera::protocol;
@@ -14,7 +16,10 @@ MeshPublisher::MeshPublisher(proto::Participant& participant, proto::SurfaceTopo
   topology_writer_.write(mesh_id_, proto::encode(topology));
   pending_.mesh_id = mesh_id_;
   pending_.positions.resize(3 * nodes_.size());
-  thread_ = std::thread([this] { publish_loop(); });
+  thread_ = std::thread([this] {
+    pthread_setname_np(pthread_self(), "mesh-publisher");
+    publish_loop();
+  });
 }
 
 MeshPublisher::~MeshPublisher() {

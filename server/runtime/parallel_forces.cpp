@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include <pthread.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -48,6 +49,7 @@ void ParallelForces::helper() {
   // Lowest priority: a thread that answers a client (the command thread) preempts the helper at
   // once; the physics thread then takes the helper's chunks itself.
   setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+  pthread_setname_np(pthread_self(), "forces-helper");
   std::uint64_t seen = 0;
   for (;;) {
     go_.wait(seen, std::memory_order_acquire);

@@ -11,6 +11,8 @@
 #include <optional>
 #include <thread>
 
+#include <pthread.h>
+
 #include "common/input_error.hpp"
 #include "grasp_hold.hpp"
 #include "mesh_publisher.hpp"
@@ -601,6 +603,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
   // The command thread answers commands as they arrive, on the other core, while this thread steps.
   std::atomic<bool> stopping{false};
   std::thread command_thread([&] {
+    pthread_setname_np(pthread_self(), "command");
     while (!stopping.load())
       if (s.commands.wait(std::chrono::milliseconds(20))) s.answer_new_commands();
   });
