@@ -62,6 +62,11 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
+    // Building a large organ takes seconds (the 96k liver about 3 s): say so before it starts.
+    if (!quiet) {
+      std::printf("viscera-server: loading %s\n", scene.c_str());
+      std::fflush(stdout);
+    }
     viscera::runtime::SimulationServer server(viscera::runtime::read_scene_file(scene), scene_dir);
     std::printf("viscera-server: %s\n", server.describe().c_str());
     std::fflush(stdout);
