@@ -50,8 +50,8 @@ void ParallelForces::helper() {
   // SCHED_IDLE: the helper runs only on a core nothing else wants, and the kernel counts a core
   // that runs nothing but such threads as idle when it places a waking thread, so the command
   // thread and the clients' threads go straight there. With nice 19 instead, the busy helper's
-  // core was not idle and they could queue behind the physics thread (round trip p99 at 12k on
-  // two threads 597-722 us against 817-962, docs/PERFORMANCE.md). The physics thread takes the
+  // core was not idle and they could queue behind the physics thread (the runs are in
+  // docs/SCENE.md, "Physics threads"). The physics thread takes the
   // helper's chunks itself when the helper is held off. Nice 19 where SCHED_IDLE is refused.
   const sched_param idle{};
   if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
