@@ -33,7 +33,7 @@ expect fig-bad-mechanisms 2 "mechanisms" -- "$fig" --mechanisms 9 --csv "$tmp/f.
 server="$build/server/runtime/viscera-server"; hc="$build/tools/haptic-client/haptic-client"
 echo '{"organ": {"mesh": "x.msh"}}' >"$tmp/bad_scene.json"
 expect server-help 0 "Usage: viscera-server" -- "$server" --help
-expect server-no-scene 2 "--scene FILE is required" -- "$server"
+expect server-no-scene 2 "viscera-server: --scene is required" -- "$server"
 expect server-bad-scene 2 "bad_scene.json: organ.material: missing" -- "$server" --scene "$tmp/bad_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json", "added_mass_fraction": 2}, "instruments": [{"id": 1}]}' >"$tmp/heavy_scene.json"
 expect server-bad-mass-scaling 2 "heavy_scene.json: organ.added_mass_fraction: 2 is outside" -- "$server" --scene "$tmp/heavy_scene.json"
@@ -45,8 +45,10 @@ echo '{"physics_threads": 2, "organ": {"mesh": "x.msh", "material": "m.json"}, "
 expect server-unknown-field 2 "misplaced_scene.json: physics_threads: unknown field (known here: name, " -- "$server" --scene "$tmp/misplaced_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json"}, "instruments": [{"id": 1, "tip_radius": 0.01}]}' >"$tmp/typo_scene.json"
 expect server-misspelt-field 2 "typo_scene.json: instruments\[0\].tip_radius: unknown field" -- "$server" --scene "$tmp/typo_scene.json"
-expect server-bad-duration 2 "'soon' is not a non-negative number" -- "$server" --scene x --duration soon
+expect server-bad-duration 2 "viscera-server: --duration: 'soon' is not a finite number" -- "$server" --scene x --duration soon
 expect server-bad-scene-dir 2 "--scene-dir: '/nonexistent' is not a directory" -- "$server" --scene x --scene-dir /nonexistent
+expect server-negative-duration 2 "viscera-server: --duration: -1 is outside" -- "$server" --scene x --duration -1
+expect server-unknown 2 "viscera-server: unknown option --sceen" -- "$server" --sceen x
 expect hc-help 0 "Usage: haptic-client" -- "$hc" --help
 expect hc-bad-rate 2 "--rate: 0 is outside" -- "$hc" --rate 0
 printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n0.5,0,0,abc\n' >"$tmp/t1.csv"
