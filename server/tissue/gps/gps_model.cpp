@@ -338,11 +338,12 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
           e2[d] = p[2][d][j] - p[0][d][j];
           e3[d] = p[3][d][j] - p[0][d][j];
         }
-        const double g1[3] = {(e2[1] * e3[2] - e2[2] * e3[1]) / 6, (e2[2] * e3[0] - e2[0] * e3[2]) / 6, (e2[0] * e3[1] - e2[1] * e3[0]) / 6};
-        const double g2[3] = {(e3[1] * e1[2] - e3[2] * e1[1]) / 6, (e3[2] * e1[0] - e3[0] * e1[2]) / 6, (e3[0] * e1[1] - e3[1] * e1[0]) / 6};
-        const double g3[3] = {(e1[1] * e2[2] - e1[2] * e2[1]) / 6, (e1[2] * e2[0] - e1[0] * e2[2]) / 6, (e1[0] * e2[1] - e1[1] * e2[0]) / 6};
-        const double V = e1[0] * g1[0] + e1[1] * g1[1] + e1[2] * g1[2];
-        const double scale = -b.kappa[j] * (V / b.rest_volume[j] - 1.0);
+        // 6 x the volume gradients (the 1/6 goes into the scale: divisions are the slow unit)
+        const double g1[3] = {e2[1] * e3[2] - e2[2] * e3[1], e2[2] * e3[0] - e2[0] * e3[2], e2[0] * e3[1] - e2[1] * e3[0]};
+        const double g2[3] = {e3[1] * e1[2] - e3[2] * e1[1], e3[2] * e1[0] - e3[0] * e1[2], e3[0] * e1[1] - e3[1] * e1[0]};
+        const double g3[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const double V = (e1[0] * g1[0] + e1[1] * g1[1] + e1[2] * g1[2]) * (1.0 / 6);
+        const double scale = -b.kappa[j] * (V / b.rest_volume[j] - 1.0) * (1.0 / 6);
         for (int d = 0; d < 3; ++d) {
           fv[1][d][j] += scale * g1[d];
           fv[2][d][j] += scale * g2[d];
