@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <map>
 #include <memory>
 #include <thread>
 
@@ -156,7 +155,12 @@ int main(int argc, char** argv) {
                 device->name().c_str(), rate, duration);
     std::fflush(stdout);
 
-    std::map<std::uint64_t, Vector3> sent;  // tip of each recent command, for the local model
+    // Tip of each of the last 4096 commands, for the local model (a ring: no allocation per period).
+    struct Sent {
+      std::uint64_t seq = 0;
+      Vector3 tip{};
+    };
+    std::vector<Sent> sent(4096);
     std::uint64_t seq = 0, clamps = 0, model_seq = 0;
     viscera::client::LocalForceRenderer renderer(max_force, cl.number_in("blend", 0, 0.1));
     MeshWatch mesh;
@@ -189,15 +193,15 @@ int main(int argc, char** argv) {
       const auto in = device->read(t);
       if (in.finished) break;
       client.send_tip(instrument, in.tip_m, in.jaw_rad);
-      sent[++seq] = in.tip_m;
-      if (sent.size() > 4096) sent.erase(sent.begin());
+      ++seq;
+      sent[seq % sent.size()] = {seq, in.tip_m};
       // Wait for the answer to this command until shortly before the next device period.
       if (const auto f = client.wait_force(instrument, next + period - std::chrono::microseconds(100))) {
         // The force rendered now, from the server's local models at the current tip: a new model
         // (the answer to a newer command) is blended in over --blend seconds.
         if (f->command_seq > model_seq)
-          if (const auto it = sent.find(f->command_seq); it != sent.end()) {
-            renderer.update(*f, it->second, t);
+          if (const Sent& it = sent[f->command_seq % sent.size()]; it.seq == f->command_seq && it.seq != 0) {
+            renderer.update(*f, it.tip, t);
             model_seq = f->command_seq;
           }
         const auto rendered = renderer.render(in.tip_m, t);
