@@ -5,7 +5,8 @@
 # REPEAT=N runs every pair N times, interleaved (the run-to-run spread on a shared machine is
 # larger than the effect of the mesh updates), and reports the median ratio.
 # Prints a markdown table (docs/PERFORMANCE.md).
-# Usage: [DEPTH=0.02] [SCENES="liver liver-12k"] [REPEAT=1] bench/haptics.sh [SECONDS]   (default 30 s)
+# CLIENT_ARGS adds haptic-client options (e.g. CLIENT_ARGS="--tick-phase -1": a free-running device loop).
+# Usage: [DEPTH=0.02] [SCENES="liver liver-12k"] [REPEAT=1] [CLIENT_ARGS=...] bench/haptics.sh [SECONDS]   (default 30 s)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-30}"
@@ -36,7 +37,7 @@ for scene in ${SCENES:-liver liver-12k}; do
     watch=""; [ "$mesh_hz" -gt 0 ] && watch="--watch-mesh"
     # The client waits for the server (large meshes take seconds to load), then runs SECONDS.
     "$root/build/tools/haptic-client/haptic-client" --domain "$domain" --duration "$seconds" --depth "${DEPTH:-0.02}" $watch \
-      --report "$tmp/report.json" > /dev/null
+      --report "$tmp/report.json" ${CLIENT_ARGS:-} > /dev/null
     kill -INT "$server"; wait "$server"
     python3 - "$scene" "$mesh_hz" "$tmp/report.json" "$tmp/server.log" >> "$tmp/rows.txt" <<'PY'
 import json, re, statistics, sys

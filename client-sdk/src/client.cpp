@@ -143,6 +143,10 @@ std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
       return;
     }
     if (f->client_id != client_id_) return;
+    if (f->step_time_ns > 0) {  // published after a tick (the immediate answers carry 0)
+      auto& end = tick_end_ns_[f->instrument_id];
+      end = std::max(end, f->server_stamp_ns);
+    }
     auto& slot = latest_[f->instrument_id];
     if (f->command_seq >= slot.command_seq) {
       if (f->command_seq > slot.command_seq) rtt_us_.push_back(1e-3 * static_cast<double>(now - f->command_client_stamp_ns));
@@ -151,6 +155,12 @@ std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
   });
   const auto it = latest_.find(instrument_id);
   if (it == latest_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::optional<std::int64_t> Client::last_tick_end_ns(std::uint32_t instrument_id) const {
+  const auto it = tick_end_ns_.find(instrument_id);
+  if (it == tick_end_ns_.end()) return std::nullopt;
   return it->second;
 }
 

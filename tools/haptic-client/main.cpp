@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,8 @@
 #include "trajectory_device.hpp"
 #include "viscera/client/client.hpp"
 #include "viscera/client/local_force_model.hpp"
+#include "viscera/client/tick_phase.hpp"
+#include "viscera/protocol/dds.hpp"
 
 namespace {
 
@@ -109,6 +112,7 @@ int main(int argc, char** argv) {
   cl.flag("frame", "NAME", "trajectory positions: scene (absolute) | organ-top (relative to the organ's top centre)", "scene");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
   cl.flag("blend", "S", "blend from one local force model to the next over this time [s]", "0.003");
+  cl.flag("tick-phase", "US", "send commands this long after each server tick [us] (at --rate = physics rate; -1: loop free)", "100");
   cl.option_switch("watch-mesh", "receive the organ's surface frames and report their rate and the surface's displacement");
   cl.option_switch("quiet", "no live lines, only the summary");
   cl.flag("report", "FILE.json", "write samples and statistics here");
@@ -131,6 +135,7 @@ int main(int argc, char** argv) {
     }
     const double duration = cl.has("duration") ? cl.number_in("duration", 0.1, 36000) : trajectory.empty() ? 4.0 : trajectory.back().t_s;
     const bool quiet = cl.has("quiet"), watch_mesh = cl.has("watch-mesh");
+    const double tick_phase_us = cl.number_in("tick-phase", -1, 1e6);
 
     viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)), client_id);
     const auto scene = client.wait_for_scene(std::chrono::seconds(10));
@@ -173,6 +178,12 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     const double start_epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
     auto next = start;
+    // Commands timed to arrive just after a physics tick, in the server's idle time (tick_phase.hpp).
+    std::optional<viscera::client::TickPhase> phase;
+    if (tick_phase_us >= 0) phase.emplace(period, std::chrono::nanoseconds(std::llround(tick_phase_us * 1e3)));
+    const auto rate_matches = [&](const viscera::protocol::Scene& s) { return std::abs(s.physics_rate_hz - rate) <= 0.01 * rate; };
+    bool in_phase_possible = rate_matches(*scene);
+    std::uint64_t phased = 0, near_phase = 0;  // periods timed by the lock; of them within 50 us of the target
     double last_print = -1, last_scene_check = 0;
     std::uint32_t generation = scene->generation;
     for (;;) {
@@ -180,6 +191,7 @@ int main(int argc, char** argv) {
       if (t >= duration) break;
       if (t - last_scene_check >= 0.1) {  // a scene loaded at run time releases every instrument: claim it again
         last_scene_check = t;
+        if (const auto now = client.scene()) in_phase_possible = rate_matches(*now);
         if (const auto now = client.scene(); now && now->generation != generation) {
           generation = now->generation;
           const bool again = client.claim(instrument, std::chrono::seconds(2));
@@ -224,6 +236,14 @@ int main(int argc, char** argv) {
       }
       if (watch_mesh) mesh.take(client, t, in.tip_m);
       next += period;
+      if (phase && in_phase_possible)
+        if (const auto tick_end = client.last_tick_end_ns(instrument)) {
+          const std::int64_t next_ns = viscera::protocol::now_ns() +
+                                       std::chrono::duration_cast<std::chrono::nanoseconds>(next - std::chrono::steady_clock::now()).count();
+          ++phased;
+          near_phase += std::abs(phase->error(next_ns, *tick_end).count()) < 50'000;
+          next += phase->correction(next_ns, *tick_end);
+        }
       std::this_thread::sleep_until(next);
     }
     client.release(instrument);
@@ -233,11 +253,15 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(clamps), max_force);
     if (watch_mesh)
       std::printf("haptic-client: %zu surface frames at %.1f Hz\n", mesh.frames, mesh.rate_hz());
+    if (phased > 0)
+      std::printf("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us\n",
+                  tick_phase_us, static_cast<unsigned long long>(phased), 100.0 * static_cast<double>(near_phase) / static_cast<double>(phased));
     if (cl.has("report")) {
       nlohmann::json r{{"scene", scene->name}, {"instrument", instrument}, {"client_id", client_id}, {"rate_hz", rate},
                        {"start_epoch_s", start_epoch_s},
                        {"duration_s", duration}, {"device", device->name()},
                        {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
+                       {"tick_phase", {{"offset_us", tick_phase_us}, {"periods", phased}, {"within_50us", near_phase}}},
                        {"samples", to_json(samples)}};
       if (watch_mesh) r["mesh"] = {{"frames", mesh.frames}, {"rate_hz", mesh.rate_hz()}, {"samples", mesh.samples}};
       std::ofstream(cl.text("report")) << r.dump(1) << "\n";

@@ -56,6 +56,9 @@ class Client {
   /// instrument; returns the newest force seen either way.
   std::optional<protocol::Force> wait_force(std::uint32_t instrument_id, std::chrono::steady_clock::time_point deadline);
   LatencyStats round_trip() const;
+  /// When the server ended the newest tick whose force for this instrument has been taken (its
+  /// stamp, DDS time [ns]), for keeping a loop in phase with the physics (tick_phase.hpp).
+  std::optional<std::int64_t> last_tick_end_ns(std::uint32_t instrument_id) const;
 
   /// The organ's boundary surface (triangles, rest positions), once it has arrived. The first
   /// call subscribes this client to the mesh streams; clients that never call it receive none.
@@ -86,6 +89,7 @@ class Client {
   std::uint64_t request_seq_ = 0;  // starts at the clock: a restarted client never matches its old outcomes
   std::vector<double> rtt_us_;
   std::map<std::uint32_t, protocol::Force> latest_;
+  std::map<std::uint32_t, std::int64_t> tick_end_ns_;  // per instrument: the newest tick force's stamp
 };
 
 }  // namespace viscera::client
