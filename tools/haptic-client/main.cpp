@@ -191,8 +191,9 @@ int main(int argc, char** argv) {
       if (t >= duration) break;
       if (t - last_scene_check >= 0.1) {  // a scene loaded at run time releases every instrument: claim it again
         last_scene_check = t;
-        if (const auto now = client.scene()) in_phase_possible = rate_matches(*now);
-        if (const auto now = client.scene(); now && now->generation != generation) {
+        const auto now = client.scene();
+        if (now) in_phase_possible = rate_matches(*now);  // the physics rate may change at run time
+        if (now && now->generation != generation) {
           generation = now->generation;
           const bool again = client.claim(instrument, std::chrono::seconds(2));
           std::printf("t = %5.2f s  the server loaded scene %s: instrument %u %s\n", t, now->name.c_str(), instrument,
