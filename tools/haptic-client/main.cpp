@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
   cl.flag("frame", "NAME", "trajectory positions: scene (absolute) | organ-top (relative to the organ's top centre)", "scene");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
   cl.flag("blend", "S", "blend from one local force model to the next over this time [s]", "0.003");
-  cl.flag("tick-phase", "US", "send commands this long after each server tick [us] (at --rate = physics rate; -1: loop free)", "100");
+  cl.flag("tick-phase", "US", "send commands this long after each server tick [us] (at --rate = physics rate; negative: loop free)", "100");
   cl.option_switch("watch-mesh", "receive the organ's surface frames and report their rate and the surface's displacement");
   cl.option_switch("quiet", "no live lines, only the summary");
   cl.flag("report", "FILE.json", "write samples and statistics here");

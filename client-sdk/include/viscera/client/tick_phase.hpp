@@ -1,9 +1,11 @@
 #pragma once
 // Keeps a client's periodic loop (a haptic device at the server's physics rate) at a fixed phase
 // after the server's physics ticks, so that its command, the server's immediate answer and the
-// network threads on both sides run in the server's idle time between ticks rather than taking a
-// core from the physics (docs/PERFORMANCE.md, "what a connected client costs the 12k tick"). The
-// next tick then takes a command that is `offset` old instead of anywhere from 0 to a period.
+// network threads on both sides run in the server's idle time between ticks, and every tick takes
+// a command of the same age (the rest of the period after the tick and the offset) instead of
+// anywhere from 0 to a period. Measured on the 12k liver (docs/PERFORMANCE.md, "what a connected
+// client costs the 12k tick"): round trip p99 about a tenth lower, median tick a little shorter,
+// late ticks unchanged.
 //
 // The server stamps each force it publishes after a tick (Force::step_time_ns > 0) with its clock
 // (Force::server_stamp_ns, DDS time). The client compares that with its own DDS time: exact on one
