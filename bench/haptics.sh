@@ -24,7 +24,7 @@ for line in open(sys.argv[1]):
     m = re.search(r"50% ([0-9.]+)us 90% [0-9.]+us 99% ([0-9.]+)us max ([0-9.]+)us", line)
     if m:
         p50.append(float(m.group(1))); p99.append(float(m.group(2))); mx.append(float(m.group(3)))
-print(f"| ddsperf ping-pong, 64 B at 1 kHz (as ddsperf prints it) | - | {statistics.median(p50):.0f} | {statistics.median(p99):.0f} | {max(mx):.0f} | - | - | - | - | - | - |")
+print(f"| ddsperf ping-pong, 64 B at 1 kHz (as ddsperf prints it) | - | {statistics.median(p50):.0f} | {statistics.median(p99):.0f} | {max(mx):.0f} | - | - | - | - | - | - | - |")
 PY
 for rep in $(seq "${REPEAT:-1}"); do
 for scene in ${SCENES:-liver liver-12k}; do
@@ -50,24 +50,24 @@ render_hz = (len(s) - 1) / (s[-1]["t_s"] - s[0]["t_s"]) if len(s) > 1 else 0
 frames = f"{rep['mesh']['rate_hz']:.0f}" if "mesh" in rep else "-"
 p50, p99, mx, jit, rate = [], [], [], [], []
 tets = ""
-overruns = resets = 0
+late = missed = resets = 0
 for line in open(log):
-    m = re.search(r"([0-9]+) Hz physics, step p50 ([0-9]+) us p99 ([0-9]+) us max ([0-9]+) us, jitter p99 ([0-9]+) us, overruns ([0-9]+)", line)
+    m = re.search(r"([0-9]+) Hz physics, step p50 ([0-9]+) us p99 ([0-9]+) us max ([0-9]+) us, jitter p99 ([0-9]+) us, late ticks ([0-9]+), missed slots ([0-9]+)", line)
     if m:
         rate.append(float(m.group(1))); p50.append(float(m.group(2))); p99.append(float(m.group(3))); mx.append(float(m.group(4)))
-        jit.append(float(m.group(5))); overruns = int(m.group(6))
+        jit.append(float(m.group(5))); late = int(m.group(6)); missed = int(m.group(7))
     m = re.search(r"([0-9]+) tets", line)
     if m: tets = m.group(1)
     m = re.search(r"([0-9]+) physics resets", line)
     if m: resets = int(m.group(1))
 print(f"| viscera {scene} ({tets} tets): pose -> force round trip | {frames} | {r['p50']:.0f} | {r['p99']:.0f} | {r['max']:.0f} | "
-      f"{statistics.median(rate):.0f} | {statistics.median(p50):.0f} / {max(p99):.0f} | {max(jit):.0f} | {overruns} | {resets} | {render_hz:.0f} |")
+      f"{statistics.median(rate):.0f} | {statistics.median(p50):.0f} / {max(p99):.0f} | {max(jit):.0f} | {late} | {missed} | {resets} | {render_hz:.0f} |")
 PY
   done
 done
 done
-echo "| measurement | mesh frames received [Hz] | p50 [us] | p99 [us] | max [us] | physics rate [Hz] | step p50 / worst p99 [us] | tick jitter p99 [us] | overruns | physics resets | client force rendering [Hz] |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| measurement | mesh frames received [Hz] | p50 [us] | p99 [us] | max [us] | physics rate [Hz] | step p50 / worst p99 [us] | tick jitter p99 [us] | late ticks | missed slots | physics resets | client force rendering [Hz] |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 cat "$tmp/rows.txt"
 python3 - "$tmp/rows.txt" <<'PY'
 import statistics, sys

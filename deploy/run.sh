@@ -4,7 +4,7 @@
 # at 1 kHz) and, as a separate process over Cyclone DDS, a scripted haptic client that presses a
 # probe into the liver and then grasps and pulls it; then an instructor's console (another
 # process) makes the liver twice as stiff while the server runs, and the probe presses again. All
-# print live: the server its physics rate, step times, jitter, overruns and the force on the
+# print live: the server its physics rate, step times, jitter, late ticks, missed slots and the force on the
 # tools; the client the force it feels, the command-to-force round trip and the surface frames it
 # receives; the console what the server did.
 #   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene

@@ -109,7 +109,7 @@ std::vector<std::uint8_t> encode(const Scene& s) {
 std::vector<std::uint8_t> encode(const TelemetryReport& t) {
   flatbuffers::FlatBufferBuilder b(128);
   return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us,
-                                       t.jitter_p99_us, t.overruns, t.rejected_messages));
+                                       t.jitter_p99_us, t.late_ticks, t.rejected_messages, t.missed_slots));
 }
 
 std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
@@ -339,7 +339,7 @@ std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> by
   const auto* m = verified_root<fb::Telemetry>(bytes, why);
   if (!m) return std::nullopt;
   return TelemetryReport{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
-                         m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us()};
+                         m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us(), m->missed_slots()};
 }
 
 namespace {

@@ -18,6 +18,7 @@
 #include "mesh_publisher.hpp"
 #include "organ.hpp"
 #include "probe_contact.hpp"
+#include "tick_grid.hpp"
 #include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/messages.hpp"
 
@@ -617,7 +618,8 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
   } join{stopping, command_thread};
 
   const auto start = clock::now();
-  auto next = start;
+  TickGrid grid(start.time_since_epoch());  // 1 kHz slots fixed from here: simulated time keeps wall time
+  auto next = start;  // when this tick was meant to start: its slot's start, or at once after a late tick
   auto last_report = start;
   std::vector<double> step_us, jitter_us;
   std::uint64_t ticks_at_report = 0;
@@ -659,8 +661,9 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       stats.jitter_p99_us = percentile(jitter_us, 0.99);
       stats.rejected = s.rejected;
       s.mesh_counts(stats);
-      s.telemetry.write(0, proto::encode(proto::TelemetryReport{proto::now_ns(), stats.ticks, stats.overruns, stats.rejected, stats.rate_hz,
-                                                                stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us}));
+      s.telemetry.write(0, proto::encode(proto::TelemetryReport{proto::now_ns(), stats.ticks, stats.late_ticks, stats.rejected, stats.rate_hz,
+                                                                stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
+                                                                stats.missed_slots}));
       if (status) {
         char line[400];
         int owned = 0;
@@ -669,10 +672,10 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
           owned += inst.active;
           fmax = std::max(fmax, inst.result.force_on_tool.norm());
         }
-        std::snprintf(line, sizeof line, "%.0f Hz physics%s, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, overruns %llu, "
+        std::snprintf(line, sizeof line, "%.0f Hz physics%s, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, late ticks %llu, missed slots %llu, "
                       "%d instruments in use, |F| %.3f N, rejected %llu, physics resets %llu, mesh frames %llu (%llu skipped)",
                       stats.rate_hz, s.paused ? " (paused)" : "", stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
-                      static_cast<unsigned long long>(stats.overruns), owned, fmax, static_cast<unsigned long long>(stats.rejected),
+                      static_cast<unsigned long long>(stats.late_ticks), static_cast<unsigned long long>(stats.missed_slots), owned, fmax, static_cast<unsigned long long>(stats.rejected),
                       static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.mesh_frames),
                       static_cast<unsigned long long>(stats.mesh_frames_skipped));
         status(line);
@@ -683,14 +686,15 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       ticks_at_report = stats.ticks;
     }
     if (duration_s > 0 && std::chrono::duration<double>(t1 - start).count() >= duration_s) break;
-    next += std::chrono::nanoseconds(static_cast<long long>(1e9 * dt));
+    // A late tick is followed at once in its own slot; slots that passed with no tick are counted
+    // missed and skipped, never made up in a burst (tick_grid.hpp).
     const auto now = clock::now();
-    if (now > next) {
-      ++stats.overruns;  // missed the deadline: do not try to catch up with a burst
-      next = now;
-    } else {
-      // Sleep to shortly before the deadline, then wait actively: the scheduler wakes a sleeping
-      // thread up to ~150 us late on this VM, which with a 0.9 ms tick (12k liver) is an overrun.
+    next = clock::time_point(grid.tick_ended(now.time_since_epoch(), std::chrono::nanoseconds(static_cast<long long>(1e9 * dt))));
+    stats.late_ticks = grid.late_ticks();
+    stats.missed_slots = grid.missed_slots();
+    if (next > now) {
+      // Sleep to shortly before the slot, then wait actively: the scheduler wakes a sleeping
+      // thread up to ~150 us late on this VM, which with a 0.9 ms tick (12k liver) makes it late.
       const auto early = next - std::chrono::microseconds(200);
       if (early > now) std::this_thread::sleep_until(early);
       while (clock::now() < next) std::this_thread::yield();

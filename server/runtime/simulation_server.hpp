@@ -12,7 +12,9 @@
 namespace viscera::runtime {
 
 struct ServerStats {
-  std::uint64_t ticks = 0, overruns = 0, rejected = 0, forces_sent = 0;
+  std::uint64_t ticks = 0, rejected = 0, forces_sent = 0;
+  std::uint64_t late_ticks = 0;    ///< ticks that ended after their 1/rate slot (the next one starts at once)
+  std::uint64_t missed_slots = 0;  ///< slots of the fixed-rate grid that passed with no tick
   std::uint64_t physics_resets = 0;  ///< organ reset to rest after an integration failure
   std::uint64_t mesh_frames = 0, mesh_frames_skipped = 0;  ///< surface frames published; due but replaced
   double step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0, rate_hz = 0;

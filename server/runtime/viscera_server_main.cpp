@@ -60,8 +60,8 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     });
-    std::printf("viscera-server: stopped after %llu ticks, %llu overruns, %llu physics resets, %llu forces sent, %llu messages rejected, %llu mesh frames\n",
-                static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.overruns),
+    std::printf("viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected, %llu mesh frames\n",
+                static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.late_ticks), static_cast<unsigned long long>(stats.missed_slots),
                 static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.forces_sent),
                 static_cast<unsigned long long>(stats.rejected), static_cast<unsigned long long>(stats.mesh_frames));
     return 0;

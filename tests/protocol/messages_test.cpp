@@ -49,7 +49,11 @@ TEST(Messages, RoundTripsEveryMessage) {
   const auto sd = decode_scene(encode(sc), &why);
   ASSERT_TRUE(sd) << why;
   EXPECT_EQ(sd->instruments.at(0).owner_client_id, 7u);
-  EXPECT_TRUE(decode_telemetry(encode(TelemetryReport{1, 2, 3, 4, 999.0, 1, 2, 3, 4}), &why));
+  const auto t = decode_telemetry(encode(TelemetryReport{1, 2, 3, 4, 999.0, 1, 2, 3, 4, 5}), &why);
+  ASSERT_TRUE(t) << why;
+  EXPECT_EQ(t->late_ticks, 3u);
+  EXPECT_EQ(t->missed_slots, 5u);
+  EXPECT_EQ(t->physics_rate_hz, 999.0);
 }
 
 TEST(Messages, RejectsTruncatedGarbageWrongSchemaAndBadNumbers) {

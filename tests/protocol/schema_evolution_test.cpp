@@ -6,6 +6,7 @@
 #include "force_feedback_generated.h"  // schema 1, from tests/protocol/schema_v1
 #include "instrument_command_generated.h"
 #include "session_generated.h"
+#include "telemetry_generated.h"
 #include "viscera/protocol/messages.hpp"  // schema 2 (current)
 
 namespace v1 = viscera::wire_v1;
@@ -94,4 +95,25 @@ TEST(SchemaEvolution, SchemaOneSessionRequestsStillDecode) {
   EXPECT_EQ(r->instrument_id, 2u);
   EXPECT_EQ(r->request_seq, 0u);  // absent: defaults
   EXPECT_TRUE(r->material.empty());
+}
+
+TEST(SchemaEvolution, TelemetryOfSchema5AndOfEarlierServersReadBothWays) {
+  // Schema 5 adds Telemetry.missed_slots; a console of schema 1 reads the rest of today's report...
+  const auto bytes = encode(TelemetryReport{7, 30'000, 12, 1, 1000.0, 600, 900, 1400, 25, 3});
+  flatbuffers::Verifier verifier(bytes.data(), bytes.size());
+  ASSERT_TRUE(v1::VerifyTelemetryBuffer(verifier));
+  const auto* old = v1::GetTelemetry(bytes.data());
+  EXPECT_EQ(old->steps(), 30'000u);
+  EXPECT_EQ(old->overruns(), 12u);
+  EXPECT_EQ(old->rejected_messages(), 1u);
+  EXPECT_EQ(old->physics_rate_hz(), 1000.0);
+  // ...and today's decoder reads a report of an earlier server with no slots missed.
+  flatbuffers::FlatBufferBuilder b;
+  b.Finish(v1::CreateTelemetry(b, 7, 29'990, 998.0, 600, 900, 1400, 25, 12, 1));
+  std::string why;
+  const auto t = decode_telemetry({b.GetBufferPointer(), b.GetSize()}, &why);
+  ASSERT_TRUE(t) << why;
+  EXPECT_EQ(t->late_ticks, 12u);
+  EXPECT_EQ(t->missed_slots, 0u);  // absent: the schema's default
+  EXPECT_EQ(t->physics_rate_hz, 998.0);
 }

@@ -99,8 +99,11 @@ struct Scene {
 
 struct TelemetryReport {
   std::int64_t server_stamp_ns = 0;
-  std::uint64_t steps = 0, overruns = 0, rejected_messages = 0;
+  std::uint64_t steps = 0;
+  std::uint64_t late_ticks = 0;  ///< ended after their slot (wire: `overruns`); the next tick starts at once
+  std::uint64_t rejected_messages = 0;
   double physics_rate_hz = 0, step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0;
+  std::uint64_t missed_slots = 0;  ///< slots that passed with no tick (schema 5; 0 from older servers)
 };
 
 /// An organ's boundary surface, sent once per mesh_id; frames list positions in its vertex order.
