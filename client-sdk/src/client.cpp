@@ -15,7 +15,7 @@ struct Client::Impl {
   proto::Writer commands, sessions;
   proto::Reader forces, scene;
   std::optional<proto::Scene> last_scene;
-  std::unique_ptr<proto::Reader> topology, frames, events;  // created on first use
+  std::unique_ptr<proto::Reader> topology, frames, events, telemetry;  // created on first use
   std::unique_ptr<proto::Writer> annotations;
   std::optional<proto::SurfaceTopology> surface;
   explicit Impl(std::uint32_t domain)
@@ -212,6 +212,18 @@ std::vector<proto::Event> Client::poll_events() {
     if (auto e = proto::decode_event(r.payload, &why)) out.push_back(std::move(*e));
     else ++rejected_;
   });
+  return out;
+}
+
+std::vector<proto::TelemetryReport> Client::poll_telemetry() {
+  if (!impl_->telemetry) impl_->telemetry = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::telemetry);
+  std::vector<proto::TelemetryReport> out;
+  impl_->telemetry->take([&](const proto::Received& r) {
+    std::string why;
+    if (auto t = proto::decode_telemetry(r.payload, &why)) out.push_back(*t);
+    else ++rejected_;
+  });
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.server_stamp_ns < b.server_stamp_ns; });
   return out;
 }
 

@@ -338,8 +338,17 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
 std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> bytes, std::string* why) {
   const auto* m = verified_root<fb::Telemetry>(bytes, why);
   if (!m) return std::nullopt;
-  return TelemetryReport{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
-                         m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us(), m->missed_slots()};
+  TelemetryReport t{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
+                    m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us(), m->missed_slots()};
+  const std::pair<const char*, double> figures[] = {{"physics_rate_hz", t.physics_rate_hz},     {"step_time_p50_us", t.step_p50_us},
+                                                    {"step_time_p99_us", t.step_p99_us},        {"step_time_max_us", t.step_max_us},
+                                                    {"tick_jitter_p99_us", t.jitter_p99_us}};
+  for (const auto& [name, v] : figures)
+    if (!std::isfinite(v) || v < 0) {
+      *why = std::string(name) + " is " + std::to_string(v) + " (a rate or a time: finite, >= 0)";
+      return std::nullopt;
+    }
+  return t;
 }
 
 namespace {

@@ -2,15 +2,19 @@
 # Integration, as separate processes over a real DDS domain on loopback with the project's Cyclone
 # configuration: viscera-server runs the liver scene; haptic-client claims a probe and presses it
 # into the liver and back at 1 kHz. The force must oppose the motion and grow with depth; the
-# server must stop cleanly on SIGINT. Usage: probe_press_test.sh BUILD_DIR SOURCE_DIR
+# server must stop cleanly on SIGINT. Meanwhile an instructor's console watches the server's health
+# reports: by the server's own clock, ticks run plus slots missed must cover the time elapsed. Usage: probe_press_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 trap 'kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
+"$build/tools/viscera-control/viscera-control" health --domain "$domain" --client-id 903 --duration 4.5 > "$tmp/health.log" 2>&1 &
+health=$!
 "$build/tools/haptic-client/haptic-client" --domain "$domain" --duration 4 --depth 0.03 --watch-mesh --report "$tmp/report.json" > "$tmp/client.log" 2>&1
 client_rc=$?
+wait "$health"; health_rc=$?
 # Grasp and pull: the grasper (instrument 3) closes its jaws on the top surface, pulls up 2 cm, opens.
 "$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 2 --instrument 3 --script grasp --depth 0 --pull 0.02 \
   --duration 4 --report "$tmp/grasp.json" >> "$tmp/client.log" 2>&1
@@ -31,6 +35,20 @@ check "schema-1 client exit code 0 (got $old_rc)" "[ $old_rc -eq 0 ]"
 check "trajectory client exit code 0 (got $trajectory_rc)" "[ $trajectory_rc -eq 0 ]"
 check "server exit code 0 after SIGINT (got $server_rc)" "[ $server_rc -eq 0 ]"
 check "server reports a clean stop" "grep -q 'stopped after' '$tmp/server.log'"
+check "the console received health reports (rc $health_rc)" "[ $health_rc -eq 0 ]"
+python3 - "$tmp/health.log" "$scene" <<'PY' || failures=$((failures+1))
+import json, re, sys
+rate = json.load(open(sys.argv[2]))["physics_rate_hz"]
+r = [(float(m[1]), int(m[2]), int(m[3]), int(m[4])) for m in
+     re.finditer(r"t \+([0-9.]+) s: [0-9]+ Hz physics, ([0-9]+) ticks \(([0-9]+) late, ([0-9]+) slots missed\)", open(sys.argv[1]).read())]
+assert len(r) >= 3, f"{len(r)} health reports in 4.5 s (one a second expected)"
+(t0, n0, _, m0), (t1, n1, _, m1) = r[0], r[-1]
+slots = (t1 - t0) * rate
+# The grid: every slot that passed holds a tick or is counted missed (a report is written within
+# its tick, up to a slot or two after the slot began).
+assert abs((n1 + m1) - (n0 + m0) - slots) <= 5, f"{n1 - n0} ticks + {m1 - m0} missed slots in {t1 - t0:.4f} s at {rate:.0f} Hz ({slots:.0f} slots)"
+print(f"[ figure ] health reports: {len(r)}; over {t1 - t0:.3f} s, {n1 - n0} ticks and {m1 - m0} missed slots for {slots:.1f} slots of the grid")
+PY
 python3 - "$tmp/grasp.json" <<'PY' || failures=$((failures+1))
 import json, sys
 r = json.load(open(sys.argv[1]))

@@ -90,6 +90,14 @@ TEST(Messages, RejectsTruncatedGarbageWrongSchemaAndBadNumbers) {
   Force f;
   f.force = {std::numeric_limits<double>::infinity(), 0, 0};
   EXPECT_FALSE(decode_force(encode(f), &why));
+  TelemetryReport t{1, 2, 3, 4, 999.0, 1, 2, 3, 4, 5};
+  t.step_p99_us = std::nan("");
+  EXPECT_FALSE(decode_telemetry(encode(t), &why));
+  EXPECT_NE(why.find("step_time_p99_us"), std::string::npos) << why;
+  t.step_p99_us = 2;
+  t.physics_rate_hz = -1000;
+  EXPECT_FALSE(decode_telemetry(encode(t), &why));
+  EXPECT_NE(why.find("physics_rate_hz"), std::string::npos) << why;
 }
 
 namespace {

@@ -1,17 +1,56 @@
 // viscera-control: session control of a running viscera-server from the command line, as an
 // instructor's console does it: pause, resume, reset the organ, load another scene, change the
-// material or the physics rate, show the scene state, follow the session's events, or annotate
-// the session.
+// material or the physics rate, show the scene state, watch the server's health, follow the
+// session's events, or annotate the session.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include "common/command_line.hpp"
 #include "viscera/client/client.hpp"
+
+namespace {
+
+/// Prints each health report of the server for `duration_s`, then the ticks, late ticks and
+/// missed slots over the watched span (by the server's stamps). Returns 1 if no report came.
+int watch_health(viscera::client::Client& client, const viscera::protocol::Scene& scene, double duration_s) {
+  client.poll_telemetry();  // subscribe
+  std::printf("watching the health of scene %s (physics %.0f Hz) for %.1f s\n", scene.name.c_str(), scene.physics_rate_hz, duration_s);
+  std::fflush(stdout);
+  std::optional<viscera::protocol::TelemetryReport> first, last;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+  while (std::chrono::steady_clock::now() < end) {
+    for (const auto& t : client.poll_telemetry()) {
+      if (!first) first = t;
+      last = t;
+      std::printf("t +%.4f s: %.0f Hz physics, %llu ticks (%llu late, %llu slots missed), step p50 %.0f us p99 %.0f us max %.0f us, "
+                  "tick jitter p99 %.0f us, %llu messages rejected\n",
+                  1e-9 * static_cast<double>(t.server_stamp_ns - first->server_stamp_ns), t.physics_rate_hz,
+                  static_cast<unsigned long long>(t.steps), static_cast<unsigned long long>(t.late_ticks),
+                  static_cast<unsigned long long>(t.missed_slots), t.step_p50_us, t.step_p99_us, t.step_max_us, t.jitter_p99_us,
+                  static_cast<unsigned long long>(t.rejected_messages));
+      std::fflush(stdout);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (!first) {
+    std::fprintf(stderr, "viscera-control: no health report from the server in %.1f s\n", duration_s);
+    return 1;
+  }
+  const double span_s = 1e-9 * static_cast<double>(last->server_stamp_ns - first->server_stamp_ns);
+  std::printf("over %.3f s: %llu ticks, %llu late, %llu slots missed, %llu messages rejected\n", span_s,
+              static_cast<unsigned long long>(last->steps - first->steps), static_cast<unsigned long long>(last->late_ticks - first->late_ticks),
+              static_cast<unsigned long long>(last->missed_slots - first->missed_slots),
+              static_cast<unsigned long long>(last->rejected_messages - first->rejected_messages));
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   viscera::cli::CommandLine cl("viscera-control",
@@ -22,12 +61,14 @@ int main(int argc, char** argv) {
       "  material        change material parameters (the flags below; the organ keeps its deformation)\n"
       "  rate HZ         change the physics rate [Hz]\n"
       "  show            print the scene state\n"
+      "  health          print the server's health reports (physics rate, step times, late ticks, missed slots,\n"
+      "                  rejected messages) for --duration seconds, then what changed over them\n"
       "  events          print the session's events and annotations for --duration seconds\n"
       "  annotate TEXT   a note for recorders and consoles\n"
       "Usage: viscera-control ACTION [ARGUMENT] [--domain ID] [--duration S] [material flags]");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
-  cl.flag("duration", "S", "events: how long to follow them [s]", "10");
+  cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
   cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
   cl.flag("youngs-modulus-pa", "E", "material: Young's modulus [Pa] (isotropic materials)");
   cl.flag("poisson-ratio", "NU", "material: Poisson's ratio (isotropic materials)");
@@ -38,11 +79,11 @@ int main(int argc, char** argv) {
   try {
     if (!cl.parse(argc, argv)) return 0;
     const auto& rest = cl.positional();
-    const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, events or annotate TEXT";
+    const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, health, events or annotate TEXT";
     if (rest.empty()) throw viscera::cli::UsageError("missing ACTION (" + actions + ")");
     const std::string action = rest[0];
     const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false}, {"load", true}, {"material", false},
-                                               {"rate", true},   {"show", false},   {"events", false}, {"annotate", true}};
+                                               {"rate", true},   {"show", false},   {"health", false}, {"events", false}, {"annotate", true}};
     const auto k = known.find(action);
     if (k == known.end()) throw viscera::cli::UsageError("ACTION '" + action + "' is not " + actions);
     if (k->second != (rest.size() == 2))
@@ -97,6 +138,7 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
+    if (action == "health") return watch_health(client, *scene, duration);
     if (action == "annotate") {
       client.annotate(rest[1]);  // waits for the readers' acknowledgements
       std::printf("annotated scene %s\n", scene->name.c_str());

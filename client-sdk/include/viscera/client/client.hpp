@@ -71,6 +71,11 @@ class Client {
   /// Session events (server) and annotations (clients) that arrived since the last call, in
   /// order. The first call subscribes; events before it are not seen.
   std::vector<protocol::Event> poll_events();
+  /// The server's health reports (about one a second: achieved physics rate, step times, tick
+  /// jitter, ticks run, late ticks, missed slots, rejected messages) that arrived since the last
+  /// call, oldest first. The first call subscribes; reports before it are not seen. Best effort,
+  /// keep last 1: a client that polls less than once a second sees only the newest.
+  std::vector<protocol::TelemetryReport> poll_telemetry();
   /// Publishes an annotation (at most 1024 bytes of text) for recorders and consoles. The first
   /// call waits (up to 1 s) for a reader to be discovered; each waits (up to 1 s) for the readers'
   /// acknowledgements, so a client that exits right after still delivers it.
