@@ -72,6 +72,8 @@ expect control-rate-range 2 "rate '5' is not a number of hertz in \[10, 10000\]"
 expect control-material-empty 2 "material needs at least one of" -- "$build/tools/viscera-control/viscera-control" material
 expect control-material-flag-elsewhere 2 "material flags are for the material action" -- "$build/tools/viscera-control/viscera-control" pause --shear-q 3
 expect control-material-range 2 "poisson-ratio" -- "$build/tools/viscera-control/viscera-control" material --poisson-ratio 0.7
+expect control-health-argument 2 "unexpected argument 'now'" -- "$build/tools/viscera-control/viscera-control" health now
+expect control-health-duration 2 "duration" -- "$build/tools/viscera-control/viscera-control" health --duration 0
 expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
