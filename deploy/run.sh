@@ -6,7 +6,7 @@
 # process) makes the liver twice as stiff while the server runs, and the probe presses again. All
 # print live: the server its physics rate, step times, jitter, late ticks, missed slots and the force on the
 # tools; the client the force it feels, the command-to-force round trip and the surface frames it
-# receives; the console what the server did.
+# receives; the console what the server did, and the server's health reports while the probe presses again.
 #   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene
 #   DURATION=20 ./deploy/run.sh                           a longer press (seconds)
 set -euo pipefail
@@ -28,7 +28,10 @@ echo "[demo] grasper 3 closes its jaws on the liver, pulls it up 2 cm, lets go (
   --duration 6 2>&1 | sed -u 's/^/[haptic] /'
 echo "[demo] an instructor's console doubles the liver's Young's modulus while the server runs"
 "$bin/tools/viscera-control/viscera-control" material --youngs-modulus-pa 10000 --domain "$domain" 2>&1 | sed -u 's/^/[console] /'
-echo "[demo] probe 1 presses 3 cm again: the stiffer liver pushes back harder (${duration} s)"
+echo "[demo] probe 1 presses 3 cm again: the stiffer liver pushes back harder (${duration} s); the console watches the server's health"
+"$bin/tools/viscera-control/viscera-control" health --duration 3.5 --domain "$domain" 2>&1 | sed -u 's/^/[console] /' &
+console=$!
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
   --duration "$duration" 2>&1 | sed -u 's/^/[haptic] /'
+wait "$console" || true
 echo "[demo] done; the server stops"

@@ -42,6 +42,10 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
     std::fprintf(stderr, "viscera-control: no health report from the server in %.1f s\n", duration_s);
     return 1;
   }
+  if (last->steps < first->steps) {  // counters start again with a new server process
+    std::printf("the server restarted while watched: no totals\n");
+    return 0;
+  }
   const double span_s = 1e-9 * static_cast<double>(last->server_stamp_ns - first->server_stamp_ns);
   std::printf("over %.3f s: %llu ticks, %llu late, %llu slots missed, %llu messages rejected\n", span_s,
               static_cast<unsigned long long>(last->steps - first->steps), static_cast<unsigned long long>(last->late_ticks - first->late_ticks),
