@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
+#include "common/known_fields.hpp"
 
 namespace viscera::lab {
 
@@ -112,15 +113,24 @@ Dataset read_dataset(const std::string& folder) {
   } catch (const json::parse_error& e) {
     throw InputError(meta, 0, "JSON", e.what());
   }
+  if (!j.is_object()) throw InputError(meta, 0, "", "not a JSON object");
+  tissue::require_known_fields(j, meta, "", {"name", "mode", "specimen", "tests"});
+  const auto text = [&](const json& o, const char* key, const std::string& field) {
+    if (!o.contains(key)) return std::string();
+    if (!o[key].is_string()) throw InputError(meta, 0, field, o[key].dump() + " is not a string");
+    return o[key].get<std::string>();
+  };
   Dataset d;
   d.folder = folder;
-  d.name = j.value("name", std::filesystem::path(folder).filename().string());
-  const std::string mode = j.value("mode", "");
+  d.name = text(j, "name", "name");
+  if (d.name.empty()) d.name = std::filesystem::path(folder).filename().string();
+  const std::string mode = text(j, "mode", "mode");
   if (mode == "uniaxial") d.mode = Mode::uniaxial;
   else if (mode == "simple_shear") d.mode = Mode::simple_shear;
   else throw InputError(meta, 0, "mode", "'" + mode + "' is not uniaxial or simple_shear");
   if (!j.contains("specimen") || !j["specimen"].is_object()) throw InputError(meta, 0, "specimen", "missing or not an object");
   const json& s = j["specimen"];
+  tissue::require_known_fields(s, meta, "specimen.", {"length_m", "width_m", "thickness_m", "density_kg_m3"});
   d.specimen = {positive(s, "length_m", meta, 1e-6, 10, "m"), positive(s, "width_m", meta, 1e-6, 10, "m"),
                 positive(s, "thickness_m", meta, 1e-6, 10, "m"), positive(s, "density_kg_m3", meta, 1, 1e5, "kg/m^3")};
   if (!j.contains("tests") || !j["tests"].is_array() || j["tests"].empty()) throw InputError(meta, 0, "tests", "missing or empty");
@@ -128,7 +138,8 @@ Dataset read_dataset(const std::string& folder) {
     const json& t = j["tests"][k];
     const std::string field = "tests[" + std::to_string(k) + "]";
     if (!t.is_object() || !t.contains("file") || !t["file"].is_string()) throw InputError(meta, 0, field + ".file", "missing");
-    const std::string control = t.value("control", "");
+    tissue::require_known_fields(t, meta, field + ".", {"file", "control"});
+    const std::string control = text(t, "control", field + ".control");
     if (control != "strain" && control != "stress")
       throw InputError(meta, 0, field + ".control", "'" + control + "' is not strain or stress");
     const std::string file = t["file"].get<std::string>();

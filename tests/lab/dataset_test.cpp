@@ -53,6 +53,12 @@ TEST(Dataset, BadInputNamesFileLineAndField) {
       {"control", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "force"}]})", kCsv, "tests[0].control: 'force'"},
       {"missing", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "zz.csv", "control": "strain"}]})", kCsv, "zz.csv: cannot open file"},
       {"garbage", kJson, "time_s,strain,stress_pa\n0,0,0\n1,abc,10\n2,0.02,20\n", "a.csv:3: strain: 'abc' is not a number"},
+      // A misspelt field would otherwise be ignored without a word.
+      {"unknown", R"({"mode": "uniaxial", "temperature_c": 37, "specimen": {}, "tests": []})", kCsv, "dataset.json: temperature_c: unknown field"},
+      {"unknown-specimen", R"({"mode": "uniaxial", "specimen": {"lenght_m": 0.01}, "tests": []})", kCsv, "dataset.json: specimen.lenght_m: unknown field"},
+      {"unknown-test", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "contol": "strain"}]})", kCsv, "dataset.json: tests[0].contol: unknown field"},
+      {"mode-type", R"({"mode": 3, "specimen": {}, "tests": []})", kCsv, "dataset.json: mode: 3 is not a string"},
+      {"array", R"([1, 2])", kCsv, "dataset.json: not a JSON object"},
   };
   for (const auto& c : cases) {
     const std::string msg = error_of(make(c.name, c.json, c.csv));

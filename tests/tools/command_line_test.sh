@@ -81,6 +81,16 @@ expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/tit
 expect lab-no-dataset 2 "nowhere/dataset.json: cannot open file" -- "$lab" analyze "$tmp/nowhere" --out "$tmp/o"
 expect lab-analyze 0 "causes: broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet
 expect lab-predict 0 "wrote" -- "$lab" predict "$tmp/titin/model.json" "$src/data/titin-passive-muscle" --out "$tmp/predicted"
+# A model file edited by hand: each mistake named by file and field.
+model_case() {  # model_case NAME PATTERN PYTHON-EDIT
+  python3 -c "import json; m=json.load(open('$tmp/titin/model.json')); $3; json.dump(m, open('$tmp/$1.json', 'w'))"
+  expect "lab-model-$1" 2 "$2" -- "$lab" predict "$tmp/$1.json" "$src/data/titin-passive-muscle" --out "$tmp/p-$1"
+}
+model_case misspelt "misspelt.json: modulus: unknown field" "m['modulus'] = m.pop('modulus_pa')"
+model_case negative "negative.json: modulus_pa: -5 is outside" "m['modulus_pa'] = -5"
+model_case relaxation "relaxation.json: relaxation_time_s\[1\]: 0 is outside" "m['relaxation_time_s'][1] = 0"
+model_case text "text.json: viscosity_pa_s: \"a lot\" is not a number" "m['viscosity_pa_s'] = 'a lot'"
+model_case softening "softening.json: softening_d: 1.5 is outside" "m['mechanisms'].append('first_load_softening'); m['softening_d'] = 1.5"
 grep -q '"rms_pa"' "$tmp/predicted/report.json" || { echo "FAIL lab-predict: no rms_pa"; failures=$((failures+1)); }
 for key in baseline.model baseline.heldout_rms_pa causes final.model final.heldout_rms_pa gain; do
   python3 -c "import json,sys; r=json.load(open('$tmp/titin/report.json')); v=r
