@@ -75,6 +75,9 @@ expect control-material-range 2 "poisson-ratio" -- "$build/tools/viscera-control
 expect control-health-argument 2 "unexpected argument 'now'" -- "$build/tools/viscera-control/viscera-control" health now
 expect control-health-duration 2 "duration" -- "$build/tools/viscera-control/viscera-control" health --duration 0
 expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
+expect bench-thread-cpu-help 0 "Usage: .*thread_cpu.sh" -- "$src/bench/thread_cpu.sh" --help
+expect bench-thread-cpu-scene 2 "no scene 'nowhere'" -- "$src/bench/thread_cpu.sh" nowhere
+expect bench-thread-cpu-window 2 "SECONDS: '0'" -- "$src/bench/thread_cpu.sh" liver 0
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
 expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"
