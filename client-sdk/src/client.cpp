@@ -1,6 +1,8 @@
 #include "viscera/client/client.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -10,6 +12,15 @@ namespace viscera::client {
 
 namespace proto = viscera::protocol;
 
+const char* to_string(ServerState s) {
+  switch (s) {
+    case ServerState::waiting: return "waiting";
+    case ServerState::alive: return "alive";
+    case ServerState::lost: return "lost";
+  }
+  return "?";
+}
+
 struct Client::Impl {
   proto::Participant participant;
   proto::Writer commands, sessions;
@@ -18,12 +29,29 @@ struct Client::Impl {
   std::unique_ptr<proto::Reader> topology, frames, events, telemetry;  // created on first use
   std::unique_ptr<proto::Writer> annotations;
   std::optional<proto::SurfaceTopology> surface;
+  // The server's liveliness, as its scene-state writer's: set by a DDS listener thread.
+  std::atomic<ServerState> server{ServerState::waiting};
+  std::atomic<std::int64_t> lost_ns{0};
+  std::mutex callback_mutex;
+  std::function<void(ServerState)> callback;
   explicit Impl(std::uint32_t domain)
       : participant(domain),
         commands(participant, proto::Stream::instrument_command),
         sessions(participant, proto::Stream::session_request),
         forces(participant, proto::Stream::force_feedback),
-        scene(participant, proto::Stream::scene_state) {}
+        scene(participant, proto::Stream::scene_state) {
+    scene.on_alive_writers_changed([this](int alive) { liveliness(alive); });
+    liveliness(scene.alive_writers());  // a server discovered before the listener was set
+  }
+  void liveliness(int alive) {
+    std::lock_guard lock(callback_mutex);
+    const ServerState before = server.load();
+    const ServerState now = alive > 0 ? ServerState::alive : before == ServerState::waiting ? ServerState::waiting : ServerState::lost;
+    if (now == before) return;
+    if (now == ServerState::lost) lost_ns = proto::now_ns();
+    server = now;
+    if (callback) callback(now);
+  }
   void take_scene(std::uint64_t& rejected) {
     scene.take([&](const proto::Received& r) {
       std::string why;
@@ -51,17 +79,28 @@ std::optional<proto::Scene> Client::scene() {
   return impl_->last_scene;
 }
 
-bool Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
+ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
+  const proto::SessionRequest r{client_id_, proto::Action::claim_instrument, instrument_id};
+  std::string why = "no scene state from the server";
   while (std::chrono::steady_clock::now() < end) {
-    impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, proto::Action::claim_instrument, instrument_id}));
-    impl_->scene.wait(std::chrono::milliseconds(100));
     impl_->take_scene(rejected_);
-    if (impl_->last_scene)
-      for (const auto& i : impl_->last_scene->instruments)
-        if (i.instrument_id == instrument_id && i.owner_client_id == client_id_) return true;
+    if (const auto& s = impl_->last_scene) {
+      // The scene state lists the instruments and their owners.
+      const auto it = std::find_if(s->instruments.begin(), s->instruments.end(), [&](const auto& i) { return i.instrument_id == instrument_id; });
+      if (it == s->instruments.end()) {
+        std::string list;
+        for (const auto& i : s->instruments) list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.grasper ? " (grasper)" : " (probe)");
+        return {false, "scene " + s->name + " has no instrument " + std::to_string(instrument_id) + " (its instruments: " + list + ")"};
+      }
+      if (it->owner_client_id == client_id_) return {true, {}};
+      // Taken: keep asking until the timeout, its owner may release it (or lose it to the lease).
+      why = it->owner_client_id != 0 ? "taken by client " + std::to_string(it->owner_client_id) : "the server did not confirm the claim";
+    }
+    impl_->sessions.write(client_id_, proto::encode(r));
+    impl_->scene.wait(std::chrono::milliseconds(100));
   }
-  return false;
+  return {false, why};
 }
 
 void Client::release(std::uint32_t instrument_id) {
@@ -236,6 +275,21 @@ void Client::annotate(const std::string& text) {
   }
   impl_->annotations->write(client_id_, proto::encode(proto::Event{client_id_, proto::EventKind::annotation, 0, client_id_, 0, proto::now_ns(), text}));
   impl_->annotations->wait_for_acks(std::chrono::seconds(1));
+}
+
+std::int64_t now_ns() { return proto::now_ns(); }
+
+ServerState Client::server_state() const { return impl_->server.load(); }
+
+std::optional<std::int64_t> Client::server_lost_ns() const {
+  const std::int64_t t = impl_->lost_ns.load();
+  if (t == 0) return std::nullopt;
+  return t;
+}
+
+void Client::on_server_state(std::function<void(ServerState)> f) {
+  std::lock_guard lock(impl_->callback_mutex);
+  impl_->callback = std::move(f);
 }
 
 LatencyStats Client::round_trip() const {

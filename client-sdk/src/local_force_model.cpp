@@ -26,6 +26,12 @@ RenderedForce render_local_model(const protocol::Force& f, const protocol::Vecto
 }
 
 void LocalForceRenderer::update(const protocol::Force& f, const protocol::Vector3& x0, double t_s) {
+  const double g = gain(t_s);
+  if (g < 1) {  // the server answers again after a fade: fade back in from where the force is
+    resume_s_ = t_s;
+    resume_gain_ = g;
+  }
+  lost_s_ = std::numeric_limits<double>::infinity();
   if (has_new_) {
     old_ = new_;
     has_old_ = true;
@@ -33,6 +39,22 @@ void LocalForceRenderer::update(const protocol::Force& f, const protocol::Vector
   new_ = {f, x0};
   has_new_ = true;
   arrived_s_ = t_s;
+}
+
+void LocalForceRenderer::server_lost(double t_s) { lost_s_ = std::min(lost_s_, t_s); }
+
+double LocalForceRenderer::fade_start_s() const {
+  return std::min(lost_s_, has_new_ ? arrived_s_ + fade_.stale_after_s : std::numeric_limits<double>::infinity());
+}
+
+double LocalForceRenderer::gain(double t_s) const {
+  const double rate = fade_.fade_s > 0 ? 1.0 / fade_.fade_s : std::numeric_limits<double>::infinity();
+  // Fading back in after a model came while fading out, and fading out once the models stop.
+  const double in = std::min(1.0, resume_gain_ + rate * std::max(0.0, t_s - resume_s_));
+  const double start = fade_start_s();
+  if (t_s <= start) return in;
+  const double at_start = std::min(1.0, resume_gain_ + rate * std::max(0.0, start - resume_s_));
+  return std::max(0.0, at_start - rate * (t_s - start));
 }
 
 RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s) const {
@@ -50,6 +72,8 @@ RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s)
     for (double& c : r.force) c *= max_force_ / mag;
     r.clamped = true;
   }
+  const double g = gain(t_s);
+  for (double& c : r.force) c *= g;
   return r;
 }
 

@@ -155,6 +155,23 @@ bool Reader::wait(std::chrono::nanoseconds timeout) {
   return dds_waitset_wait(waitset_, nullptr, 0, timeout.count()) > 0;
 }
 
+int Reader::alive_writers() const {
+  dds_liveliness_changed_status_t st{};
+  dds_get_liveliness_changed_status(handle_, &st);
+  return static_cast<int>(st.alive_count);
+}
+
+void Reader::on_alive_writers_changed(std::function<void(int)> f) {
+  on_alive_ = std::move(f);
+  dds_listener_t* l = dds_create_listener(this);
+  dds_lset_liveliness_changed(l, [](dds_entity_t, const dds_liveliness_changed_status_t st, void* arg) {
+    static_cast<Reader*>(arg)->on_alive_(static_cast<int>(st.alive_count));
+  });
+  const dds_return_t rc = dds_set_listener(handle_, l);
+  dds_delete_listener(l);
+  check(rc, "set listener");
+}
+
 std::int64_t now_ns() { return dds_time(); }
 
 }  // namespace viscera::protocol

@@ -103,13 +103,16 @@ std::vector<std::uint8_t> encode(const Scene& s) {
     outcomes.push_back(fb::CreateRequestOutcome(b, o.client_id, o.request_seq, static_cast<fb::SessionAction>(o.action), o.accepted,
                                                 b.CreateString(o.message)));
   const auto recent = b.CreateVector(outcomes);
-  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent));
+  const auto unreadable = b.CreateVectorOfStrings(s.unreadable_scenes);
+  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent,
+                                        unreadable));
 }
 
 std::vector<std::uint8_t> encode(const TelemetryReport& t) {
   flatbuffers::FlatBufferBuilder b(128);
   return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us,
-                                       t.jitter_p99_us, t.late_ticks, t.rejected_messages, t.missed_slots));
+                                       t.jitter_p99_us, t.late_ticks, t.rejected_messages, t.missed_slots, t.rejected_malformed,
+                                       t.rejected_not_owner, t.rejected_unknown_instrument));
 }
 
 std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
@@ -324,6 +327,8 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
   if (m->available_scenes())
     for (const auto* n : *m->available_scenes()) s.available_scenes.push_back(n->str());
   s.preparing = m->preparing() ? m->preparing()->str() : "";
+  if (m->unreadable_scenes())
+    for (const auto* n : *m->unreadable_scenes()) s.unreadable_scenes.push_back(n->str());
   if (m->recent_requests())
     for (const auto* o : *m->recent_requests())
       s.recent_requests.push_back({o->client_id(), o->request_seq(), static_cast<Action>(o->action()), o->accepted(),
@@ -339,7 +344,8 @@ std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> by
   const auto* m = verified_root<fb::Telemetry>(bytes, why);
   if (!m) return std::nullopt;
   TelemetryReport t{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
-                    m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us(), m->missed_slots()};
+                    m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us(), m->missed_slots(),
+                    m->rejected_malformed(), m->rejected_not_owner(), m->rejected_unknown_instrument()};
   const std::pair<const char*, double> figures[] = {{"physics_rate_hz", t.physics_rate_hz},     {"step_time_p50_us", t.step_p50_us},
                                                     {"step_time_p99_us", t.step_p99_us},        {"step_time_max_us", t.step_max_us},
                                                     {"tick_jitter_p99_us", t.jitter_p99_us}};

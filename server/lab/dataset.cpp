@@ -1,19 +1,22 @@
 #include "dataset.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <optional>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
-#include "common/known_fields.hpp"
+#include "common/json_input.hpp"
 
 namespace viscera::lab {
 
 using tissue::InputError;
+using tissue::JsonObject;
 using nlohmann::json;
 
 const char* to_string(Mode m) { return m == Mode::uniaxial ? "uniaxial" : "simple_shear"; }
@@ -21,37 +24,41 @@ const char* to_string(Control c) { return c == Control::strain ? "strain" : "str
 
 namespace {
 
-double positive(const json& j, const char* key, const std::string& source, double lo, double hi, const char* unit) {
-  const std::string field = std::string("specimen.") + key;
-  if (!j.contains(key)) throw InputError(source, 0, field, "missing");
-  if (!j[key].is_number()) throw InputError(source, 0, field, j[key].dump() + " is not a number");
-  const double v = j[key].get<double>();
-  if (!(v >= lo && v <= hi)) {
-    std::ostringstream s;
-    s << v << " " << unit << " cannot be right (expected " << lo << " to " << hi << ")";
-    throw InputError(source, 0, field, s.str());
-  }
-  return v;
-}
+// A test more than this many times stiffer or softer than the others is in another unit.
+constexpr double kUnitRatio = 250.0;
+// Apparent moduli no tissue has: below 10 Pa (the softest brain and fat are about 100 Pa-1 kPa)
+// and above 50 GPa (cortical bone is about 20 GPa).
+constexpr double kSoftestPa = 10.0, kStiffestPa = 5e10;
+// A test file larger than this is not a measurement of one specimen (1.3 million rows are 43 MB).
+constexpr std::size_t kMaxCsvBytes = std::size_t{1} << 30;
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) {
-    while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.pop_back();
-    while (!cell.empty() && cell.front() == ' ') cell.erase(cell.begin());
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> out;
+  for (;;) {
+    const std::size_t comma = line.find(',');
+    std::string_view cell = line.substr(0, comma);
+    while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.remove_suffix(1);
+    while (!cell.empty() && cell.front() == ' ') cell.remove_prefix(1);
     out.push_back(cell);
+    if (comma == std::string_view::npos) return out;
+    line.remove_prefix(comma + 1);
   }
-  return out;
 }
 
 TestData read_csv(const std::string& path, const std::string& file, Control control) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, 0, "", "cannot open file");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(path, 1, "header", "file is empty");
-  const auto header = split(line);
+  const std::string content = tissue::read_text_file(path, kMaxCsvBytes);
+  std::string_view text(content);
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // a UTF-8 byte-order mark (spreadsheet exports)
+  const auto next_line = [&]() -> std::optional<std::string_view> {
+    if (text.empty()) return std::nullopt;
+    const std::size_t end = text.find('\n');
+    const std::string_view line = text.substr(0, end);
+    text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
+    return line;
+  };
+  const auto first = next_line();
+  if (!first) throw InputError(path, 1, "header", "file is empty");
+  const auto header = split(*first);
   int col_t = -1, col_e = -1, col_s = -1, col_sd = -1;
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (header[c] == "time_s") col_t = static_cast<int>(c);
@@ -60,40 +67,37 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
     else if (header[c] == "stress_sd_pa") col_sd = static_cast<int>(c);
   }
   for (const auto& [col, name] : {std::pair{col_t, "time_s"}, std::pair{col_e, "strain"}, std::pair{col_s, "stress_pa"}})
-    if (col < 0) throw InputError(path, 1, name, "column missing (header: " + line + ")");
+    if (col < 0) throw InputError(path, 1, name, "column missing (the first line, '" + tissue::printable(*first, 60) + "', must name the columns time_s,strain,stress_pa[,stress_sd_pa])");
   TestData t;
   t.file = file;
   t.control = control;
   long row = 1;
-  while (std::getline(in, line)) {
+  while (const auto line = next_line()) {
     ++row;
-    if (line.empty() || line == "\r") continue;
-    const auto cells = split(line);
+    if (line->empty() || *line == "\r") continue;
+    const auto cells = split(*line);
     const auto value = [&](int col, const char* name) {
       if (col >= static_cast<int>(cells.size())) throw InputError(path, row, name, "missing value");
-      const std::string& c = cells[static_cast<std::size_t>(col)];
+      const std::string_view c = cells[static_cast<std::size_t>(col)];
       double v = 0;
       const auto [end, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
-      if (ec != std::errc() || end != c.data() + c.size()) throw InputError(path, row, name, "'" + c + "' is not a number");
-      if (!std::isfinite(v)) throw InputError(path, row, name, "'" + c + "' is not finite");
+      if (ec != std::errc() || end != c.data() + c.size()) throw InputError(path, row, name, "'" + tissue::printable(c) + "' is not a number");
+      if (!std::isfinite(v)) throw InputError(path, row, name, "'" + tissue::printable(c) + "' is not finite");
       return v;
     };
     const double time = value(col_t, "time_s"), strain = value(col_e, "strain"), stress = value(col_s, "stress_pa");
-    if (!t.time_s.empty() && !(time > t.time_s.back())) {
-      std::ostringstream s;
-      s << time << " s does not increase (previous row " << t.time_s.back() << " s)";
-      throw InputError(path, row, "time_s", s.str());
-    }
+    if (!t.time_s.empty() && !(time > t.time_s.back()))
+      throw InputError(path, row, "time_s", tissue::short_number(time) + " s does not increase (previous row " + tissue::short_number(t.time_s.back()) + " s)");
     if (std::abs(strain) > 5.0)
-      throw InputError(path, row, "strain", std::to_string(strain) + " cannot be right: strain is dimensionless (1 = 100%), not percent");
+      throw InputError(path, row, "strain", tissue::short_number(strain) + " cannot be right: strain is dimensionless (1 = 100%), not percent");
     if (std::abs(stress) > 1e9)
-      throw InputError(path, row, "stress_pa", std::to_string(stress) + " Pa cannot be right for soft tissue (stress in pascals?)");
+      throw InputError(path, row, "stress_pa", tissue::short_number(stress) + " Pa cannot be right for soft tissue (stress in pascals?)");
     t.time_s.push_back(time);
     t.strain.push_back(strain);
     t.stress_pa.push_back(stress);
     if (col_sd >= 0) {
       const double sd = value(col_sd, "stress_sd_pa");
-      if (sd < 0) throw InputError(path, row, "stress_sd_pa", std::to_string(sd) + " is negative");
+      if (sd < 0) throw InputError(path, row, "stress_sd_pa", tissue::short_number(sd) + " is negative");
       t.stress_sd_pa.push_back(sd);
     }
   }
@@ -101,51 +105,89 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
   return t;
 }
 
+/// The test file named in dataset.json, which must lie inside the data-set folder (a data set is
+/// a folder a user hands over; it must not make the tool read other files of the machine).
+std::string test_path(const std::string& folder, const std::string& file, const JsonObject& test) {
+  namespace fs = std::filesystem;
+  const fs::path name(file);
+  if (file.empty() || name.is_absolute()) test.fail("file", "'" + tissue::printable(file) + "' must be a file name relative to the data-set folder");
+  const fs::path base = fs::weakly_canonical(fs::path(folder));
+  const fs::path full = fs::weakly_canonical(base / name);
+  const fs::path inside = full.lexically_relative(base);
+  if (inside.empty() || *inside.begin() == "..")
+    test.fail("file", "'" + tissue::printable(file) + "' lies outside the data-set folder " + tissue::printable(folder, 200));
+  return full.string();
+}
+
+/// Stresses that cannot be in pascals: a test whose apparent modulus (peak |stress| / peak
+/// |strain|) is hundreds of times the other tests' (one test in kPa or MPa), or a data set whose
+/// apparent modulus is below any soft tissue or above bone.
+void check_stress_units(const Dataset& d, const std::string& meta) {
+  std::vector<double> modulus;
+  for (const auto& t : d.tests) {
+    double s = 0, e = 0;
+    for (std::size_t k = 0; k < t.time_s.size(); ++k) {
+      s = std::max(s, std::abs(t.stress_pa[k]));
+      e = std::max(e, std::abs(t.strain[k]));
+    }
+    modulus.push_back(e > 0 ? s / e : 0.0);
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  for (std::size_t k = 0; k < d.tests.size() && d.tests.size() >= 2; ++k) {
+    std::vector<double> others = modulus;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
+    const double m = median(others), ratio = modulus[k] / m;
+    if (m > 0 && modulus[k] > 0 && (ratio > kUnitRatio || ratio < 1 / kUnitRatio))
+      throw InputError((std::filesystem::path(d.folder) / d.tests[k].file).string(), 0, "stress_pa",
+                       "apparent modulus " + tissue::short_number(modulus[k]) + " Pa is " + tissue::short_number(ratio) +
+                           " times the other tests' (" + tissue::short_number(m) + " Pa): is this test in another unit (kPa, MPa)?");
+  }
+  const double m = median(modulus);
+  if (m > 0 && m < kSoftestPa)
+    throw InputError(meta, 0, "tests", "apparent modulus " + tissue::short_number(m) + " Pa (peak stress / peak strain) is below any tissue (" +
+                                           tissue::short_number(kSoftestPa) + " Pa): are the stresses in kPa? The unit is Pa");
+  if (m > kStiffestPa)
+    throw InputError(meta, 0, "tests", "apparent modulus " + tissue::short_number(m) + " Pa is above bone's (" + tissue::short_number(kStiffestPa) +
+                                           " Pa): are the stresses or strains in another unit?");
+}
+
 }  // namespace
 
 Dataset read_dataset(const std::string& folder) {
   const std::string meta = (std::filesystem::path(folder) / "dataset.json").string();
-  std::ifstream in(meta);
-  if (!in) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(meta, 0, "JSON", e.what());
-  }
-  if (!j.is_object()) throw InputError(meta, 0, "", "not a JSON object");
-  tissue::require_known_fields(j, meta, "", {"name", "mode", "specimen", "tests"});
-  const auto text = [&](const json& o, const char* key, const std::string& field) {
-    if (!o.contains(key)) return std::string();
-    if (!o[key].is_string()) throw InputError(meta, 0, field, o[key].dump() + " is not a string");
-    return o[key].get<std::string>();
-  };
+  if (!std::filesystem::exists(meta)) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");
+  const json j = tissue::read_json_file(meta);
+  const JsonObject top(j, meta);
+  top.require_known({"name", "mode", "specimen", "tests", "max_test_duration_s"});
   Dataset d;
   d.folder = folder;
-  d.name = text(j, "name", "name");
-  if (d.name.empty()) d.name = std::filesystem::path(folder).filename().string();
-  const std::string mode = text(j, "mode", "mode");
-  if (mode == "uniaxial") d.mode = Mode::uniaxial;
-  else if (mode == "simple_shear") d.mode = Mode::simple_shear;
-  else throw InputError(meta, 0, "mode", "'" + mode + "' is not uniaxial or simple_shear");
-  if (!j.contains("specimen") || !j["specimen"].is_object()) throw InputError(meta, 0, "specimen", "missing or not an object");
-  const json& s = j["specimen"];
-  tissue::require_known_fields(s, meta, "specimen.", {"length_m", "width_m", "thickness_m", "density_kg_m3"});
-  d.specimen = {positive(s, "length_m", meta, 1e-6, 10, "m"), positive(s, "width_m", meta, 1e-6, 10, "m"),
-                positive(s, "thickness_m", meta, 1e-6, 10, "m"), positive(s, "density_kg_m3", meta, 1, 1e5, "kg/m^3")};
-  if (!j.contains("tests") || !j["tests"].is_array() || j["tests"].empty()) throw InputError(meta, 0, "tests", "missing or empty");
-  for (std::size_t k = 0; k < j["tests"].size(); ++k) {
-    const json& t = j["tests"][k];
-    const std::string field = "tests[" + std::to_string(k) + "]";
-    if (!t.is_object() || !t.contains("file") || !t["file"].is_string()) throw InputError(meta, 0, field + ".file", "missing");
-    tissue::require_known_fields(t, meta, field + ".", {"file", "control"});
-    const std::string control = text(t, "control", field + ".control");
-    if (control != "strain" && control != "stress")
-      throw InputError(meta, 0, field + ".control", "'" + control + "' is not strain or stress");
-    const std::string file = t["file"].get<std::string>();
-    d.tests.push_back(read_csv((std::filesystem::path(folder) / file).string(), file,
-                               control == "strain" ? Control::strain : Control::stress));
+  d.name = top.text("name", std::filesystem::path(folder).filename().string());
+  d.mode = top.choice("mode", {"uniaxial", "simple_shear"}, "") == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
+  const JsonObject s = top.object("specimen");
+  s.require_known({"length_m", "width_m", "thickness_m", "density_kg_m3"});
+  d.specimen = {s.number("length_m", 1e-6, 10), s.number("width_m", 1e-6, 10), s.number("thickness_m", 1e-6, 10),
+                s.number("density_kg_m3", 1, 1e5)};
+  // Longer tests exist (creep over days) but are rare; a span beyond a day is more often a time
+  // column in another unit, so it must be declared.
+  const double max_duration_s = top.number("max_test_duration_s", 1e-3, 1e9, 86400.0);
+  const json& tests = top.array("tests", 1);
+  for (std::size_t k = 0; k < tests.size(); ++k) {
+    const JsonObject t(tests[k], meta, "tests[" + std::to_string(k) + "]");
+    t.require_known({"file", "control"});
+    const std::string file = t.text("file");
+    const Control control = t.choice("control", {"strain", "stress"}, "") == "strain" ? Control::strain : Control::stress;
+    d.tests.push_back(read_csv(test_path(folder, file, t), file, control));
+    const TestData& added = d.tests.back();
+    const double span = added.time_s.back() - added.time_s.front();
+    if (span > max_duration_s)
+      throw InputError((std::filesystem::path(folder) / file).string(), 0, "time_s",
+                       "the test spans " + tissue::short_number(span) + " s, more than " + tissue::short_number(max_duration_s) +
+                           " s: is the time in another unit? (a longer test is declared with \"max_test_duration_s\" in dataset.json)");
   }
+  check_stress_units(d, meta);
   return d;
 }
 

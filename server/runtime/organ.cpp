@@ -1,6 +1,8 @@
 #include "organ.hpp"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cstdio>
 
 #include "common/input_error.hpp"
@@ -15,8 +17,24 @@ using namespace viscera::tissue;
 
 namespace {
 
-/// Model, integrator and compliance of `organ` from its scene, material and mesh.
-void build_physics(Organ& organ) {
+/// One explicit sub-step of the organ, timed: the median of five after one to warm up [s].
+double time_substep(Organ& organ) {
+  State s = State::at_rest(*organ.mesh);
+  organ.integrator->step(s);
+  std::array<double, 5> t{};
+  for (double& d : t) {
+    const auto t0 = std::chrono::steady_clock::now();
+    organ.integrator->step(s);
+    d = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  std::nth_element(t.begin(), t.begin() + 2, t.end());
+  return t[2];
+}
+
+/// Model, integrator and compliance of `organ` from its scene, material and mesh, once a tick at
+/// `rate_hz` is known to fit the budget (a step that cannot run is refused before any is taken).
+/// `field` names what the user chose (the material file, or the parameter changed).
+void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const std::string& source, const std::string& field) {
   const SceneSpec& s = organ.scene;
   const Material& material = organ.material;
   Mat6 D = material.elasticity;
@@ -39,12 +57,15 @@ void build_physics(Organ& organ) {
   // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
   organ.integrator = std::make_unique<ExplicitIntegrator>(*organ.model, density, bc,
                                                           ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
+  check_tick_budget(organ.integrator->dt_s(), 0, rate_hz, budget, source, field);
   if (s.physics_threads > 1) {
     organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, s.physics_threads);
     organ.integrator->set_force_evaluation(
         [p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return (*p)(x, f, m); });
   }
   // The compliance predicts the simulated response, so it sees the same inertia.
+  organ.substep_cost_s = time_substep(organ);
+  check_tick_budget(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget, source, field);
   organ.compliance = std::make_unique<ContactCompliance>(*organ.model, organ.integrator->mass_scaling().density_kg_m3, bc);
 }
 
@@ -79,7 +100,7 @@ std::string Organ::describe_step() const {
   return out;
 }
 
-std::unique_ptr<Organ> build_organ(const SceneSpec& scene) {
+std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& budget) {
   auto organ = std::make_unique<Organ>();
   organ->scene = scene;
   organ->mesh = std::make_shared<TetMesh>(read_tet_mesh(scene.mesh));
@@ -88,11 +109,11 @@ std::unique_ptr<Organ> build_organ(const SceneSpec& scene) {
   organ->material = read_material_file(scene.material);
   organ->bounds = bounding_box(*organ->mesh);
   organ->boundary = extract_boundary(*organ->mesh);
-  build_physics(*organ);
+  build_physics(*organ, scene.physics_rate_hz, budget, scene.source, "organ.material");
   return organ;
 }
 
-std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change) {
+std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change, double rate_hz, const TickBudget& budget) {
   auto next = std::make_unique<Organ>();
   next->scene = organ.scene;
   next->material = organ.material;
@@ -116,7 +137,9 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   if (change.damping_per_s) next->scene.damping_per_s = *change.damping_per_s;
   const std::string mark = " (changed at run time)";
   if ((change.youngs_modulus_pa || change.poisson_ratio || change.shear_q || change.density_kg_m3) && !m.name.ends_with(mark)) m.name += mark;
-  build_physics(*next);
+  const char* changed = change.youngs_modulus_pa ? "youngs_modulus_pa" : change.poisson_ratio ? "poisson_ratio" : change.density_kg_m3 ? "density_kg_m3"
+                        : change.shear_q ? "shear_q" : "damping_per_s";
+  build_physics(*next, rate_hz, budget, source, changed);
   return next;
 }
 

@@ -11,6 +11,7 @@
 #include "material/material_file.hpp"
 #include "mesh/boundary_surface.hpp"
 #include "scene_file.hpp"
+#include "tick_budget.hpp"
 #include "viscera/protocol/messages.hpp"
 
 namespace viscera::runtime {
@@ -25,6 +26,8 @@ struct Organ {
   std::unique_ptr<ParallelForces> parallel_forces;  ///< scene physics_threads > 1; used by the integrator
   std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
   std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
+  /// One explicit sub-step of this organ on this machine [s] (the median of five, timed when built).
+  double substep_cost_s = 0;
 
   /// The material as the scene state shows it.
   protocol::MaterialInfo material_info() const;
@@ -33,12 +36,14 @@ struct Organ {
 };
 
 /// Reads the scene's mesh and material and builds the organ. Throws InputError naming the file
-/// and field.
-std::unique_ptr<Organ> build_organ(const SceneSpec& scene);
+/// and field, also when a tick at the scene's physics rate would not fit `budget`.
+std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& budget = {});
 
 /// The same organ (mesh shared) with some material parameters changed. Throws InputError naming
 /// the parameter when the change does not apply (Young's modulus of a material that is not
-/// isotropic, Q of an elastic one) or gives an invalid material.
-std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change);
+/// isotropic, Q of an elastic one), gives an invalid material, or a tick that would not fit
+/// `budget` at `rate_hz` (the rate the server runs at now).
+std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change, double rate_hz,
+                                             const TickBudget& budget = {});
 
 }  // namespace viscera::runtime

@@ -2,120 +2,95 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "common/input_error.hpp"
-#include "common/known_fields.hpp"
+#include "common/json_input.hpp"
 
 namespace viscera::runtime {
 
 using nlohmann::json;
 using tissue::InputError;
-using tissue::require_known_fields;
+using tissue::JsonObject;
 
 SceneSpec read_scene_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, 0, "", "cannot open file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(path, 0, "JSON", e.what());
-  }
+  const json j = tissue::read_json_file(path);
+  const JsonObject top(j, path);
   const auto dir = std::filesystem::path(path).parent_path();
-  const auto number = [&](const json& o, const char* key, const std::string& prefix, double lo, double hi, double fallback) {
-    if (!o.contains(key)) return fallback;
-    if (!o[key].is_number()) throw InputError(path, 0, prefix + key, o[key].dump() + " is not a number");
-    const double v = o[key].get<double>();
-    if (!(v >= lo && v <= hi))
-      throw InputError(path, 0, prefix + key, o[key].dump() + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return v;
-  };
-  if (!j.is_object()) throw InputError(path, 0, "JSON", "the scene must be an object");
-  require_known_fields(j, path, "", {"name", "domain_id", "physics_rate_hz", "mesh_rate_hz", "max_tool_speed_m_s", "organ", "instruments"});
+  top.require_known({"name", "domain_id", "physics_rate_hz", "mesh_rate_hz", "max_tool_speed_m_s", "organ", "instruments"});
   SceneSpec s;
   s.source = path;
-  s.name = j.value("name", std::filesystem::path(path).stem().string());
-  s.domain_id = static_cast<std::uint32_t>(number(j, "domain_id", "", 0, 230, 0));
-  s.physics_rate_hz = number(j, "physics_rate_hz", "", 10, 10000, 1000);
-  s.mesh_rate_hz = number(j, "mesh_rate_hz", "", 0, 240, 60);
-  if (!j.contains("organ") || !j["organ"].is_object()) throw InputError(path, 0, "organ", "missing or not an object");
-  const json& o = j["organ"];
-  require_known_fields(o, path, "organ.", {"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction",
-                           "physics_threads", "volume_term", "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m",
-                           "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab"});
-  for (const char* key : {"mesh", "material"})
-    if (!o.contains(key) || !o[key].is_string()) throw InputError(path, 0, std::string("organ.") + key, "missing (a path)");
-  s.mesh = (dir / o["mesh"].get<std::string>()).string();
-  s.material = (dir / o["material"].get<std::string>()).string();
-  s.model = o.value("model", "gps_energy");
-  s.scale_m_per_unit = number(o, "scale_m_per_unit", "organ.", 1e-6, 1e3, 1.0);
-  s.damping_per_s = number(o, "damping_per_s", "organ.", 0, 1e4, 0.0);
-  s.gravity_m_s2 = number(o, "gravity_m_s2", "organ.", 0, 100, 9.81);
-  s.volume_term = number(o, "volume_term", "organ.", 0, 0.99, 0.5);
-  s.refine = static_cast<int>(number(o, "refine", "organ.", 0, 2, 0));
-  const std::string step = o.value("stable_step", "element");
-  if (step != "element" && step != "global")
-    throw InputError(path, 0, "organ.stable_step", "'" + step + "' is not element or global");
-  s.global_stable_step = step == "global";
-  s.added_mass_fraction = number(o, "added_mass_fraction", "organ.", 0, 1, 0.0);
-  s.physics_threads = static_cast<int>(number(o, "physics_threads", "organ.", 1, 8, 1));
-  if (o.contains("physics_threads") && o["physics_threads"].get<double>() != s.physics_threads)
-    throw InputError(path, 0, "organ.physics_threads", o["physics_threads"].dump() + " is not a whole number");
-  s.contact_stiffness_n_per_m = number(o, "contact_stiffness_n_per_m", "organ.", 1e-3, 1e7, 200.0);
-  s.grasp_stiffness_n_per_m = number(o, "grasp_stiffness_n_per_m", "organ.", 1e-3, 1e7, 100.0);
-  s.contact_damping_s_per_m = number(o, "contact_damping_s_per_m", "organ.", 0, 1e4, 0.0);
-  s.max_tool_speed_m_s = number(j, "max_tool_speed_m_s", "", 1e-3, 100, 0.5);
-  if (o.contains("fix_slab")) {
-    const json& f = o["fix_slab"];
-    if (!f.is_array() || f.size() != 3 || !f[0].is_string() || !f[1].is_string() || !f[2].is_number())
-      throw InputError(path, 0, "organ.fix_slab", "must be [axis, side, fraction], e.g. [\"z\", \"max\", 0.2]");
+  s.name = top.text("name", std::filesystem::path(path).stem().string());
+  s.domain_id = static_cast<std::uint32_t>(top.integer("domain_id", 0, 230, 0));
+  // Whole hertz: the tick grid's period is 1/rate, and a rate such as 333.3 Hz would say more
+  // precision than the clock's slots keep.
+  s.physics_rate_hz = static_cast<double>(top.integer("physics_rate_hz", 10, 10000, 1000));
+  s.mesh_rate_hz = top.number("mesh_rate_hz", 0, 240, 60);
+  s.max_tool_speed_m_s = top.number("max_tool_speed_m_s", 1e-3, 100, 0.5);
+  const JsonObject o = top.object("organ");
+  o.require_known({"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction", "physics_threads",
+                   "volume_term", "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m",
+                   "grasp_stiffness_n_per_m", "fix_slab"});
+  s.mesh = (dir / o.text("mesh")).string();
+  s.material = (dir / o.text("material")).string();
+  s.model = o.choice("model", {"gps", "gps_energy", "corotational", "linear"}, "gps_energy");
+  s.scale_m_per_unit = o.number("scale_m_per_unit", 1e-6, 1e3, 1.0);
+  s.damping_per_s = o.number("damping_per_s", 0, 1e4, 0.0);
+  s.gravity_m_s2 = o.number("gravity_m_s2", 0, 100, 9.81);
+  s.volume_term = o.number("volume_term", 0, 0.99, 0.5);
+  s.refine = static_cast<int>(o.integer("refine", 0, 2, 0));
+  s.global_stable_step = o.choice("stable_step", {"element", "global"}, "element") == "global";
+  s.added_mass_fraction = o.number("added_mass_fraction", 0, 1, 0.0);
+  s.physics_threads = static_cast<int>(o.integer("physics_threads", 1, 8, 1));
+  s.contact_stiffness_n_per_m = o.number("contact_stiffness_n_per_m", 1e-3, 1e7, 200.0);
+  s.grasp_stiffness_n_per_m = o.number("grasp_stiffness_n_per_m", 1e-3, 1e7, 100.0);
+  s.contact_damping_s_per_m = o.number("contact_damping_s_per_m", 0, 1e4, 0.0);
+  if (o.has("fix_slab")) {
+    const json& f = o.array("fix_slab");
+    if (f.size() != 3 || !f[0].is_string() || !f[1].is_string() || !f[2].is_number())
+      o.fail("fix_slab", "must be [axis, side, fraction], e.g. [\"z\", \"max\", 0.2]");
     s.fix_axis = f[0].get<std::string>();
     s.fix_side = f[1].get<std::string>();
     s.fix_fraction = f[2].get<double>();
-    if (s.fix_axis != "x" && s.fix_axis != "y" && s.fix_axis != "z") throw InputError(path, 0, "organ.fix_slab", "axis '" + s.fix_axis + "' is not x, y or z");
-    if (s.fix_side != "min" && s.fix_side != "max") throw InputError(path, 0, "organ.fix_slab", "side '" + s.fix_side + "' is not min or max");
-    if (!(s.fix_fraction > 0 && s.fix_fraction <= 1)) throw InputError(path, 0, "organ.fix_slab", "fraction must lie in (0, 1]");
+    if (s.fix_axis != "x" && s.fix_axis != "y" && s.fix_axis != "z") o.fail("fix_slab", "axis '" + tissue::printable(s.fix_axis) + "' is not x, y or z");
+    if (s.fix_side != "min" && s.fix_side != "max") o.fail("fix_slab", "side '" + tissue::printable(s.fix_side) + "' is not min or max");
+    if (!(s.fix_fraction > 0 && s.fix_fraction <= 1)) o.fail("fix_slab", "fraction must lie in (0, 1]");
   }
-  if (!j.contains("instruments") || !j["instruments"].is_array() || j["instruments"].empty())
-    throw InputError(path, 0, "instruments", "missing or empty");
+  const json& instruments = top.array("instruments", 1);
   std::set<std::uint32_t> ids;
-  for (std::size_t k = 0; k < j["instruments"].size(); ++k) {
-    const json& i = j["instruments"][k];
-    const std::string prefix = "instruments[" + std::to_string(k) + "].";
-    if (!i.is_object()) throw InputError(path, 0, prefix.substr(0, prefix.size() - 1), "not an object");
-    require_known_fields(i, path, prefix, {"id", "kind", "tip_radius_m", "grasp_radius_m"});
+  for (std::size_t k = 0; k < instruments.size(); ++k) {
+    const JsonObject i(instruments[k], path, "instruments[" + std::to_string(k) + "]");
+    i.require_known({"id", "kind", "tip_radius_m", "grasp_radius_m"});
     InstrumentSpec spec;
-    spec.id = static_cast<std::uint32_t>(number(i, "id", prefix, 1, 1e6, 0));
-    if (spec.id == 0) throw InputError(path, 0, prefix + "id", "missing");
-    if (!ids.insert(spec.id).second) throw InputError(path, 0, prefix + "id", std::to_string(spec.id) + " is used twice");
-    spec.kind = i.value("kind", "probe");
-    if (spec.kind != "probe" && spec.kind != "grasper")
-      throw InputError(path, 0, prefix + "kind", "'" + spec.kind + "' is not probe or grasper");
-    spec.grasp_radius_m = number(i, "grasp_radius_m", prefix, 1e-4, 0.05, 0.01);
-    spec.tip_radius_m = number(i, "tip_radius_m", prefix, 1e-4, 0.05, 0.005);
+    spec.id = static_cast<std::uint32_t>(i.integer("id", 1, 1'000'000));
+    if (!ids.insert(spec.id).second) i.fail("id", std::to_string(spec.id) + " is used twice");
+    spec.kind = i.choice("kind", {"probe", "grasper"}, "probe") == "grasper" ? InstrumentKind::grasper : InstrumentKind::probe;
+    spec.grasp_radius_m = i.number("grasp_radius_m", 1e-4, 0.05, 0.01);
+    spec.tip_radius_m = i.number("tip_radius_m", 1e-4, 0.05, 0.005);
     s.instruments.push_back(spec);
   }
   return s;
 }
 
-std::vector<std::string> list_scenes(const std::string& directory) {
-  std::vector<std::string> names;
+SceneListing list_scenes(const std::string& directory) {
+  SceneListing listing;
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
     if (entry.path().extension() != ".json") continue;
+    const std::string name = entry.path().stem().string();
     try {
       read_scene_file(entry.path().string());
-      names.push_back(entry.path().stem().string());
-    } catch (const InputError&) {
-      // not a scene (or a broken one): not offered
+      listing.loadable.push_back(name);
+    } catch (const std::exception& e) {
+      // A broken sibling never takes the server down: it is listed with its error.
+      listing.unreadable.push_back({name, e.what()});
     }
   }
-  std::sort(names.begin(), names.end());
-  return names;
+  std::sort(listing.loadable.begin(), listing.loadable.end());
+  std::sort(listing.unreadable.begin(), listing.unreadable.end());
+  return listing;
 }
 
 }  // namespace viscera::runtime

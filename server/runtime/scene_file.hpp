@@ -4,13 +4,16 @@
 // the file and the field.
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace viscera::runtime {
 
+enum class InstrumentKind { probe, grasper };
+
 struct InstrumentSpec {
   std::uint32_t id = 0;
-  std::string kind = "probe";  ///< probe | grasper
+  InstrumentKind kind = InstrumentKind::probe;
   double tip_radius_m = 0.005;
   double grasp_radius_m = 0.01;  ///< grasper: surface nodes this close to the tip are grasped
 };
@@ -41,8 +44,12 @@ struct SceneSpec {
 
 SceneSpec read_scene_file(const std::string& path);
 
-/// The scenes of a directory that load_scene may name: the stems of its *.json files that read
-/// as scene files, sorted.
-std::vector<std::string> list_scenes(const std::string& directory);
+/// The scenes of a directory: the stems of its *.json files that read as scene files (what
+/// load_scene may name), and those that do not, each with its error; both sorted.
+struct SceneListing {
+  std::vector<std::string> loadable;
+  std::vector<std::pair<std::string, std::string>> unreadable;  ///< name, error
+};
+SceneListing list_scenes(const std::string& directory);
 
 }  // namespace viscera::runtime

@@ -28,6 +28,14 @@ namespace proto = viscera::protocol;
 using namespace viscera::tissue;
 
 namespace {
+std::atomic<int> g_abandoned{0};
+
+/// Lets a background build or destruction finish on a thread of its own instead of waiting for it.
+void abandon(std::future<void> f) {
+  ++g_abandoned;
+  std::thread([f = std::move(f)]() mutable { f.wait(); }).detach();
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
   const auto k = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
@@ -42,8 +50,10 @@ struct SimulationServer::Impl {
   // The organ (mesh, model, integrator, compliance) is the physics thread's. Session control
   // replaces it between ticks; the command thread reads it (compliance, instruments' queries)
   // only while holding organ_mutex, which the physics thread takes to swap it.
-  std::unique_ptr<Organ> organ;
+  std::shared_ptr<Organ> organ;  // shared with a material change being prepared from it
   std::mutex organ_mutex;
+  TickBudget budget;
+  const std::atomic<bool>* stop = nullptr;  // run()'s stop flag: a long tick checks it between sub-steps
   State state;
   double sim_time_s = 0;
   std::uint32_t generation = 1;  // +1 per scene loaded: the surface's mesh_id
@@ -96,23 +106,24 @@ struct SimulationServer::Impl {
   proto::Writer forces, scene_state, telemetry, events;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread; after the writers it uses
   std::uint64_t mesh_frames_before = 0, mesh_skipped_before = 0;  // of the publishers of earlier scenes
-  std::atomic<std::uint64_t> rejected{0}, forces_sent{0};
+  std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, forces_sent{0};
 
   // Session control: a scene or material is built on a thread of its own while the physics goes
   // on; the physics thread swaps it in when ready. One at a time.
   struct Preparing {
-    std::future<std::unique_ptr<Organ>> organ;
+    std::future<std::shared_ptr<Organ>> organ;
     proto::SessionRequest request;
     std::string what;
   };
   std::optional<Preparing> preparing;
   std::deque<proto::RequestOutcome> outcomes;  // the last 8, for the scene state
-  std::vector<std::string> available_scenes;
+  SceneListing scenes;
   std::vector<std::future<void>> retiring;  // organs being destroyed (a compliance worker may be mid-factorisation)
 
-  Impl(const SceneSpec& s, std::string dir)
+  Impl(const SceneSpec& s, std::string dir, const TickBudget& b)
       : scene(s),
         scene_dir(std::move(dir)),
+        budget(b),
         participant(s.domain_id),
         commands(participant, proto::Stream::instrument_command),
         sessions(participant, proto::Stream::session_request),
@@ -120,13 +131,17 @@ struct SimulationServer::Impl {
         scene_state(participant, proto::Stream::scene_state),
         telemetry(participant, proto::Stream::telemetry),
         events(participant, proto::Stream::event) {
-    available_scenes = list_scenes(scene_dir);
-    adopt(build_organ(s), true);
+    scenes = list_scenes(scene_dir);
+    adopt(build_organ(s, budget), true);
     publish_scene();
   }
 
   ~Impl() {
-    if (preparing) preparing->organ.wait();
+    // A stop never waits for an organ still being built or destroyed (the 96k liver takes seconds):
+    // it finishes on a thread of its own, holding what it uses.
+    if (preparing) abandon(std::async(std::launch::deferred, [f = std::move(preparing->organ)]() mutable { f.wait(); }));
+    for (auto& f : retiring)
+      if (f.wait_for(std::chrono::seconds(0)) != std::future_status::ready) abandon(std::move(f));
   }
 
   /// The instruments of the scene, each with its contact on the organ's surface.
@@ -145,12 +160,13 @@ struct SimulationServer::Impl {
   /// Physics thread, between ticks: `next` becomes the organ. A new scene starts at rest with its
   /// own instruments (owners lose theirs and must claim again) and a new surface; a new material
   /// on the same mesh keeps the organ's deformation, its owners and its tools.
-  void adopt(std::unique_ptr<Organ> next, bool new_scene) {
+  void adopt(std::shared_ptr<Organ> next, bool new_scene) {
     next->integrator->boundary_conditions().force_field = [this](const BoundaryConditions::FieldEvaluation& e) { apply_instruments(e); };
+    next->integrator->set_interruption([this] { return stop && stop->load(); });
     std::map<std::uint32_t, Instrument> made;
     if (new_scene) made = make_instruments(*next);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> released;  // instrument, owner
-    std::unique_ptr<Organ> old;
+    std::shared_ptr<Organ> old;
     {
       std::lock_guard world(organ_mutex);
       std::lock_guard lock(command_mutex);
@@ -233,14 +249,15 @@ struct SimulationServer::Impl {
     sc.paused = paused;
     {
       std::lock_guard lock(command_mutex);
-      for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, inst.spec.kind == "grasper", inst.spec.tip_radius_m, inst.owner});
+      for (const auto& [id, inst] : instruments) sc.instruments.push_back({id, inst.spec.kind == InstrumentKind::grasper, inst.spec.tip_radius_m, inst.owner});
     }
     const Box& bounds = organ->bounds;
     sc.bounds_min = {bounds.lo.x(), bounds.lo.y(), bounds.lo.z()};
     sc.bounds_max = {bounds.hi.x(), bounds.hi.y(), bounds.hi.z()};
     sc.generation = generation;
     sc.material = organ->material_info();
-    sc.available_scenes = available_scenes;
+    sc.available_scenes = scenes.loadable;
+    for (const auto& [name, error] : scenes.unreadable) sc.unreadable_scenes.push_back(name + ": " + error.substr(0, 300));
     if (preparing) sc.preparing = preparing->what;
     sc.recent_requests.assign(outcomes.begin(), outcomes.end());
     scene_state.write(0, proto::encode(sc));
@@ -254,7 +271,7 @@ struct SimulationServer::Impl {
       std::string why;
       const auto req = proto::decode_session_request(r.payload, &why);
       if (!req) {
-        ++rejected;
+        ++rejected_malformed;
         return;
       }
       const std::string who = "client " + std::to_string(req->client_id);
@@ -282,28 +299,36 @@ struct SimulationServer::Impl {
         default:
           break;
       }
+      // The scene state lists the instruments and their owners: a client sees there at once that
+      // an instrument does not exist or is taken (Client::claim says which).
       std::lock_guard lock(command_mutex);
       const auto it = instruments.find(req->instrument_id);
       if (it == instruments.end()) {
-        ++rejected;
+        ++rejected_unknown_instrument;
         return;
       }
       Instrument& inst = it->second;
-      if (req->action == proto::Action::claim_instrument && inst.owner == 0) {
-        inst.owner = req->client_id;
-        inst.has_command = false;
-        inst.last_heard_ns = proto::now_ns();
-        changed = true;
-        event(proto::EventKind::instrument_claimed, req->instrument_id, req->client_id);
-      } else if (req->action == proto::Action::release_instrument && inst.owner == req->client_id) {
+      if (req->action == proto::Action::claim_instrument) {
+        if (inst.owner == 0) {
+          inst.owner = req->client_id;
+          inst.has_command = false;
+          inst.last_heard_ns = proto::now_ns();
+          changed = true;
+          event(proto::EventKind::instrument_claimed, req->instrument_id, req->client_id);
+        }  // a claim of a taken instrument is no fault: its owner may let it go
+      } else if (inst.owner == req->client_id) {
         inst.owner = 0;
         inst.has_command = false;
         changed = true;
         event(proto::EventKind::instrument_released, req->instrument_id, req->client_id, "released by its owner");
+      } else {
+        ++rejected_not_owner;
       }
     });
     if (changed) publish_scene();
   }
+
+
 
   /// Run-time control (physics thread): a new physics rate at once; a scene or material is
   /// prepared in the background (finish_preparing() swaps it in). Every request gets an outcome
@@ -311,6 +336,14 @@ struct SimulationServer::Impl {
   void control(const proto::SessionRequest& req, const std::function<void(const std::string&)>& status) {
     const auto refuse = [&](const std::string& why) { conclude(req, false, why, status); };
     if (req.action == proto::Action::set_physics_rate) {
+      // Whole hertz, as in scene files: the tick grid's period is 1/rate.
+      if (req.physics_rate_hz != std::floor(req.physics_rate_hz))
+        return refuse("physics rate " + short_number(req.physics_rate_hz) + " Hz: whole hertz only");
+      try {
+        check_tick_budget(organ->integrator->dt_s(), organ->substep_cost_s, req.physics_rate_hz, budget, "set_physics_rate", "physics_rate_hz");
+      } catch (const InputError& e) {
+        return refuse(e.what());
+      }
       char text[160];
       std::snprintf(text, sizeof text, "physics rate %.0f Hz (was %.0f Hz)", req.physics_rate_hz, scene.physics_rate_hz);
       scene.physics_rate_hz = req.physics_rate_hz;
@@ -322,20 +355,23 @@ struct SimulationServer::Impl {
       const std::string path = (std::filesystem::path(scene_dir) / (req.scene_name + ".json")).string();
       if (!std::filesystem::exists(path)) {
         std::string list;
-        for (const auto& n : available_scenes) list += (list.empty() ? "" : ", ") + n;
+        for (const auto& n : scenes.loadable) list += (list.empty() ? "" : ", ") + n;
         return refuse("no scene '" + req.scene_name + "' in " + scene_dir + " (available: " + list + ")");
       }
       SceneSpec spec;
       try {
         spec = read_scene_file(path);
-      } catch (const InputError& e) {
+      } catch (const std::exception& e) {
         return refuse(e.what());
       }
       if (spec.domain_id != scene.domain_id) spec.domain_id = scene.domain_id;  // the server stays on its domain
-      preparing = Preparing{std::async(std::launch::async, [spec] { return build_organ(spec); }), req, "scene " + req.scene_name};
+      preparing = Preparing{std::async(std::launch::async, [spec, b = budget] { return std::shared_ptr<Organ>(build_organ(spec, b)); }), req,
+                            "scene " + req.scene_name};
     } else {
-      const Organ& current = *organ;  // stays alive: nothing else replaces it while this is prepared
-      preparing = Preparing{std::async(std::launch::async, [&current, change = req.material] { return rebuild_with_material(current, change); }),
+      // The current organ stays alive for the build (shared), even if the server stops meanwhile.
+      preparing = Preparing{std::async(std::launch::async, [current = organ, change = req.material, rate = scene.physics_rate_hz, b = budget] {
+                              return std::shared_ptr<Organ>(rebuild_with_material(*current, change, rate, b));
+                            }),
                             req, "material " + describe_change(req.material)};
     }
     if (status) status("client " + std::to_string(req.client_id) + " asked for " + preparing->what + "; preparing it");
@@ -369,7 +405,7 @@ struct SimulationServer::Impl {
       conclude(done.request, false, done.what + ": " + e.what(), status);
       return;
     }
-    if (new_scene) available_scenes = list_scenes(scene_dir);
+    if (new_scene) scenes = list_scenes(scene_dir);
     conclude(done.request, true, (new_scene ? "loaded " : "changed to ") + done.what + " (" + organ->describe_step() + ")", status);
   }
 
@@ -384,6 +420,13 @@ struct SimulationServer::Impl {
     event(kind, 0, req.client_id, message.substr(0, 1000));
     if (status) status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + (accepted ? "" : "refused: ") + message);
     publish_scene();
+  }
+
+  void rejected_counts(ServerStats& stats) const {
+    stats.rejected_malformed = rejected_malformed;
+    stats.rejected_not_owner = rejected_not_owner;
+    stats.rejected_unknown_instrument = rejected_unknown_instrument;
+    stats.rejected = stats.rejected_malformed + stats.rejected_not_owner + stats.rejected_unknown_instrument;
   }
 
   void mesh_counts(ServerStats& stats) const {
@@ -424,7 +467,7 @@ struct SimulationServer::Impl {
   /// Graspers: jaws closing (opening below 0.1 rad) grasp the surface nodes within the grasp
   /// radius of the tip; opening them (above 0.2 rad, hysteresis) releases them.
   void update_grasp(Instrument& inst) {
-    if (inst.spec.kind != "grasper") return;
+    if (inst.spec.kind != InstrumentKind::grasper) return;
     const Vec3& tip = inst.proxy;  // the grasped nodes follow the simulated tool
     if (inst.grasped.empty() && inst.tick.jaw_opening < 0.1) {
       inst.grasped = GraspHold(tip, orientation(inst.tick), organ->boundary.nodes, state.x, inst.spec.grasp_radius_m, scene.grasp_stiffness_n_per_m);
@@ -487,13 +530,17 @@ struct SimulationServer::Impl {
       std::string why;
       const auto c = proto::decode_command(r.payload, &why);
       if (!c) {
-        ++rejected;
+        ++rejected_malformed;
         return;
       }
       std::lock_guard lock(command_mutex);
       const auto it = instruments.find(c->instrument_id);
-      if (it == instruments.end() || it->second.owner != c->client_id) {
-        ++rejected;
+      if (it == instruments.end()) {
+        ++rejected_unknown_instrument;
+        return;
+      }
+      if (it->second.owner != c->client_id) {
+        ++rejected_not_owner;
         return;
       }
       Instrument& inst = it->second;
@@ -583,11 +630,14 @@ struct SimulationServer::Impl {
   }
 };
 
-SimulationServer::SimulationServer(const SceneSpec& scene, const std::string& scene_dir)
+SimulationServer::SimulationServer(const SceneSpec& scene, const std::string& scene_dir, const TickBudget& budget)
     : impl_(std::make_unique<Impl>(scene, !scene_dir.empty() ? scene_dir
                                           : std::filesystem::path(scene.source).has_parent_path() ? std::filesystem::path(scene.source).parent_path().string()
-                                                                                                  : std::string("."))) {}
+                                                                                                  : std::string("."),
+                                          budget)) {}
 SimulationServer::~SimulationServer() = default;
+
+int SimulationServer::abandoned_work() { return g_abandoned.load(); }
 
 std::string SimulationServer::describe() const {
   char b[400];
@@ -599,6 +649,7 @@ std::string SimulationServer::describe() const {
 
 ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration_s, const std::function<void(const std::string&)>& status) {
   Impl& s = *impl_;
+  s.stop = &stop;
   ServerStats stats;
   using clock = std::chrono::steady_clock;
   // The command thread answers commands as they arrive, on the other core, while this thread steps.
@@ -659,11 +710,12 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       stats.step_p99_us = percentile(step_us, 0.99);
       stats.step_max_us = *std::max_element(step_us.begin(), step_us.end());
       stats.jitter_p99_us = percentile(jitter_us, 0.99);
-      stats.rejected = s.rejected;
+      s.rejected_counts(stats);
       s.mesh_counts(stats);
       s.telemetry.write(0, proto::encode(proto::TelemetryReport{proto::now_ns(), stats.ticks, stats.late_ticks, stats.rejected, stats.rate_hz,
                                                                 stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
-                                                                stats.missed_slots}));
+                                                                stats.missed_slots, stats.rejected_malformed, stats.rejected_not_owner,
+                                                                stats.rejected_unknown_instrument}));
       if (status) {
         char line[400];
         int owned = 0;
@@ -673,9 +725,12 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
           fmax = std::max(fmax, inst.result.force_on_tool.norm());
         }
         std::snprintf(line, sizeof line, "%.0f Hz physics%s, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, late ticks %llu, missed slots %llu, "
-                      "%d instruments in use, |F| %.3f N, rejected %llu, physics resets %llu, mesh frames %llu (%llu skipped)",
+                      "%d instruments in use, |F| %.3f N, rejected %llu (malformed %llu, not owner %llu, unknown instrument %llu), physics resets %llu, "
+                      "mesh frames %llu (%llu skipped)",
                       stats.rate_hz, s.paused ? " (paused)" : "", stats.step_p50_us, stats.step_p99_us, stats.step_max_us, stats.jitter_p99_us,
                       static_cast<unsigned long long>(stats.late_ticks), static_cast<unsigned long long>(stats.missed_slots), owned, fmax, static_cast<unsigned long long>(stats.rejected),
+                      static_cast<unsigned long long>(stats.rejected_malformed), static_cast<unsigned long long>(stats.rejected_not_owner),
+                      static_cast<unsigned long long>(stats.rejected_unknown_instrument),
                       static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.mesh_frames),
                       static_cast<unsigned long long>(stats.mesh_frames_skipped));
         status(line);
@@ -700,7 +755,7 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
       while (clock::now() < next) std::this_thread::yield();
     }
   }
-  stats.rejected = s.rejected;
+  s.rejected_counts(stats);
   stats.forces_sent = s.forces_sent;
   s.mesh_counts(stats);
   return stats;

@@ -8,11 +8,15 @@
 #include <string>
 
 #include "scene_file.hpp"
+#include "tick_budget.hpp"
 
 namespace viscera::runtime {
 
 struct ServerStats {
   std::uint64_t ticks = 0, rejected = 0, forces_sent = 0;
+  /// rejected, by reason: failed verification; from a client that does not own the instrument;
+  /// naming an instrument the scene does not have
+  std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0;
   std::uint64_t late_ticks = 0;    ///< ticks that ended after their 1/rate slot (the next one starts at once)
   std::uint64_t missed_slots = 0;  ///< slots of the fixed-rate grid that passed with no tick
   std::uint64_t physics_resets = 0;  ///< organ reset to rest after an integration failure
@@ -22,13 +26,18 @@ struct ServerStats {
 
 class SimulationServer {
  public:
-  /// scene_dir: where load_scene requests find scenes (empty: the scene file's directory).
-  explicit SimulationServer(const SceneSpec& scene, const std::string& scene_dir = {});
+  /// scene_dir: where load_scene requests find scenes (empty: the scene file's directory). A scene,
+  /// material or physics rate whose tick would not fit `budget` is refused (tick_budget.hpp).
+  explicit SimulationServer(const SceneSpec& scene, const std::string& scene_dir = {}, const TickBudget& budget = {});
   ~SimulationServer();
-  /// Runs until `stop` becomes true (or for duration_s > 0). `status` gets a line each second.
+  /// Runs until `stop` becomes true (or for duration_s > 0). `status` gets a line each second. A
+  /// tick checks `stop` between its sub-steps, so a stop is seen within one sub-step.
   ServerStats run(const std::atomic<bool>& stop, double duration_s, const std::function<void(const std::string&)>& status);
   /// One line describing the loaded scene.
   std::string describe() const;
+  /// Organs still being built or destroyed in the background when the server was destroyed: they
+  /// were left to finish on their own threads, and the program should end with std::quick_exit.
+  static int abandoned_work();
 
  private:
   struct Impl;

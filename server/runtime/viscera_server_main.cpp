@@ -2,8 +2,12 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <string>
+
+#include <unistd.h>
 
 #include "common/command_line.hpp"
 #include "common/input_error.hpp"
@@ -12,7 +16,17 @@
 
 namespace {
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+std::atomic<bool> g_running{false};
+// While the organ is being built (seconds for the 96k liver) a stop ends the process at once; once
+// the physics runs, it sets the flag, which the loop checks between ticks and sub-steps.
+void on_signal(int sig) {
+  if (!g_running.load()) {
+    constexpr char msg[] = "viscera-server: stopped while loading\n";
+    [[maybe_unused]] const auto n = ::write(2, msg, sizeof msg - 1);
+    ::_exit(128 + sig);
+  }
+  g_stop = true;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -25,9 +39,11 @@ int main(int argc, char** argv) {
   cl.flag("scene", "FILE", "scene file (required)");
   cl.flag("scene-dir", "DIR", "scenes that clients may load by name (default: the scene file's directory)");
   cl.flag("duration", "S", "stop after S seconds; 0 runs until signalled", "0");
+  cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "33.3");
   cl.option_switch("quiet", "no status lines");
   std::string scene, scene_dir;
   double duration = 0;
+  viscera::runtime::TickBudget budget;
   bool quiet = false;
   try {
     if (!cl.parse(argc, argv)) return 0;
@@ -38,6 +54,7 @@ int main(int argc, char** argv) {
         throw viscera::cli::UsageError("--scene-dir: '" + scene_dir + "' is not a directory");
     }
     duration = cl.number_in("duration", 0.0, 1e9);
+    budget.max_tick_s = 1e-3 * cl.number_in("max-tick-ms", 0.1, 10000);
     quiet = cl.has("quiet");
   } catch (const viscera::cli::UsageError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
@@ -51,10 +68,11 @@ int main(int argc, char** argv) {
       std::printf("viscera-server: loading %s\n", scene.c_str());
       std::fflush(stdout);
     }
-    viscera::runtime::SimulationServer server(viscera::runtime::read_scene_file(scene), scene_dir);
-    std::printf("viscera-server: %s\n", server.describe().c_str());
+    auto server = std::make_unique<viscera::runtime::SimulationServer>(viscera::runtime::read_scene_file(scene), scene_dir, budget);
+    std::printf("viscera-server: %s\n", server->describe().c_str());
     std::fflush(stdout);
-    const auto stats = server.run(g_stop, duration, [&](const std::string& line) {
+    g_running = true;
+    const auto stats = server->run(g_stop, duration, [&](const std::string& line) {
       if (!quiet) {
         std::printf("viscera-server: %s\n", line.c_str());
         std::fflush(stdout);
@@ -64,6 +82,13 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.late_ticks), static_cast<unsigned long long>(stats.missed_slots),
                 static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.forces_sent),
                 static_cast<unsigned long long>(stats.rejected), static_cast<unsigned long long>(stats.mesh_frames));
+    server.reset();  // leaves the DDS domain: clients see the server gone at once
+    if (viscera::runtime::SimulationServer::abandoned_work() > 0) {
+      // An organ still being built in the background is not waited for.
+      std::fflush(stdout);
+      std::fflush(stderr);
+      std::quick_exit(0);
+    }
     return 0;
   } catch (const viscera::tissue::InputError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
@@ -71,5 +96,8 @@ int main(int argc, char** argv) {
   } catch (const viscera::protocol::DdsError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
     return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "viscera-server: %s\n", e.what());
+    return 1;
   }
 }

@@ -55,3 +55,40 @@ TEST(LocalForceRenderer, BlendsFromTheOldModelToTheNewOneWithoutAJump) {
   EXPECT_NEAR(deep.force[2], 10.0, 1e-12);
   EXPECT_TRUE(deep.clamped);
 }
+
+// When the server stops answering, the force fades linearly from full to none over fade_s,
+// starting stale_after_s after the newest model: F(t) = F0 (1 - (t - t_stale) / fade_s).
+TEST(LocalForceRenderer, FadesLinearlyToZeroWhenTheModelsStop) {
+  client::LocalForceRenderer renderer(10.0, 0.0, {0.2, 0.4});
+  const protocol::Vector3 x{0, 0, 0.01};
+  renderer.update(contact(), x, 5.0);  // 2 N
+  EXPECT_NEAR(renderer.render(x, 5.2).force[2], 2.0, 1e-12);  // stale from 5.2 s
+  EXPECT_NEAR(renderer.render(x, 5.3).force[2], 2.0 * 0.75, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 5.5).force[2], 2.0 * 0.25, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 5.6).force[2], 0.0, 1e-12);
+  EXPECT_EQ(renderer.render(x, 5.601).force[2], 0.0);
+  EXPECT_EQ(renderer.render(x, 9.0).force[2], 0.0);
+  // Never a step: over the fade, no two samples 1 ms apart differ by more than F0 x 1 ms / fade_s.
+  double before = renderer.render(x, 5.0).force[2];
+  for (double t = 5.001; t < 5.7; t += 0.001) {
+    const double now = renderer.render(x, t).force[2];
+    EXPECT_LE(std::abs(now - before), 2.0 * 0.001 / 0.4 + 1e-9) << "at t = " << t;
+    before = now;
+  }
+}
+
+TEST(LocalForceRenderer, AServerKnownToBeGoneFadesAtOnceAndAReturningOneFadesBackIn) {
+  client::LocalForceRenderer renderer(10.0, 0.0, {0.25, 0.2});
+  const protocol::Vector3 x{0, 0, 0.01};
+  renderer.update(contact(), x, 1.0);
+  renderer.server_lost(1.05);  // before the model goes stale
+  EXPECT_NEAR(renderer.render(x, 1.05).force[2], 2.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.1).force[2], 1.5, 1e-12);
+  EXPECT_NEAR(renderer.gain(1.15), 0.5, 1e-12);
+  // A model again (a server came back) at 1.15 s: from the gain then, back up at the same rate.
+  renderer.update(contact(), x, 1.15);
+  EXPECT_NEAR(renderer.gain(1.15), 0.5, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.2).force[2], 2.0 * 0.75, 1e-12);
+  EXPECT_NEAR(renderer.gain(1.25), 1.0, 1e-12);
+  EXPECT_NEAR(renderer.gain(1.3), 1.0, 1e-12);
+}

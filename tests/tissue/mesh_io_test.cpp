@@ -1,7 +1,10 @@
 // Mesh readers on the real organ meshes, in every supported format, and on malformed files.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <sstream>
+
+#include <sys/stat.h>
 
 #include "common/input_error.hpp"
 #include "mesh/mesh_reader.hpp"
@@ -106,13 +109,17 @@ TEST(MeshIo, MalformedFilesGiveOneClearErrorNamingFileAndField) {
   const std::vector<Case> cases = {
       {"nan.msh", gmsh_v2("0 nan 1"), "node y: 'nan' is not a finite number"},
       {"garbage.msh", gmsh_v2("0 x1 1"), "node y: 'x1' is not a number"},
-      {"range.msh", gmsh_v2("0 0 1", "2 3 4 9"), "element 3: references node 9, which does not exist"},
+      // Element errors name the element by its number in the file and its line (element 3 is on line 20).
+      {"range.msh", gmsh_v2("0 0 1", "2 3 4 9"), ":20: element 3: references node 9, which does not exist"},
       {"truncated.msh", truncated, "unexpected end of file"},
       {"count.msh", gmsh_v2("0 0 1", "2 3 4 5", 4), "expected '$EndNodes', found '5'"},
-      {"inverted.msh", gmsh_v2("0 0 1", "2 4 3 5"), "tetrahedron 1: is inverted"},
+      {"inverted.msh", gmsh_v2("0 0 1", "2 4 3 5"), ":20: element 3: is inverted"},
       {"flat.msh", gmsh_v2("1 1 0"), "is degenerate"},
-      {"dup.msh", gmsh_v2("0 0 1", "1 2 4 3"), "tetrahedron 1: duplicates tetrahedron 0"},
-      {"repeat.msh", gmsh_v2("0 0 1", "2 3 3 5"), "tetrahedron 1: repeats a vertex"},
+      {"dup.msh", gmsh_v2("0 0 1", "1 2 4 3"), ":20: element 3: duplicates element 2"},
+      {"repeat.msh", gmsh_v2("0 0 1", "2 3 3 5"), ":20: element 3: repeats a vertex"},
+      // Bytes from the file are never printed raw: a control character shows as \xNN.
+      {"control.msh", gmsh_v2("0 \x01\x1b[2J 1"), "node y: '\\x01\\x1B[2J' is not a number"},
+      {"nul.msh", std::string("$MeshFormat\n2.2 0 8\n\0\0\x7f", 23), ":3: holds binary data (a NUL byte at byte 20)"},
       {"unused.msh", [] { std::string s = gmsh_v2("0 0 1", "1 2 3 4", 5); return s; }(), ""},
       {"tet10.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n$Elements\n1\n1 11 0 1 1 1 1 1 1 1 1 1 1\n$EndElements\n",
        "element 1 type: 11 is a volume element other than the linear tetrahedron"},
@@ -138,6 +145,13 @@ TEST(MeshIo, MalformedFilesGiveOneClearErrorNamingFileAndField) {
   unused.replace(unused.find("$Elements\n3"), 11, "$Elements\n2");
   unused.erase(unused.find("3 4 2 1 1 2 3 4 5\n"), 18);
   const std::string msg = expect_error(test::write_file("unused.msh", unused));
-  EXPECT_NE(msg.find("node 4: is used by no tetrahedron"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(":14: node 5: is used by no tetrahedron"), std::string::npos) << msg;
   EXPECT_NE(expect_error(test::tmp_path("does_not_exist.msh")).find("cannot open file"), std::string::npos);
+  // Only regular files are read: a FIFO would block the reader forever, a directory is no mesh.
+  const std::string fifo = test::tmp_path("fifo.msh");
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(expect_error(fifo).find("fifo.msh: is not a regular file"), std::string::npos);
+  std::filesystem::create_directories(test::tmp_path("folder.vtu"));
+  EXPECT_NE(expect_error(test::tmp_path("folder.vtu")).find("folder.vtu: is a directory"), std::string::npos);
 }

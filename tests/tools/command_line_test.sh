@@ -25,7 +25,7 @@ expect sim-missing-mesh 2 "mesh is required" -- "$sim"
 expect sim-no-file 2 "nowhere.msh: cannot open file" -- "$sim" --mesh "$tmp/nowhere.msh"
 expect sim-bad-mesh 2 "bad.msh" -- "$sim" --mesh "$tmp/bad.msh"
 expect sim-bad-number 2 "'abc' is not a finite number" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale abc
-expect sim-bad-material 2 "bad.json: poisson_ratio: 0.7" -- "$sim" --mesh "$src/data/meshes/liver.msh" --material "$tmp/bad.json"
+expect sim-bad-material 2 "bad.json: elasticity.poisson_ratio: 0.7 is outside" -- "$sim" --mesh "$src/data/meshes/liver.msh" --material "$tmp/bad.json"
 expect sim-bad-model 2 "'fem' is not one of" -- "$sim" --mesh "$src/data/meshes/liver.msh" --model fem
 expect sim-bad-slab 2 "fix-slab: axis 'w'" -- "$sim" --mesh "$src/data/meshes/liver.msh" --fix-slab w,max,0.1
 expect sim-runs 0 "wrote" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale 0.035 --fix-slab z,max,0.2 --duration 0.05 --out "$tmp/frames"
@@ -68,7 +68,7 @@ expect control-two-actions 2 "unexpected argument 'resume'" -- "$build/tools/vis
 expect control-annotate-no-text 2 "annotate needs its argument" -- "$build/tools/viscera-control/viscera-control" annotate
 expect control-load-path 2 "SCENE '../x' is not a scene name" -- "$build/tools/viscera-control/viscera-control" load ../x
 expect control-load-no-name 2 "load needs its argument" -- "$build/tools/viscera-control/viscera-control" load
-expect control-rate-range 2 "rate '5' is not a number of hertz in \[10, 10000\]" -- "$build/tools/viscera-control/viscera-control" rate 5
+expect control-rate-range 2 "rate '5' is not a whole number of hertz in \[10, 10000\]" -- "$build/tools/viscera-control/viscera-control" rate 5
 expect control-material-empty 2 "material needs at least one of" -- "$build/tools/viscera-control/viscera-control" material
 expect control-material-flag-elsewhere 2 "material flags are for the material action" -- "$build/tools/viscera-control/viscera-control" pause --shear-q 3
 expect control-material-range 2 "poisson-ratio" -- "$build/tools/viscera-control/viscera-control" material --poisson-ratio 0.7

@@ -2,7 +2,9 @@
 // device at the device rate (a virtual device: a scripted gesture or a trajectory file; real
 // devices implement viscera::client::Device), streams the tip to the server, renders the
 // server's local force model back to the device, prints force and round-trip latency live and
-// writes a JSON report. With --watch-mesh it also receives the organ's surface frames.
+// writes a JSON report. With --watch-mesh it also receives the organ's surface frames. When the
+// server goes away (stopped, killed, its host cut off) the rendered force fades to zero, the client
+// says so and exits with status 4, or with --reconnect waits for a server to come back.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +12,8 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -20,7 +24,6 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/local_force_model.hpp"
 #include "viscera/client/tick_phase.hpp"
-#include "viscera/protocol/dds.hpp"
 
 namespace {
 
@@ -90,6 +93,202 @@ nlohmann::json to_json(const std::vector<ForceSample>& samples) {
   return out;
 }
 
+
+struct Options {
+  std::uint32_t domain = 0, client_id = 1, instrument = 1;
+  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100, duration_s = 4;
+  viscera::client::FadePolicy fade;
+  std::string script, frame, report;
+  std::vector<viscera::haptic::TrajectoryPoint> trajectory;
+  std::string trajectory_file;
+  bool quiet = false, watch_mesh = false, reconnect = false;
+};
+
+Options parse(viscera::cli::CommandLine& cl) {
+  Options o;
+  o.domain = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
+  o.client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
+  o.instrument = static_cast<std::uint32_t>(cl.number_in("instrument", 1, 1e6));
+  o.rate_hz = cl.number_in("rate", 1, 20000);
+  o.depth_m = cl.number_in("depth", 0, 0.2);
+  o.max_force_n = cl.number_in("max-force", 0.1, 1000);
+  o.pull_m = cl.number_in("pull", 0, 0.2);
+  o.blend_s = cl.number_in("blend", 0, 0.1);
+  o.fade.fade_s = cl.number_in("fade", 0.001, 5);
+  o.fade.stale_after_s = cl.number_in("stale-after", 0.001, 5);
+  o.script = cl.text("script");
+  o.frame = cl.text("frame");
+  if (o.script != "press" && o.script != "grasp") throw viscera::cli::UsageError("--script: '" + o.script + "' is not press or grasp");
+  if (o.frame != "scene" && o.frame != "organ-top") throw viscera::cli::UsageError("--frame: '" + o.frame + "' is not scene or organ-top");
+  if (cl.has("trajectory")) {  // before connecting: a bad file fails at once
+    o.trajectory_file = cl.text("trajectory");
+    try {
+      o.trajectory = viscera::haptic::read_trajectory(o.trajectory_file);
+    } catch (const std::runtime_error& e) {
+      throw viscera::cli::UsageError(e.what());
+    }
+  }
+  o.duration_s = cl.has("duration") ? cl.number_in("duration", 0.1, 36000) : o.trajectory.empty() ? 4.0 : o.trajectory.back().t_s;
+  o.quiet = cl.has("quiet");
+  o.watch_mesh = cl.has("watch-mesh");
+  o.reconnect = cl.has("reconnect");
+  o.tick_phase_us = cl.number_in("tick-phase", -1, 1e6);
+  if (cl.has("report")) o.report = cl.text("report");
+  return o;
+}
+
+std::unique_ptr<viscera::client::Device> make_device(const Options& o, const viscera::protocol::Scene& scene) {
+  if (o.trajectory.empty()) return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m);
+  const Vector3 origin = o.frame == "scene" ? Vector3{0, 0, 0}
+                                            : Vector3{0.5 * (scene.bounds_min[0] + scene.bounds_max[0]),
+                                                      0.5 * (scene.bounds_min[1] + scene.bounds_max[1]), scene.bounds_max[2]};
+  return std::make_unique<viscera::haptic::TrajectoryDevice>(o.trajectory_file, o.trajectory, origin);
+}
+
+/// What the device loop saw, for the summary and the report.
+struct RunResult {
+  std::uint64_t clamps = 0, phased = 0, near_phase = 0;  // periods timed by the phase lock; of them within 50 us of the target
+  std::vector<ForceSample> samples;
+  MeshWatch mesh;
+  double server_lost_t_s = -1;  // when the client noticed the server was gone (-1: never)
+  double faded_t_s = -1;        // when the rendered force had faded to zero after that
+  int server_returns = 0;       // --reconnect: servers claimed again after a loss
+  bool lost = false;            // ended because the server was gone
+};
+
+void print_live(const Options& o, viscera::client::Client& client, double t, const Vector3& tip, const viscera::protocol::Force& f,
+                std::size_t frames) {
+  const auto rtt = client.round_trip();
+  std::printf("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s\n", t, tip[2], f.force[0],
+              f.force[1], f.force[2], f.in_contact ? "  contact" : "         ", rtt.p50_us, rtt.p99_us,
+              o.watch_mesh ? ("  mesh frames " + std::to_string(frames)).c_str() : "");
+  std::fflush(stdout);
+}
+
+/// The device loop: read the device, send the tip, render the server's local model, keep the
+/// phase after the server's ticks, claim again after a scene load, and fade out when the server
+/// goes away.
+RunResult run_device(const Options& o, viscera::client::Client& client, viscera::client::Device& device, std::uint32_t generation) {
+  RunResult run;
+  // Tip of each of the last 4096 commands, for the local model (a ring: no allocation per period).
+  struct Sent {
+    std::uint64_t seq = 0;
+    Vector3 tip{};
+  };
+  std::vector<Sent> sent(4096);
+  std::uint64_t seq = 0, model_seq = 0;
+  viscera::client::LocalForceRenderer renderer(o.max_force_n, o.blend_s, o.fade);
+  run.mesh.record = !o.report.empty();
+  // Reserved up front so the loop never reallocates (pages are touched only as samples come).
+  if (!o.report.empty()) run.samples.reserve(static_cast<std::size_t>(std::min(o.duration_s * o.rate_hz + 16, double{1 << 22})));
+  const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / o.rate_hz));
+  const auto start = std::chrono::steady_clock::now();
+  auto next = start;
+  // Commands timed to arrive just after a physics tick, in the server's idle time (tick_phase.hpp).
+  std::optional<viscera::client::TickPhase> phase;
+  if (o.tick_phase_us >= 0) phase.emplace(period, std::chrono::nanoseconds(std::llround(o.tick_phase_us * 1e3)));
+  const auto rate_matches = [&](const viscera::protocol::Scene& s) { return std::abs(s.physics_rate_hz - o.rate_hz) <= 0.01 * o.rate_hz; };
+  bool in_phase_possible = true;
+  double last_print = -1, last_scene_check = 0;
+  for (;;) {
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (t >= o.duration_s) break;
+    const auto server = client.server_state();
+    if (server == viscera::client::ServerState::lost && run.server_lost_t_s < 0) {
+      run.server_lost_t_s = t;
+      renderer.server_lost(t);
+      std::printf("t = %5.2f s  the server is gone (no DDS liveliness); the force fades to zero over %.2f s\n", t, o.fade.fade_s);
+      std::fflush(stdout);
+    }
+    if (run.server_lost_t_s >= 0 && run.faded_t_s < 0 && renderer.gain(t) == 0) {
+      run.faded_t_s = t;
+      if (!o.reconnect) {
+        run.lost = true;
+        break;
+      }
+      std::printf("t = %5.2f s  waiting for a server to come back (--reconnect)\n", t);
+      std::fflush(stdout);
+    }
+    if (run.faded_t_s >= 0 && server == viscera::client::ServerState::alive) {  // --reconnect: a server is back
+      const auto again = client.claim(o.instrument, std::chrono::seconds(5));
+      std::printf("t = %5.2f s  a server is back: instrument %u %s\n", t, o.instrument, again ? "claimed again" : ("not claimed: " + again.why).c_str());
+      std::fflush(stdout);
+      if (const auto now = client.scene()) generation = now->generation;
+      run.server_lost_t_s = run.faded_t_s = -1;
+      ++run.server_returns;
+      next = std::chrono::steady_clock::now();
+      continue;
+    }
+    if (t - last_scene_check >= 0.1 && run.server_lost_t_s < 0) {  // a scene loaded at run time releases every instrument: claim it again
+      last_scene_check = t;
+      const auto now = client.scene();
+      if (now) in_phase_possible = rate_matches(*now);  // the physics rate may change at run time
+      if (now && now->generation != generation) {
+        generation = now->generation;
+        const auto again = client.claim(o.instrument, std::chrono::seconds(2));
+        std::printf("t = %5.2f s  the server loaded scene %s: instrument %u %s\n", t, now->name.c_str(), o.instrument,
+                    again ? "claimed again" : ("could not be claimed again: " + again.why).c_str());
+        std::fflush(stdout);
+        next = std::chrono::steady_clock::now();
+        continue;
+      }
+    }
+    const auto in = device.read(t);
+    if (in.finished) break;
+    client.send_tip(o.instrument, in.tip_m, in.jaw_rad);
+    ++seq;
+    sent[seq % sent.size()] = {seq, in.tip_m};
+    // Wait for the answer to this command until shortly before the next device period.
+    if (const auto f = client.wait_force(o.instrument, next + period - std::chrono::microseconds(100))) {
+      // The force rendered now, from the server's local models at the current tip: a new model
+      // (the answer to a newer command) is blended in over --blend seconds.
+      if (f->command_seq > model_seq)
+        if (const Sent& it = sent[f->command_seq % sent.size()]; it.seq == f->command_seq && it.seq != 0) {
+          renderer.update(*f, it.tip, t);
+          model_seq = f->command_seq;
+        }
+      const auto rendered = renderer.render(in.tip_m, t);
+      device.render(rendered.force, f->in_contact);
+      run.clamps += rendered.clamped;
+      double normal_stiffness = 0;  // n^T K n of the local model [N/m]
+      for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) normal_stiffness += f->contact_normal[i] * f->stiffness[3 * i + j] * f->contact_normal[j];
+      if (!o.report.empty())
+        run.samples.push_back({t, in.tip_m[2], in.jaw_rad, f->force, f->torque, rendered.force, f->in_contact, f->penetration_m, normal_stiffness,
+                               1e3 * renderer.model_age_s(t), seq - f->command_seq, f->command_seq});
+      if (!o.quiet && t - last_print >= 0.25) {
+        print_live(o, client, t, in.tip_m, *f, run.mesh.frames);
+        last_print = t;
+      }
+    }
+    if (o.watch_mesh) run.mesh.take(client, t, in.tip_m);
+    next += period;
+    if (phase && in_phase_possible)
+      if (const auto tick_end = client.last_tick_end_ns(o.instrument)) {
+        const std::int64_t next_ns = viscera::client::now_ns() +
+                                     std::chrono::duration_cast<std::chrono::nanoseconds>(next - std::chrono::steady_clock::now()).count();
+        ++run.phased;
+        run.near_phase += std::abs(phase->error(next_ns, *tick_end).count()) < 50'000;
+        next += phase->correction(next_ns, *tick_end);
+      }
+    std::this_thread::sleep_until(next);
+  }
+  return run;
+}
+
+void write_report(const Options& o, const std::string& scene, const std::string& device, double start_epoch_s,
+                  const viscera::client::LatencyStats& rtt, const RunResult& run) {
+  nlohmann::json r{{"scene", scene}, {"instrument", o.instrument}, {"client_id", o.client_id}, {"rate_hz", o.rate_hz},
+                   {"start_epoch_s", start_epoch_s}, {"duration_s", o.duration_s}, {"device", device},
+                   {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
+                   {"tick_phase", {{"offset_us", o.tick_phase_us}, {"periods", run.phased}, {"within_50us", run.near_phase}}},
+                   {"fade", {{"stale_after_s", o.fade.stale_after_s}, {"fade_s", o.fade.fade_s}}},
+                   {"server_lost_t_s", run.server_lost_t_s}, {"faded_t_s", run.faded_t_s}, {"server_returns", run.server_returns},
+                   {"samples", to_json(run.samples)}};
+  if (o.watch_mesh) r["mesh"] = {{"frames", run.mesh.frames}, {"rate_hz", run.mesh.rate_hz()}, {"samples", run.mesh.samples}};
+  std::ofstream(o.report) << r.dump(1) << "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -99,7 +298,10 @@ int main(int argc, char** argv) {
       "server reports contact, presses DEPTH further by mid-run and comes back to the contact height by the end.\n"
       "Script 'grasp': the grasper moves down to contact (plus DEPTH), closes its jaws, pulls up PULL, opens.\n"
       "--trajectory FILE.csv plays a recorded or designed trajectory instead (docs/PROTOCOL.md).\n"
-      "Prints force and command-to-force round trip live; --report writes every sample as JSON.");
+      "Prints force and command-to-force round trip live; --report writes every sample as JSON.\n"
+      "If the server goes away the rendered force fades to zero (--fade) and the client exits with status 4\n"
+      "(--reconnect: it waits for a server to come back and claims the instrument again).\n"
+      "Exit status: 0 done, 2 bad arguments, 3 no server or instrument not claimed, 4 the server went away, 1 other errors.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");
   cl.flag("instrument", "ID", "instrument to claim", "1");
@@ -112,160 +314,46 @@ int main(int argc, char** argv) {
   cl.flag("frame", "NAME", "trajectory positions: scene (absolute) | organ-top (relative to the organ's top centre)", "scene");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");
   cl.flag("blend", "S", "blend from one local force model to the next over this time [s]", "0.003");
+  cl.flag("fade", "S", "when the server stops answering or is gone, fade the rendered force to zero over this time [s]", "0.25");
+  cl.flag("stale-after", "S", "a local force model this old means the server is not answering: start the fade [s]", "0.25");
   cl.flag("tick-phase", "US", "send commands this long after each server tick [us] (at --rate = physics rate; negative: loop free)", "100");
   cl.option_switch("watch-mesh", "receive the organ's surface frames and report their rate and the surface's displacement");
+  cl.option_switch("reconnect", "when the server goes away, wait for one to come back and claim the instrument again");
   cl.option_switch("quiet", "no live lines, only the summary");
   cl.flag("report", "FILE.json", "write samples and statistics here");
   try {
     if (!cl.parse(argc, argv)) return 0;
-    const auto client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
-    const auto instrument = static_cast<std::uint32_t>(cl.number_in("instrument", 1, 1e6));
-    const double rate = cl.number_in("rate", 1, 20000), depth = cl.number_in("depth", 0, 0.2);
-    const double max_force = cl.number_in("max-force", 0.1, 1000), pull = cl.number_in("pull", 0, 0.2);
-    const std::string script = cl.text("script"), frame = cl.text("frame");
-    if (script != "press" && script != "grasp") throw viscera::cli::UsageError("--script: '" + script + "' is not press or grasp");
-    if (frame != "scene" && frame != "organ-top") throw viscera::cli::UsageError("--frame: '" + frame + "' is not scene or organ-top");
-    std::vector<viscera::haptic::TrajectoryPoint> trajectory;
-    if (cl.has("trajectory")) {  // before connecting: a bad file fails at once
-      try {
-        trajectory = viscera::haptic::read_trajectory(cl.text("trajectory"));
-      } catch (const std::runtime_error& e) {
-        throw viscera::cli::UsageError(e.what());
-      }
-    }
-    const double duration = cl.has("duration") ? cl.number_in("duration", 0.1, 36000) : trajectory.empty() ? 4.0 : trajectory.back().t_s;
-    const bool quiet = cl.has("quiet"), watch_mesh = cl.has("watch-mesh");
-    const double tick_phase_us = cl.number_in("tick-phase", -1, 1e6);
-
-    viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)), client_id);
+    const Options o = parse(cl);
+    viscera::client::Client client(o.domain, o.client_id);
     const auto scene = client.wait_for_scene(std::chrono::seconds(10));
     if (!scene) {
       std::fprintf(stderr, "haptic-client: no viscera-server found in 10 s (same domain and CYCLONEDDS_URI?)\n");
       return 3;
     }
-    if (!client.claim(instrument, std::chrono::seconds(5))) {
-      std::fprintf(stderr, "haptic-client: instrument %u could not be claimed (taken, or not in scene %s)\n", instrument, scene->name.c_str());
+    if (const auto claim = client.claim(o.instrument, std::chrono::seconds(5)); !claim) {
+      std::fprintf(stderr, "haptic-client: instrument %u not claimed in scene %s: %s\n", o.instrument, scene->name.c_str(), claim.why.c_str());
       return 3;
     }
-    std::unique_ptr<viscera::client::Device> device;
-    if (!trajectory.empty()) {
-      const Vector3 origin = frame == "scene" ? Vector3{0, 0, 0}
-                                              : Vector3{0.5 * (scene->bounds_min[0] + scene->bounds_max[0]),
-                                                        0.5 * (scene->bounds_min[1] + scene->bounds_max[1]), scene->bounds_max[2]};
-      device = std::make_unique<viscera::haptic::TrajectoryDevice>(cl.text("trajectory"), std::move(trajectory), origin);
-    } else {
-      device = std::make_unique<viscera::haptic::ScriptedDevice>(script, *scene, duration, depth, pull);
-    }
-    std::printf("haptic-client: scene %s, instrument %u claimed; device: %s, %.0f Hz for %.1f s\n", scene->name.c_str(), instrument,
-                device->name().c_str(), rate, duration);
+    const auto device = make_device(o, *scene);
+    std::printf("haptic-client: scene %s, instrument %u claimed; device: %s, %.0f Hz for %.1f s\n", scene->name.c_str(), o.instrument,
+                device->name().c_str(), o.rate_hz, o.duration_s);
     std::fflush(stdout);
-
-    // Tip of each of the last 4096 commands, for the local model (a ring: no allocation per period).
-    struct Sent {
-      std::uint64_t seq = 0;
-      Vector3 tip{};
-    };
-    std::vector<Sent> sent(4096);
-    std::uint64_t seq = 0, clamps = 0, model_seq = 0;
-    viscera::client::LocalForceRenderer renderer(max_force, cl.number_in("blend", 0, 0.1));
-    MeshWatch mesh;
-    const bool record = cl.has("report");
-    mesh.record = record;
-    std::vector<ForceSample> samples;
-    // Reserved up front so the loop never reallocates (pages are touched only as samples come).
-    if (record) samples.reserve(static_cast<std::size_t>(std::min(duration * rate + 16, double{1 << 22})));
-    const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / rate));
-    const auto start = std::chrono::steady_clock::now();
     const double start_epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-    auto next = start;
-    // Commands timed to arrive just after a physics tick, in the server's idle time (tick_phase.hpp).
-    std::optional<viscera::client::TickPhase> phase;
-    if (tick_phase_us >= 0) phase.emplace(period, std::chrono::nanoseconds(std::llround(tick_phase_us * 1e3)));
-    const auto rate_matches = [&](const viscera::protocol::Scene& s) { return std::abs(s.physics_rate_hz - rate) <= 0.01 * rate; };
-    bool in_phase_possible = rate_matches(*scene);
-    std::uint64_t phased = 0, near_phase = 0;  // periods timed by the lock; of them within 50 us of the target
-    double last_print = -1, last_scene_check = 0;
-    std::uint32_t generation = scene->generation;
-    for (;;) {
-      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (t >= duration) break;
-      if (t - last_scene_check >= 0.1) {  // a scene loaded at run time releases every instrument: claim it again
-        last_scene_check = t;
-        const auto now = client.scene();
-        if (now) in_phase_possible = rate_matches(*now);  // the physics rate may change at run time
-        if (now && now->generation != generation) {
-          generation = now->generation;
-          const bool again = client.claim(instrument, std::chrono::seconds(2));
-          std::printf("t = %5.2f s  the server loaded scene %s: instrument %u %s\n", t, now->name.c_str(), instrument,
-                      again ? "claimed again" : "could not be claimed again");
-          std::fflush(stdout);
-          next = std::chrono::steady_clock::now();
-          continue;
-        }
-      }
-      const auto in = device->read(t);
-      if (in.finished) break;
-      client.send_tip(instrument, in.tip_m, in.jaw_rad);
-      ++seq;
-      sent[seq % sent.size()] = {seq, in.tip_m};
-      // Wait for the answer to this command until shortly before the next device period.
-      if (const auto f = client.wait_force(instrument, next + period - std::chrono::microseconds(100))) {
-        // The force rendered now, from the server's local models at the current tip: a new model
-        // (the answer to a newer command) is blended in over --blend seconds.
-        if (f->command_seq > model_seq)
-          if (const Sent& it = sent[f->command_seq % sent.size()]; it.seq == f->command_seq && it.seq != 0) {
-            renderer.update(*f, it.tip, t);
-            model_seq = f->command_seq;
-          }
-        const auto rendered = renderer.render(in.tip_m, t);
-        device->render(rendered.force, f->in_contact);
-        clamps += rendered.clamped;
-        double normal_stiffness = 0;  // n^T K n of the local model [N/m]
-        for (std::size_t i = 0; i < 3; ++i)
-          for (std::size_t j = 0; j < 3; ++j) normal_stiffness += f->contact_normal[i] * f->stiffness[3 * i + j] * f->contact_normal[j];
-        if (record)
-          samples.push_back({t, in.tip_m[2], in.jaw_rad, f->force, f->torque, rendered.force, f->in_contact, f->penetration_m,
-                             normal_stiffness, 1e3 * renderer.model_age_s(t), seq - f->command_seq, f->command_seq});
-        if (!quiet && t - last_print >= 0.25) {
-          const auto rtt = client.round_trip();
-          std::printf("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s\n", t,
-                      in.tip_m[2], f->force[0], f->force[1], f->force[2], f->in_contact ? "  contact" : "         ", rtt.p50_us,
-                      rtt.p99_us, watch_mesh ? ("  mesh frames " + std::to_string(mesh.frames)).c_str() : "");
-          last_print = t;
-          std::fflush(stdout);
-        }
-      }
-      if (watch_mesh) mesh.take(client, t, in.tip_m);
-      next += period;
-      if (phase && in_phase_possible)
-        if (const auto tick_end = client.last_tick_end_ns(instrument)) {
-          const std::int64_t next_ns = viscera::protocol::now_ns() +
-                                       std::chrono::duration_cast<std::chrono::nanoseconds>(next - std::chrono::steady_clock::now()).count();
-          ++phased;
-          near_phase += std::abs(phase->error(next_ns, *tick_end).count()) < 50'000;
-          next += phase->correction(next_ns, *tick_end);
-        }
-      std::this_thread::sleep_until(next);
-    }
-    client.release(instrument);
+    const RunResult run = run_device(o, client, *device, scene->generation);
+    if (!run.lost) client.release(o.instrument);
     const auto rtt = client.round_trip();
     std::printf("haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
                 rtt.samples, rtt.p50_us, rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()),
-                static_cast<unsigned long long>(clamps), max_force);
-    if (watch_mesh)
-      std::printf("haptic-client: %zu surface frames at %.1f Hz\n", mesh.frames, mesh.rate_hz());
-    if (phased > 0)
-      std::printf("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us\n",
-                  tick_phase_us, static_cast<unsigned long long>(phased), 100.0 * static_cast<double>(near_phase) / static_cast<double>(phased));
-    if (cl.has("report")) {
-      nlohmann::json r{{"scene", scene->name}, {"instrument", instrument}, {"client_id", client_id}, {"rate_hz", rate},
-                       {"start_epoch_s", start_epoch_s},
-                       {"duration_s", duration}, {"device", device->name()},
-                       {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
-                       {"tick_phase", {{"offset_us", tick_phase_us}, {"periods", phased}, {"within_50us", near_phase}}},
-                       {"samples", to_json(samples)}};
-      if (watch_mesh) r["mesh"] = {{"frames", mesh.frames}, {"rate_hz", mesh.rate_hz()}, {"samples", mesh.samples}};
-      std::ofstream(cl.text("report")) << r.dump(1) << "\n";
+                static_cast<unsigned long long>(run.clamps), o.max_force_n);
+    if (o.watch_mesh) std::printf("haptic-client: %zu surface frames at %.1f Hz\n", run.mesh.frames, run.mesh.rate_hz());
+    if (run.phased > 0)
+      std::printf("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us\n", o.tick_phase_us,
+                  static_cast<unsigned long long>(run.phased), 100.0 * static_cast<double>(run.near_phase) / static_cast<double>(run.phased));
+    if (!o.report.empty()) write_report(o, scene->name, device->name(), start_epoch_s, rtt, run);
+    if (run.lost) {
+      std::fprintf(stderr, "haptic-client: the server went away at t = %.2f s; the force had faded to zero at t = %.2f s\n", run.server_lost_t_s,
+                   run.faded_t_s);
+      return 4;
     }
     return 0;
   } catch (const viscera::cli::UsageError& e) {

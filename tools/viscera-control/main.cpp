@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -16,6 +17,16 @@
 
 namespace {
 
+/// Exit status when the server went away while watched.
+constexpr int kServerGone = 4;
+
+/// True (after saying so) when the server is gone.
+bool server_gone(viscera::client::Client& client) {
+  if (client.server_state() != viscera::client::ServerState::lost) return false;
+  std::fprintf(stderr, "viscera-control: the server is gone (its DDS liveliness lapsed or it left the domain)\n");
+  return true;
+}
+
 /// Prints each health report of the server for `duration_s`, then the ticks, late ticks and
 /// missed slots over the watched span (by the server's stamps). Returns 1 if no report came.
 int watch_health(viscera::client::Client& client, const viscera::protocol::Scene& scene, double duration_s) {
@@ -25,15 +36,17 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
   std::optional<viscera::protocol::TelemetryReport> first, last;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
   while (std::chrono::steady_clock::now() < end) {
+    if (server_gone(client)) return kServerGone;
     for (const auto& t : client.poll_telemetry()) {
       if (!first) first = t;
       last = t;
       std::printf("t +%.4f s: %.0f Hz physics, %llu ticks (%llu late, %llu slots missed), step p50 %.0f us p99 %.0f us max %.0f us, "
-                  "tick jitter p99 %.0f us, %llu messages rejected\n",
+                  "tick jitter p99 %.0f us, %llu messages rejected (%llu malformed, %llu not from the owner, %llu for unknown instruments)\n",
                   1e-9 * static_cast<double>(t.server_stamp_ns - first->server_stamp_ns), t.physics_rate_hz,
                   static_cast<unsigned long long>(t.steps), static_cast<unsigned long long>(t.late_ticks),
                   static_cast<unsigned long long>(t.missed_slots), t.step_p50_us, t.step_p99_us, t.step_max_us, t.jitter_p99_us,
-                  static_cast<unsigned long long>(t.rejected_messages));
+                  static_cast<unsigned long long>(t.rejected_messages), static_cast<unsigned long long>(t.rejected_malformed),
+                  static_cast<unsigned long long>(t.rejected_not_owner), static_cast<unsigned long long>(t.rejected_unknown_instrument));
       std::fflush(stdout);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -69,6 +82,7 @@ int main(int argc, char** argv) {
       "                  rejected messages) for --duration seconds, then what changed over them\n"
       "  events          print the session's events and annotations for --duration seconds\n"
       "  annotate TEXT   a note for recorders and consoles\n"
+      "Exit status: 0 done, 1 refused or not confirmed, 2 bad arguments, 3 no server, 4 the server went away (health, events).\n"
       "Usage: viscera-control ACTION [ARGUMENT] [--domain ID] [--duration S] [material flags]");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
@@ -115,7 +129,8 @@ int main(int argc, char** argv) {
     if (action == "rate") {
       char* end = nullptr;
       rate_hz = std::strtod(rest[1].c_str(), &end);
-      if (*end || !(rate_hz >= 10 && rate_hz <= 10000)) throw viscera::cli::UsageError("rate '" + rest[1] + "' is not a number of hertz in [10, 10000]");
+      if (*end || !(rate_hz >= 10 && rate_hz <= 10000) || rate_hz != std::floor(rate_hz))
+        throw viscera::cli::UsageError("rate '" + rest[1] + "' is not a whole number of hertz in [10, 10000]");
     }
     const double duration = cl.number_in("duration", 0.1, 1e6);
     const auto timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));
@@ -133,6 +148,7 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration);
       while (std::chrono::steady_clock::now() < end) {
+        if (server_gone(client)) return kServerGone;
         for (const auto& e : client.poll_events()) {
           std::printf("event %s sim %.3f s instrument %u client %u%s%s\n", viscera::protocol::event_name(e.kind), e.sim_time_s, e.instrument_id,
                       e.client_id, e.text.empty() ? "" : ": ", e.text.c_str());
@@ -183,6 +199,7 @@ int main(int argc, char** argv) {
     for (const auto& n : scene->available_scenes) list += " " + n;
     std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene->preparing.empty() ? "" : "; preparing ",
                 scene->preparing.c_str());
+    for (const auto& u : scene->unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
     return 0;
   } catch (const viscera::cli::UsageError& e) {
     std::fprintf(stderr, "viscera-control: %s\n", e.what());

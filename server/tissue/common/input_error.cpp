@@ -1,5 +1,7 @@
 #include "common/input_error.hpp"
 
+#include <cstdio>
+
 namespace viscera::tissue {
 
 namespace {
@@ -17,5 +19,27 @@ InputError::InputError(std::string source, long line, std::string field, const s
       source_(std::move(source)),
       line_(line),
       field_(std::move(field)) {}
+
+std::string short_number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string printable(std::string_view text, std::size_t max_chars) {
+  std::string out;
+  for (const char c : text) {
+    if (out.size() >= max_chars) return out + "...";
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02X", u);
+      out += b;
+    }
+  }
+  return out;
+}
 
 }  // namespace viscera::tissue

@@ -3,6 +3,7 @@
 // bad value came from, so that a user can act on a single line of text.
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace viscera::tissue {
 
@@ -20,6 +21,12 @@ class InputError : public std::runtime_error {
   long line_;
   std::string field_;
 };
+
+/// A number for messages: six significant digits ("1e+300", "0.0123", "inf").
+std::string short_number(double v);
+/// Text from a file for messages: at most `max_chars` characters, bytes that are not printable
+/// ASCII shown as \xNN, "..." when cut.
+std::string printable(std::string_view text, std::size_t max_chars = 40);
 
 /// Numerical failure detected while integrating (instability, non-convergence).
 class SimulationError : public std::runtime_error {

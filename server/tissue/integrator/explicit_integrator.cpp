@@ -111,6 +111,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
 
 long ExplicitIntegrator::advance(State& state, double duration_s) {
   if (!(duration_s > 0)) return 0;
+  if (!std::isfinite(dt_) || !(dt_ > 0)) throw SimulationError("the explicit step " + short_number(dt_) + " s cannot be run");
   // Equal sub-steps no longer than dt: symplectic Euler is stable at a constant step below the
   // limit, but a short last sub-step after full ones breaks its staggering and can pump energy
   // into the highest modes (seen on the 12k liver at 0.85 of the critical step).
@@ -120,6 +121,7 @@ long ExplicitIntegrator::advance(State& state, double duration_s) {
   for (long k = 1; k <= steps; ++k) {
     step_with(state, dt);
     state.time_s = start + static_cast<double>(k) * dt;
+    if (k < steps && interrupted_ && interrupted_()) return k;
   }
   return steps;
 }

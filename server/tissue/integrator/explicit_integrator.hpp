@@ -43,8 +43,11 @@ class ExplicitIntegrator {
   /// the element and the time, and puts `state` back to the last step that passed the check.
   void step(State& state);
   /// Equal sub-steps, each at most dt_s(), until state.time_s has advanced by `duration_s`.
-  /// Returns the number of sub-steps.
+  /// Returns the number of sub-steps. Between sub-steps it asks the interruption (if set) and
+  /// returns early when it says so, with the state at the last sub-step taken.
   long advance(State& state, double duration_s);
+  /// Asked between the sub-steps of advance(): true stops it (a program that must stop at once).
+  void set_interruption(std::function<bool()> interrupted) { interrupted_ = std::move(interrupted); }
 
   /// How internal forces are evaluated: by default model.add_forces on the calling thread; a caller
   /// may split them over threads (server/runtime/parallel_forces.hpp). It must add the model's
@@ -67,6 +70,7 @@ class ExplicitIntegrator {
   std::vector<Vec3> inv_mass_;     // per coordinate; 0 where constrained
   std::vector<Vec3> gravity_;      // m g per node
   ForceEvaluation evaluate_;
+  std::function<bool()> interrupted_;
   MassScaling scaling_;
   StableStep critical_;
   double dt_;

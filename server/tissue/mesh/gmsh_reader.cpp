@@ -44,13 +44,13 @@ void check_type(TextCursor& in, long long type, long long element) {
 
 void expect(TextCursor& in, std::string_view marker) {
   const std::string_view t = in.token(marker);
-  if (t != marker) in.fail(marker, "expected '" + std::string(marker) + "', found '" + std::string(t) + "'");
+  if (t != marker) in.fail(marker, "expected '" + std::string(marker) + "', found '" + printable(t) + "'");
 }
 
 void read_nodes_v1v2(TextCursor& in, MeshBuilder& b, std::string_view end) {
   const long long n = in.integer_in("node count", 1, 100'000'000);
   for (long long i = 0; i < n; ++i) {
-    const long line = in.line();
+    const long line = in.next_line();
     const long long id = in.integer("node id");
     Vec3 p;
     p.x() = in.real("node x");
@@ -64,7 +64,7 @@ void read_nodes_v1v2(TextCursor& in, MeshBuilder& b, std::string_view end) {
 void read_elements_v1v2(TextCursor& in, MeshBuilder& b, bool v1, std::string_view end) {
   const long long m = in.integer_in("element count", 0, 1'000'000'000);
   for (long long i = 0; i < m; ++i) {
-    const long line = in.line();
+    const long line = in.next_line();
     const long long id = in.integer("element id");
     const long long type = in.integer("element type");
     check_type(in, type, id);
@@ -104,7 +104,7 @@ void read_nodes_v4(TextCursor& in, MeshBuilder& b) {
     std::vector<long> lines(count);
     for (auto& t : tags) t = in.integer("node tag");
     for (long long k = 0; k < count; ++k) {
-      const long line = in.line();
+      const long line = in.next_line();
       Vec3 p;
       p.x() = in.real("node x");
       p.y() = in.real("node y");
@@ -129,7 +129,7 @@ void read_elements_v4(TextCursor& in, MeshBuilder& b) {
     const long long count = in.integer_in("elements in block", 0, 1'000'000'000);
     const int nodes = gmsh_node_count(type);
     for (long long k = 0; k < count; ++k) {
-      const long line = in.line();
+      const long line = in.next_line();
       const long long id = in.integer("element tag");
       std::array<long long, 4> ids{};
       for (int j = 0; j < nodes; ++j) {
@@ -169,7 +169,7 @@ TetMesh read_gmsh(const std::string& path) {
       } else if (v == "4.1") {
         version = 4;
       } else {
-        in.fail("format version", "'" + std::string(v) + "' is not supported (1, 2.x, 4.1)");
+        in.fail("format version", "'" + printable(v) + "' is not supported (1, 2.x, 4.1)");
       }
       expect(in, "$EndMeshFormat");
     } else if (section == "$Nodes") {
@@ -185,9 +185,9 @@ TetMesh read_gmsh(const std::string& path) {
     } else if (section.starts_with("$")) {
       // Any other section ($PhysicalNames, $Entities, $NodeData...): skip to its end marker.
       const std::string end = "$End" + section.substr(1);
-      if (!in.skip_past(end)) in.fail(section, "section is not closed by " + end);
+      if (!in.skip_past(end)) in.fail(printable(section), "section is not closed by " + printable(end));
     } else {
-      in.fail("section", "expected a $Section, found '" + section + "'");
+      in.fail("section", "expected a $Section, found '" + printable(section) + "'");
     }
   }
   if (!nodes) throw InputError(path, 0, "$Nodes", "missing: not a Gmsh mesh?");

@@ -12,6 +12,7 @@ void MeshBuilder::add_node(long long id, const Vec3& p, long line) {
   if (!inserted) throw InputError(source_, line, "node " + std::to_string(id), "duplicate node id");
   nodes_.push_back(p);
   node_ids_.push_back(id);
+  node_lines_.push_back(line);
 }
 
 void MeshBuilder::add_tet(const std::array<long long, 4>& ids, long long element, long line) {
@@ -23,7 +24,12 @@ TetMesh MeshBuilder::build() {
   mesh.source = source_;
   mesh.nodes = std::move(nodes_);
   mesh.tets.reserve(tets_.size());
+  MeshOrigin origin;
+  origin.node_ids = std::move(node_ids_);
+  origin.node_lines = std::move(node_lines_);
   for (const PendingTet& p : tets_) {
+    origin.element_ids.push_back(p.element);
+    origin.element_lines.push_back(p.line);
     Tet t;
     for (int k = 0; k < 4; ++k) {
       const auto it = index_of_.find(p.ids[k]);
@@ -35,7 +41,7 @@ TetMesh MeshBuilder::build() {
     mesh.tets.push_back(t);
   }
   if (mesh.tets.empty()) throw InputError(source_, 0, "", "contains no tetrahedra");
-  validate_mesh(mesh);
+  validate_mesh(mesh, &origin);
   return mesh;
 }
 

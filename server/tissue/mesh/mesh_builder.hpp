@@ -28,6 +28,7 @@ class MeshBuilder {
   std::string source_;
   std::vector<Vec3> nodes_;
   std::vector<long long> node_ids_;
+  std::vector<long> node_lines_;
   std::unordered_map<long long, std::int32_t> index_of_;
   std::vector<PendingTet> tets_;
 };

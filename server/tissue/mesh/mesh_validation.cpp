@@ -18,38 +18,47 @@ double tet_quality(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x
   return 6.0 * std::sqrt(2.0) * signed_volume(x0, x1, x2, x3) / (l_rms * l_rms * l_rms);
 }
 
-void validate_mesh(const TetMesh& mesh) {
-  const auto fail = [&](const std::string& what, const std::string& msg) {
-    throw InputError(mesh.source, 0, what, msg);
+void validate_mesh(const TetMesh& mesh, const MeshOrigin* origin) {
+  const auto fail = [&](const std::string& what, const std::string& msg, long line = 0) { throw InputError(mesh.source, line, what, msg); };
+  const auto known = [](const auto& v, std::size_t k) { return k < v.size(); };
+  // The file's own numbers and lines where known.
+  const auto element = [&](std::size_t e) {
+    return origin && known(origin->element_ids, e) ? "element " + std::to_string(origin->element_ids[e]) : "tetrahedron " + std::to_string(e);
   };
+  const auto element_line = [&](std::size_t e) { return origin && known(origin->element_lines, e) ? origin->element_lines[e] : 0L; };
+  const auto node = [&](std::size_t i) {
+    return origin && known(origin->node_ids, i) ? "node " + std::to_string(origin->node_ids[i]) : "node " + std::to_string(i);
+  };
+  const auto node_line = [&](std::size_t i) { return origin && known(origin->node_lines, i) ? origin->node_lines[i] : 0L; };
   const auto n = static_cast<std::int64_t>(mesh.nodes.size());
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i)
-    if (!mesh.nodes[i].allFinite()) fail("node " + std::to_string(i), "coordinates are not finite");
+    if (!mesh.nodes[i].allFinite()) fail(node(i), "coordinates are not finite", node_line(i));
   std::vector<char> used(mesh.nodes.size(), 0);
   std::map<std::array<std::int32_t, 4>, std::size_t> seen;
   for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
     const Tet& t = mesh.tets[e];
-    const std::string name = "tetrahedron " + std::to_string(e);
+    const std::string name = element(e);
+    const long line = element_line(e);
     for (int k = 0; k < 4; ++k)
       if (t[k] < 0 || t[k] >= n)
         fail(name, "vertex index " + std::to_string(t[k]) + " is out of range [0, " +
-                       std::to_string(n - 1) + "]");
+                       std::to_string(n - 1) + "]", line);
     std::array<std::int32_t, 4> sorted = t;
     std::sort(sorted.begin(), sorted.end());
     if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
-      fail(name, "repeats a vertex");
+      fail(name, "repeats a vertex", line);
     const auto [it, inserted] = seen.emplace(sorted, e);
-    if (!inserted) fail(name, "duplicates tetrahedron " + std::to_string(it->second));
+    if (!inserted) fail(name, "duplicates " + element(it->second), line);
     const double q = tet_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
     std::ostringstream qs;
     qs.precision(3);
     qs << q;
-    if (!(std::abs(q) >= kDegenerateQuality)) fail(name, "is degenerate (shape quality " + qs.str() + ")");
-    if (q < 0) fail(name, "is inverted (negative signed volume, shape quality " + qs.str() + ")");
+    if (!(std::abs(q) >= kDegenerateQuality)) fail(name, "is degenerate (shape quality " + qs.str() + ")", line);
+    if (q < 0) fail(name, "is inverted (negative signed volume, shape quality " + qs.str() + ")", line);
     for (int k = 0; k < 4; ++k) used[t[k]] = 1;
   }
   for (std::size_t i = 0; i < used.size(); ++i)
-    if (!used[i]) fail("node " + std::to_string(i), "is used by no tetrahedron");
+    if (!used[i]) fail(node(i), "is used by no tetrahedron", node_line(i));
 }
 
 }  // namespace viscera::tissue

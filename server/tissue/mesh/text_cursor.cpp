@@ -1,11 +1,11 @@
 #include "mesh/text_cursor.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "common/input_error.hpp"
+#include "common/json_input.hpp"
 
 namespace viscera::tissue {
 
@@ -13,11 +13,17 @@ TextCursor::TextCursor(std::string source, std::string text)
     : source_(std::move(source)), text_(std::move(text)) {}
 
 TextCursor TextCursor::from_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "", "cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return TextCursor(path, ss.str());
+  std::string text = read_text_file(path, std::size_t{4} << 30);
+  if (const auto nul = text.find('\0'); nul != std::string::npos) {
+    const long line = 1 + static_cast<long>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n'));
+    throw InputError(path, line, "", "holds binary data (a NUL byte at byte " + std::to_string(nul) + "): not a text mesh file; save it as ASCII");
+  }
+  return TextCursor(path, std::move(text));
+}
+
+long TextCursor::next_line() {
+  skip_space();
+  return line_;
 }
 
 void TextCursor::skip_space() {
@@ -54,8 +60,8 @@ double TextCursor::real(std::string_view field) {
   double v = 0.0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
   if (ec != std::errc() || end != t.data() + t.size())
-    fail(field, "'" + std::string(t) + "' is not a number");
-  if (!std::isfinite(v)) fail(field, "'" + std::string(t) + "' is not a finite number");
+    fail(field, "'" + printable(t) + "' is not a number");
+  if (!std::isfinite(v)) fail(field, "'" + printable(t) + "' is not a finite number");
   return v;
 }
 
@@ -64,7 +70,7 @@ long long TextCursor::integer(std::string_view field) {
   long long v = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
   if (ec != std::errc() || end != t.data() + t.size())
-    fail(field, "'" + std::string(t) + "' is not an integer");
+    fail(field, "'" + printable(t) + "' is not an integer");
   return v;
 }
 

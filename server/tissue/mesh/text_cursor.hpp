@@ -10,11 +10,14 @@ class TextCursor {
  public:
   TextCursor(std::string source, std::string text);
 
-  /// Reads a whole file; throws InputError naming the path if it cannot be read.
+  /// Reads a whole text file; throws InputError naming the path if it cannot be read, is not a
+  /// regular file, or holds binary data (a NUL byte).
   static TextCursor from_file(const std::string& path);
 
   bool at_end();
   long line() const { return line_; }
+  /// The line on which the next token starts (skips the whitespace before it).
+  long next_line();
   const std::string& source() const { return source_; }
 
   /// Next whitespace-separated token; throws InputError ("unexpected end of file") at the end.

@@ -1,5 +1,6 @@
 // VTK readers: legacy ASCII unstructured grid (.vtk, versions 2-4 "CELLS n size" layout and
 // 5.1 "OFFSETS/CONNECTIVITY" layout) and ASCII XML unstructured grid (.vtu).
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -7,6 +8,7 @@
 #include <pugixml.hpp>
 
 #include "common/input_error.hpp"
+#include "common/json_input.hpp"
 #include "mesh/mesh_builder.hpp"
 #include "mesh/mesh_reader.hpp"
 #include "mesh/text_cursor.hpp"
@@ -27,30 +29,33 @@ long long to_integer(TextCursor& in, std::string_view t, std::string_view field)
   long long v = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
   if (ec != std::errc() || end != t.data() + t.size())
-    in.fail(field, "'" + std::string(t) + "' is not an integer");
+    in.fail(field, "'" + printable(t) + "' is not an integer");
   return v;
 }
 
+/// `lines`: each cell's line in the file (empty: `line` for all).
 void add_cells(const std::string& path, MeshBuilder& b, const std::vector<long long>& offsets,
                const std::vector<long long>& connectivity, const std::vector<long long>& types,
-               long line) {
+               const std::vector<long>& lines, long cells_line) {
   const std::size_t n = types.size();
+  const long line = cells_line;
   if (offsets.size() != n + 1)
     throw InputError(path, line, "offsets", "has " + std::to_string(offsets.size()) +
                                                 " entries for " + std::to_string(n) + " cells");
   for (std::size_t c = 0; c < n; ++c) {
     const long long begin = offsets[c], end = offsets[c + 1];
+    const long cell_line = c < lines.size() ? lines[c] : line;
     if (begin < 0 || end < begin || end > static_cast<long long>(connectivity.size()))
-      throw InputError(path, line, "cell " + std::to_string(c), "offsets out of range");
+      throw InputError(path, cell_line, "cell " + std::to_string(c), "offsets out of range");
     if (types[c] == kVtkTetra) {
       if (end - begin != 4)
-        throw InputError(path, line, "cell " + std::to_string(c),
+        throw InputError(path, cell_line, "cell " + std::to_string(c),
                          "tetrahedron with " + std::to_string(end - begin) + " points");
       b.add_tet({connectivity[begin], connectivity[begin + 1], connectivity[begin + 2],
                  connectivity[begin + 3]},
-                static_cast<long long>(c), line);
+                static_cast<long long>(c), cell_line);
     } else if (is_other_volume_cell(types[c])) {
-      throw InputError(path, line, "cell " + std::to_string(c) + " type",
+      throw InputError(path, cell_line, "cell " + std::to_string(c) + " type",
                        std::to_string(types[c]) + " is a volume cell other than the linear "
                                                   "tetrahedron (10), which is all viscera simulates");
     }
@@ -63,18 +68,19 @@ TetMesh read_legacy_vtk(const std::string& path) {
   TextCursor in = TextCursor::from_file(path);
   const std::string header = in.rest_of_line();
   if (!header.starts_with("# vtk DataFile Version"))
-    in.fail("header", "not a legacy VTK file (first line '" + header.substr(0, 40) + "')");
+    in.fail("header", "not a legacy VTK file (first line '" + printable(header) + "')");
   const bool v5 = header.find("5.") != std::string::npos;
   in.rest_of_line();  // title
   const std::string_view encoding = in.token("encoding");
-  if (encoding != "ASCII") in.fail("encoding", "'" + std::string(encoding) + "' is not supported (ASCII)");
+  if (encoding != "ASCII") in.fail("encoding", "'" + printable(encoding) + "' is not supported (ASCII)");
   if (in.token("DATASET") != "DATASET") in.fail("DATASET", "missing");
   const std::string_view kind = in.token("DATASET");
   if (kind != "UNSTRUCTURED_GRID")
-    in.fail("DATASET", "'" + std::string(kind) + "' is not an UNSTRUCTURED_GRID");
+    in.fail("DATASET", "'" + printable(kind) + "' is not an UNSTRUCTURED_GRID");
 
   MeshBuilder b(path);
   std::vector<long long> offsets, connectivity, types;
+  std::vector<long> lines;  // of each cell (CELLS of versions 2-4: a cell per line)
   long cells_line = 0;
   bool have_points = false, have_cells = false, have_types = false;
   while (!in.at_end()) {
@@ -83,7 +89,7 @@ TetMesh read_legacy_vtk(const std::string& path) {
       const long long n = in.integer_in("POINTS count", 1, 1'000'000'000);
       in.token("POINTS data type");
       for (long long i = 0; i < n; ++i) {
-        const long line = in.line();
+        const long line = in.next_line();
         Vec3 p;
         p.x() = in.real("point x");
         p.y() = in.real("point y");
@@ -97,6 +103,7 @@ TetMesh read_legacy_vtk(const std::string& path) {
       in.integer("CELLS size");
       offsets.assign(1, 0);
       for (long long c = 0; c < n; ++c) {
+        lines.push_back(in.next_line());
         const long long k = in.integer_in("cell point count", 1, 1000);
         for (long long j = 0; j < k; ++j) connectivity.push_back(in.integer("cell point index"));
         offsets.push_back(static_cast<long long>(connectivity.size()));
@@ -133,13 +140,13 @@ TetMesh read_legacy_vtk(const std::string& path) {
     } else if (key == "POINT_DATA" || key == "CELL_DATA" || key == "FIELD" || key == "METADATA") {
       break;  // attribute data follow; the mesh is complete
     } else {
-      in.fail("keyword", "unexpected '" + key + "'");
+      in.fail("keyword", "unexpected '" + printable(key) + "'");
     }
   }
   if (!have_points) throw InputError(path, 0, "POINTS", "missing");
   if (!have_cells) throw InputError(path, 0, "CELLS", "missing");
   if (!have_types) throw InputError(path, 0, "CELL_TYPES", "missing");
-  add_cells(path, b, offsets, connectivity, types, cells_line);
+  add_cells(path, b, offsets, connectivity, types, lines, cells_line);
   return b.build();
 }
 
@@ -159,10 +166,10 @@ std::vector<T> parse_ascii_array(const std::string& path, const pugi::xml_node& 
     std::istringstream one(tok);
     T v{};
     if (!(one >> v) || !one.eof())
-      throw InputError(path, 0, std::string("DataArray ") + name, "'" + tok + "' is not a number");
+      throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not a number");
     if constexpr (std::is_floating_point_v<T>)
       if (!std::isfinite(v))
-        throw InputError(path, 0, std::string("DataArray ") + name, "'" + tok + "' is not finite");
+        throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not finite");
     out.push_back(v);
   }
   return out;
@@ -177,9 +184,14 @@ pugi::xml_node find_array(const pugi::xml_node& parent, const char* name) {
 }  // namespace
 
 TetMesh read_vtu(const std::string& path) {
+  const std::string text = read_text_file(path, std::size_t{4} << 30);
+  const auto line_at = [&](std::ptrdiff_t offset) {
+    if (offset < 0 || static_cast<std::size_t>(offset) > text.size()) return 0L;
+    return 1 + static_cast<long>(std::count(text.begin(), text.begin() + offset, '\n'));
+  };
   pugi::xml_document doc;
-  const pugi::xml_parse_result ok = doc.load_file(path.c_str());
-  if (!ok) throw InputError(path, 0, "XML", std::string(ok.description()) + " at byte " +
+  const pugi::xml_parse_result ok = doc.load_buffer(text.data(), text.size());
+  if (!ok) throw InputError(path, line_at(ok.offset), "XML", std::string(ok.description()) + " at byte " +
                                                   std::to_string(ok.offset));
   const pugi::xml_node file = doc.child("VTKFile");
   if (!file || std::string(file.attribute("type").as_string()) != "UnstructuredGrid")
@@ -205,8 +217,9 @@ TetMesh read_vtu(const std::string& path) {
   offsets.insert(offsets.begin(), 0);  // VTU offsets are cell ends
 
   MeshBuilder b(path);
-  for (long long i = 0; i < np; ++i) b.add_node(i, Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]), 0);
-  add_cells(path, b, offsets, connectivity, types, 0);
+  const long points_line = line_at(piece.child("Points").child("DataArray").offset_debug());
+  for (long long i = 0; i < np; ++i) b.add_node(i, Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]), points_line);
+  add_cells(path, b, offsets, connectivity, types, {}, line_at(find_array(cells, "connectivity").offset_debug()));
   return b.build();
 }
 

@@ -7,6 +7,7 @@
 //   if (c.claim(1, std::chrono::seconds(2))) { c.send_tip(1, {x, y, z}); auto f = c.poll_force(1); }
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,6 +17,21 @@
 #include "viscera/protocol/messages.hpp"
 
 namespace viscera::client {
+
+/// Whether a server is there: none seen yet; its writers alive; or gone (stopped, killed, or its
+/// host cut off: its DDS liveliness lease of 500 ms ran out, or it left the domain).
+enum class ServerState { waiting, alive, lost };
+const char* to_string(ServerState s);
+
+/// The protocol's clock [ns] (monotonic; the stamps of commands and forces are on it).
+std::int64_t now_ns();
+
+/// What became of a claim.
+struct ClaimResult {
+  bool claimed = false;
+  std::string why;  ///< when not claimed: the server's reason (no such instrument, taken), or the timeout
+  explicit operator bool() const { return claimed; }
+};
 
 struct LatencyStats {
   std::size_t samples = 0;
@@ -31,8 +47,9 @@ class Client {
   std::optional<protocol::Scene> wait_for_scene(std::chrono::milliseconds timeout);
   /// The newest scene state received, without waiting.
   std::optional<protocol::Scene> scene();
-  /// Claims an instrument; true once the scene state shows this client as its owner.
-  bool claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
+  /// Claims an instrument: claimed once the scene state shows this client as its owner; refused at
+  /// once with the server's reason if the scene has no such instrument or another client owns it.
+  ClaimResult claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
   void release(std::uint32_t instrument_id);
   /// Session control for the whole scene (any client, e.g. an instructor's console): pause,
   /// resume or reset. True once the scene state shows the pause state asked for (for reset:
@@ -81,6 +98,12 @@ class Client {
   /// acknowledgements, so a client that exits right after still delivers it.
   void annotate(const std::string& text);
   std::uint32_t id() const { return client_id_; }
+  /// Whether the server is there (from the DDS liveliness of its scene-state writer).
+  ServerState server_state() const;
+  /// When the server was last seen going (now_ns clock), if it was.
+  std::optional<std::int64_t> server_lost_ns() const;
+  /// Calls `f` on a DDS thread each time server_state() changes. Keep it short (set a flag).
+  void on_server_state(std::function<void(ServerState)> f);
   /// Payloads that failed verification and were dropped.
   std::uint64_t rejected() const { return rejected_; }
 

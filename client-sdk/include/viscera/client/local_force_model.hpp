@@ -3,6 +3,8 @@
 // server updates and across network delay the client renders F(x) = F0 - K (x - x0), with x0 the
 // tip position the server computed F0 for and K = -dF/dx, pushing only out of the tissue (along
 // the contact normal) and never beyond the device's force limit.
+#include <limits>
+
 #include "viscera/protocol/messages.hpp"
 
 namespace viscera::client {
@@ -16,28 +18,48 @@ struct RenderedForce {
 RenderedForce render_local_model(const protocol::Force& f, const protocol::Vector3& x0, const protocol::Vector3& x,
                                  double max_force_n);
 
+/// How the rendered force goes when the server stops answering: it fades linearly to zero over
+/// `fade_s`, starting when the newest model is `stale_after_s` old or when the application says
+/// the server is gone (Client::server_state), whichever comes first. It never holds a force the
+/// server no longer confirms, and never drops it at once (a hand pushing against it would lurch).
+/// A model that arrives later fades the force back in at the same rate.
+struct FadePolicy {
+  double stale_after_s = 0.25;  ///< the newest model this old means the server is not answering
+  double fade_s = 0.25;         ///< from full force to none [s]
+};
+
 /// Renders at the device rate from the newest local model. When a new model arrives the force
 /// blends from the previous model to the new one over `blend_s` (linearly in time) instead of
 /// jumping (HAPTICS.md section 2), and is limited to the device's maximum afterwards.
 class LocalForceRenderer {
  public:
-  explicit LocalForceRenderer(double max_force_n, double blend_s = 0.003) : max_force_(max_force_n), blend_(blend_s) {}
+  explicit LocalForceRenderer(double max_force_n, double blend_s = 0.003, FadePolicy fade = {})
+      : max_force_(max_force_n), blend_(blend_s), fade_(fade) {}
   /// A new model: `f`, computed by the server for the tool at `x0`, arriving at time `t_s`.
   void update(const protocol::Force& f, const protocol::Vector3& x0, double t_s);
+  /// The server is gone (from time `t_s`): the force fades out from then, if not already fading.
+  void server_lost(double t_s);
   /// The force to command at tool position `x` at time `t_s` (zero before the first model).
   RenderedForce render(const protocol::Vector3& x, double t_s) const;
   /// Seconds since the newest model arrived (infinite before the first).
   double model_age_s(double t_s) const;
+  /// The factor (0-1) the force is rendered with at `t_s`: 1 while models come, then the fade.
+  double gain(double t_s) const;
 
  private:
   struct Model {
     protocol::Force force;
     protocol::Vector3 x0{};
   };
+  /// When the fade out starts (infinite while models come).
+  double fade_start_s() const;
   double max_force_, blend_;
+  FadePolicy fade_;
   bool has_new_ = false, has_old_ = false;
   Model new_, old_;
   double arrived_s_ = 0;
+  double lost_s_ = std::numeric_limits<double>::infinity();  // server_lost() time
+  double resume_s_ = 0, resume_gain_ = 1;  // a model after a fade: when it came, and the gain then
 };
 
 }  // namespace viscera::client

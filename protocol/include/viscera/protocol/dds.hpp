@@ -83,11 +83,18 @@ class Reader {
   int take(const std::function<void(const Received&)>& f);
   /// Blocks until data are available or the timeout passes; true if data.
   bool wait(std::chrono::nanoseconds timeout);
+  /// Matched writers whose liveliness holds now: a writer whose process died counts until its
+  /// lease (500 ms) runs out; one that was deleted (its process stopped cleanly) leaves at once.
+  int alive_writers() const;
+  /// Calls `f(alive writers)` on a DDS thread whenever the liveliness of the matched writers
+  /// changes (one joins, one is deleted, or one's lease runs out). Set once, before use.
+  void on_alive_writers_changed(std::function<void(int)> f);
 
  private:
   int32_t handle_;
   int32_t waitset_;
   int32_t condition_;
+  std::function<void(int)> on_alive_;
 };
 
 /// Monotonic clock in nanoseconds (the stamps of the protocol).

@@ -95,6 +95,7 @@ struct Scene {
   std::vector<std::string> available_scenes;
   std::string preparing;  ///< scene or material being built in the background
   std::vector<RequestOutcome> recent_requests;  ///< the last few, oldest first
+  std::vector<std::string> unreadable_scenes;   ///< schema 6: "name: error" for scene files that do not read
 };
 
 struct TelemetryReport {
@@ -104,6 +105,8 @@ struct TelemetryReport {
   std::uint64_t rejected_messages = 0;
   double physics_rate_hz = 0, step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0;
   std::uint64_t missed_slots = 0;  ///< slots that passed with no tick (schema 5; 0 from older servers)
+  /// rejected_messages by reason (schema 6; all 0 from older servers)
+  std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0;
 };
 
 /// An organ's boundary surface, sent once per mesh_id; frames list positions in its vertex order.
