@@ -32,6 +32,7 @@ struct Client::Impl {
   // The server's liveliness, as its scene-state writer's: set by a DDS listener thread.
   std::atomic<ServerState> server{ServerState::waiting};
   std::atomic<std::int64_t> lost_ns{0};
+  std::atomic<bool> scene_stale{false};  // the server was lost: its last scene state no longer holds
   std::mutex callback_mutex;
   std::function<void(ServerState)> callback;
   explicit Impl(std::uint32_t domain)
@@ -48,11 +49,15 @@ struct Client::Impl {
     const ServerState before = server.load();
     const ServerState now = alive > 0 ? ServerState::alive : before == ServerState::waiting ? ServerState::waiting : ServerState::lost;
     if (now == before) return;
-    if (now == ServerState::lost) lost_ns = proto::now_ns();
+    if (now == ServerState::lost) {
+      lost_ns = proto::now_ns();
+      scene_stale = true;
+    }
     server = now;
     if (callback) callback(now);
   }
   void take_scene(std::uint64_t& rejected) {
+    if (scene_stale.exchange(false)) last_scene.reset();  // a restarted server publishes its own
     scene.take([&](const proto::Received& r) {
       std::string why;
       if (auto s = proto::decode_scene(r.payload, &why)) last_scene = *s;

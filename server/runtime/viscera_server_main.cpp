@@ -78,10 +78,12 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     });
-    std::printf("viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected, %llu mesh frames\n",
+    std::printf("viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected (malformed %llu, not owner %llu, unknown instrument %llu), %llu mesh frames\n",
                 static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.late_ticks), static_cast<unsigned long long>(stats.missed_slots),
                 static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.forces_sent),
-                static_cast<unsigned long long>(stats.rejected), static_cast<unsigned long long>(stats.mesh_frames));
+                static_cast<unsigned long long>(stats.rejected), static_cast<unsigned long long>(stats.rejected_malformed),
+                static_cast<unsigned long long>(stats.rejected_not_owner), static_cast<unsigned long long>(stats.rejected_unknown_instrument),
+                static_cast<unsigned long long>(stats.mesh_frames));
     server.reset();  // leaves the DDS domain: clients see the server gone at once
     if (viscera::runtime::SimulationServer::abandoned_work() > 0) {
       // An organ still being built in the background is not waited for.

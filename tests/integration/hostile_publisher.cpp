@@ -1,5 +1,6 @@
 // Writes hostile payloads on the command and session topics: garbage, truncated commands,
-// another schema, NaN positions, and commands for an instrument the sender does not own.
+// another schema, NaN positions, commands for an instrument the sender does not own, and commands
+// and releases for an instrument the scene does not have.
 // Usage: hostile_publisher DOMAIN SECONDS
 #include <chrono>
 #include <cmath>
@@ -41,7 +42,11 @@ int main(int argc, char** argv) {
     commands.write(903, encode(wrong));
     commands.write(904, good);  // valid, but for an instrument owned by someone else
     sessions.write(905, garbage);
-    sent += 6;
+    Command unknown = c;
+    unknown.instrument_id = 99;  // not in the scene
+    unknown.tip_position = {0, 0, 0};
+    commands.write(906, encode(unknown));
+    sent += 7;
     std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
   std::printf("hostile_publisher: sent %ld hostile payloads\n", sent);

@@ -107,6 +107,10 @@ check "server logged the release" "grep -q 'instrument 1 released' '$tmp/server.
 check "server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
 rejected=$(sed -n 's/.* \([0-9]*\) messages rejected.*/\1/p' "$tmp/server.log" | tail -1)
 check "server rejected and counted hostile payloads ($rejected)" "[ -n '$rejected' ] && [ '$rejected' -gt 1000 ]"
+# Counted by reason: the hostile publisher sends all three kinds (4 malformed, 1 not owned, 1 unknown instrument per round).
+reasons=$(grep 'stopped after' "$tmp/server.log" | grep -o 'malformed [0-9]*, not owner [0-9]*, unknown instrument [0-9]*')
+echo "[ figure ] rejected by reason: $reasons"
+check "rejections counted by reason ($reasons)" "python3 -c \"import re,sys; m,o,u=map(int,re.findall(r'\\d+','$reasons')); sys.exit(not (m > 3*o > 0 and u > 0 and m + o + u == $rejected))\""
 python3 - "$tmp/a.json" "$tmp/b.json" "$(python3 -c "print($claimed_at - $killed_at)")" <<'PY' || failures=$((failures+1))
 import json, sys
 for path in sys.argv[1:3]:

@@ -63,7 +63,7 @@ TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
   EXPECT_EQ(cmd->tip_position[2], 0.05);
 }
 
-TEST(SchemaEvolution, OldClientReadsTheSceneStateOfSchema3) {
+TEST(SchemaEvolution, OldClientReadsTheSceneStateOfSchema6) {
   Scene sc;
   sc.name = "liver";
   sc.physics_rate_hz = 1000;
@@ -73,7 +73,12 @@ TEST(SchemaEvolution, OldClientReadsTheSceneStateOfSchema3) {
   sc.material = {"liver", 5000, 0.45, 1060, 4.8, 2};
   sc.available_scenes = {"liver", "liver-12k"};
   sc.recent_requests.push_back({900, 17, Action::load_scene, true, "loaded scene liver"});
+  sc.unreadable_scenes = {"broken: broken.json:4: JSON: number overflow parsing '1e999'"};  // schema 6
   const auto bytes = encode(sc);
+  std::string why;
+  const auto now = decode_scene(bytes, &why);
+  ASSERT_TRUE(now) << why;
+  EXPECT_EQ(now->unreadable_scenes, sc.unreadable_scenes);
   flatbuffers::Verifier verifier(bytes.data(), bytes.size());
   ASSERT_TRUE(v1::VerifySceneStateBuffer(verifier));
   const auto* old = v1::GetSceneState(bytes.data());
@@ -97,23 +102,31 @@ TEST(SchemaEvolution, SchemaOneSessionRequestsStillDecode) {
   EXPECT_TRUE(r->material.empty());
 }
 
-TEST(SchemaEvolution, TelemetryOfSchema5AndOfEarlierServersReadBothWays) {
-  // Schema 5 adds Telemetry.missed_slots; a console of schema 1 reads the rest of today's report...
-  const auto bytes = encode(TelemetryReport{7, 30'000, 12, 1, 1000.0, 600, 900, 1400, 25, 3});
+TEST(SchemaEvolution, TelemetryOfSchema6AndOfEarlierServersReadBothWays) {
+  // Schema 5 adds Telemetry.missed_slots, schema 6 the rejections by reason; a console of schema 1
+  // reads the rest of today's report...
+  const auto bytes = encode(TelemetryReport{7, 30'000, 12, 6, 1000.0, 600, 900, 1400, 25, 3, 3, 2, 1});
   flatbuffers::Verifier verifier(bytes.data(), bytes.size());
   ASSERT_TRUE(v1::VerifyTelemetryBuffer(verifier));
   const auto* old = v1::GetTelemetry(bytes.data());
   EXPECT_EQ(old->steps(), 30'000u);
   EXPECT_EQ(old->overruns(), 12u);
-  EXPECT_EQ(old->rejected_messages(), 1u);
+  EXPECT_EQ(old->rejected_messages(), 6u);
   EXPECT_EQ(old->physics_rate_hz(), 1000.0);
+  std::string why;
+  const auto now = decode_telemetry(bytes, &why);
+  ASSERT_TRUE(now) << why;
+  EXPECT_EQ(now->rejected_malformed, 3u);
+  EXPECT_EQ(now->rejected_not_owner, 2u);
+  EXPECT_EQ(now->rejected_unknown_instrument, 1u);
   // ...and today's decoder reads a report of an earlier server with no slots missed.
   flatbuffers::FlatBufferBuilder b;
   b.Finish(v1::CreateTelemetry(b, 7, 29'990, 998.0, 600, 900, 1400, 25, 12, 1));
-  std::string why;
   const auto t = decode_telemetry({b.GetBufferPointer(), b.GetSize()}, &why);
   ASSERT_TRUE(t) << why;
   EXPECT_EQ(t->late_ticks, 12u);
   EXPECT_EQ(t->missed_slots, 0u);  // absent: the schema's default
+  EXPECT_EQ(t->rejected_malformed + t->rejected_not_owner + t->rejected_unknown_instrument, 0u);
+  EXPECT_EQ(t->rejected_messages, 1u);
   EXPECT_EQ(t->physics_rate_hz, 998.0);
 }

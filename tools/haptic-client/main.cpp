@@ -200,14 +200,14 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
       std::printf("t = %5.2f s  the server is gone (no DDS liveliness); the force fades to zero over %.2f s\n", t, o.fade.fade_s);
       std::fflush(stdout);
     }
+    if (run.lost) break;  // the period after the force reached zero: it was rendered, and recorded
     if (run.server_lost_t_s >= 0 && run.faded_t_s < 0 && renderer.gain(t) == 0) {
       run.faded_t_s = t;
-      if (!o.reconnect) {
-        run.lost = true;
-        break;
+      run.lost = !o.reconnect;  // this period still renders (zero), then the loop ends
+      if (o.reconnect) {
+        std::printf("t = %5.2f s  waiting for a server to come back (--reconnect)\n", t);
+        std::fflush(stdout);
       }
-      std::printf("t = %5.2f s  waiting for a server to come back (--reconnect)\n", t);
-      std::fflush(stdout);
     }
     if (run.faded_t_s >= 0 && server == viscera::client::ServerState::alive) {  // --reconnect: a server is back
       const auto again = client.claim(o.instrument, std::chrono::seconds(5));

@@ -45,7 +45,8 @@ class Client {
 
   /// Waits for the server's scene state (published reliably, transient local).
   std::optional<protocol::Scene> wait_for_scene(std::chrono::milliseconds timeout);
-  /// The newest scene state received, without waiting.
+  /// The newest scene state received, without waiting (none once the server was lost, until a
+  /// server publishes one again).
   std::optional<protocol::Scene> scene();
   /// Claims an instrument: claimed once the scene state shows this client as its owner; refused at
   /// once with the server's reason if the scene has no such instrument or another client owns it.

@@ -1,0 +1,118 @@
+// What a tick may cost, against the explicit step's closed form: the stable step of a linear
+// material scales as sqrt(density / E), a tick of 1/rate takes ceil(1 / (rate dt)) sub-steps, and a
+// scene or material whose tick needs more than the budget allows is refused before it runs, with
+// the step, the sub-steps and the limit in the message.
+#include "tick_budget.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+
+#include "common/input_error.hpp"
+#include "organ.hpp"
+#include "scene_file.hpp"
+
+namespace viscera::runtime {
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const tissue::InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+SceneSpec liver() {
+  SceneSpec s = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  return s;
+}
+
+TEST(TickBudget, SubStepsPerTickAreTheCeilingOfTickOverStep) {
+  EXPECT_EQ(substeps_per_tick(4e-4, 1000), 3);
+  EXPECT_EQ(substeps_per_tick(5e-4, 1000), 2);   // exactly two: not three from rounding
+  EXPECT_EQ(substeps_per_tick(1e-3, 1000), 1);
+  EXPECT_EQ(substeps_per_tick(2.8e-12, 1000), 357142858);
+}
+
+TEST(TickBudget, AStepThatCannotRunOrNeedsTooManySubStepsIsRefused) {
+  const TickBudget budget{1.0 / 30, 10000};
+  EXPECT_EQ(error_of([&] { check_tick_budget(std::nan(""), 0, 1000, budget, "s.json", "organ.material"); }),
+            "s.json: organ.material: gives an explicit step of nan s, which cannot be run (not a positive number)");
+  EXPECT_NE(error_of([&] { check_tick_budget(0.0, 0, 1000, budget, "s", "f"); }).find("cannot be run"), std::string::npos);
+  // 1e-3 / 1e-7 = 10,000 sub-steps: just allowed; one more is not.
+  EXPECT_EQ(error_of([&] { check_tick_budget(1e-7, 0, 1000, budget, "s", "f"); }), "no error");
+  EXPECT_EQ(error_of([&] { check_tick_budget(0.99e-7, 0, 1000, budget, "s", "f"); }),
+            "s: f: the stable explicit step is 9.9e-08 s, so a 1 ms tick needs 10102 sub-steps, more than the 10000 any tick may take");
+  // Timed: 100 us per sub-step, 33.3 ms per tick: 333 sub-steps fit, 334 do not.
+  EXPECT_EQ(error_of([&] { check_tick_budget(1e-3 / 333, 1e-4, 1000, budget, "s", "f"); }), "no error");
+  EXPECT_EQ(error_of([&] { check_tick_budget(1e-3 / 334, 1e-4, 1000, budget, "s", "f"); }),
+            "s: f: the stable explicit step is 2.99401e-06 s, so a 1 ms tick needs 334 sub-steps of 100 us each (measured here) = 33.4 ms per tick; "
+            "a tick may take at most 33.3333 ms, which is 333 sub-steps on this machine (viscera-server --max-tick-ms)");
+}
+
+TEST(TickBudget, TheLiverStepScalesAsOneOverTheRootOfItsModulusAndAStiffLiverIsRefusedAtOnce) {
+  SceneSpec spec = liver();
+  const TickBudget generous{1e9, 1'000'000'000};
+  const auto soft = build_organ(spec, generous);
+  // The same material 100 times stiffer, through a material file (the way a user makes one).
+  const std::string stiff = std::string(VISCERA_TEST_TMP) + "/stiff-liver.json";
+  std::filesystem::create_directories(VISCERA_TEST_TMP);
+  std::ofstream(stiff) << R"({"density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 500000, "poisson_ratio": 0.45},
+    "viscoelasticity": {"model": "constant_q", "shear_q": 4.8, "bulk_q": null, "band_hz": [0.01, 10], "mechanisms": 3, "reference_frequency_hz": 2}})";
+  spec.material = stiff;
+  const auto hard = build_organ(spec, generous);
+  EXPECT_NEAR(soft->integrator->dt_s() / hard->integrator->dt_s(), 10.0, 1e-6);
+  // Young's modulus 1e12 Pa (the material files' ceiling): refused before anything is timed, at once.
+  std::ofstream(stiff) << R"({"density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 1e12, "poisson_ratio": 0.45}})";
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string why = error_of([&] { build_organ(spec); });
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  EXPECT_NE(why.find("liver.json: organ.material: the stable explicit step is "), std::string::npos) << why;
+  EXPECT_NE(why.find("more than the 10000 any tick may take"), std::string::npos) << why;
+  // The budget's boundary, from the closed form: exactly the sub-steps the soft liver needs pass.
+  const long needed = substeps_per_tick(soft->integrator->dt_s(), spec.physics_rate_hz);
+  spec.material = liver().material;
+  EXPECT_NO_THROW(build_organ(spec, {1e9, needed}));
+  EXPECT_THROW(build_organ(spec, {1e9, needed - 1}), tissue::InputError);
+  // A measured sub-step is a positive time of the order of a force evaluation.
+  EXPECT_GT(soft->substep_cost_s, 0);
+  EXPECT_LT(soft->substep_cost_s, 0.1);
+}
+
+TEST(SceneFile, BadNumbersAndBadSiblingsNeverEscapeAsLibraryErrors) {
+  const std::string dir = std::string(VISCERA_TEST_TMP) + "/scenes";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ifstream good(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  std::string text((std::istreambuf_iterator<char>(good)), std::istreambuf_iterator<char>());
+  std::ofstream(dir + "/liver.json") << text;
+  std::string over = text;
+  over.replace(over.find("\"physics_rate_hz\": 1000"), 23, "\"physics_rate_hz\": 1e999");
+  std::ofstream(dir + "/overflow.json") << over;
+  std::string fraction = text;
+  fraction.replace(fraction.find("\"physics_rate_hz\": 1000"), 23, "\"physics_rate_hz\": 333.3");
+  std::ofstream(dir + "/fraction.json") << fraction;
+  std::ofstream(dir + "/binary.json") << std::string("\x89PNG\r\n\x1a\n\0\0", 10);
+  std::filesystem::create_directories(dir + "/folder.json");
+  EXPECT_EQ(error_of([&] { read_scene_file(dir + "/overflow.json"); }), dir + "/overflow.json:4: JSON: number overflow parsing '1e999'");
+  EXPECT_EQ(error_of([&] { read_scene_file(dir + "/fraction.json"); }), dir + "/fraction.json: physics_rate_hz: 333.3 is not a whole number");
+  const SceneListing listing = list_scenes(dir);
+  EXPECT_EQ(listing.loadable, std::vector<std::string>{"liver"});
+  ASSERT_EQ(listing.unreadable.size(), 4u);
+  EXPECT_EQ(listing.unreadable[0].first, "binary");
+  EXPECT_NE(listing.unreadable[0].second.find("binary.json:1: JSON: parse error"), std::string::npos) << listing.unreadable[0].second;
+  EXPECT_EQ(listing.unreadable[0].second.find('\x89'), std::string::npos);  // no raw bytes
+  EXPECT_EQ(listing.unreadable[1].first, "folder");
+  EXPECT_EQ(listing.unreadable[2].first, "fraction");
+  EXPECT_EQ(listing.unreadable[3].first, "overflow");
+}
+
+}  // namespace
+}  // namespace viscera::runtime
