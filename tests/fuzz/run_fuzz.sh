@@ -1,18 +1,33 @@
 #!/usr/bin/env bash
-# Builds the decoder fuzz target with clang (libFuzzer + ASan + UBSan) and runs it briefly.
-# Usage: run_fuzz.sh BUILD_DIR SOURCE_DIR SECONDS
+# Builds the fuzz targets with clang (libFuzzer + ASan + UBSan; tests/fuzz/CMakeLists.txt) and runs
+# each briefly from a seed corpus: the decoders from one valid payload of every message, the
+# readers from the shipped scenes, materials, meshes, data set and a fitted model.
+# Usage: run_fuzz.sh BUILD_DIR SOURCE_DIR SECONDS   (SECONDS per target)
 set -euo pipefail
 build="$1"; src="$2"; seconds="$3"
-out="$build/fuzz"; mkdir -p "$out/corpus"
-includes=(-I "$src/protocol/include" -I "$build/protocol/generated")
-clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined "${includes[@]}" \
-  "$src/tests/fuzz/decoders_fuzz.cpp" "$src/protocol/src/verify.cpp" -o "$out/decoders_fuzz"
-# Seeds: one valid payload of every message, checked to decode (the fuzzer mutates from them).
-clang++ -std=c++20 -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=undefined "${includes[@]}" \
-  "$src/tests/fuzz/seed_corpus.cpp" "$src/protocol/src/verify.cpp" -o "$out/seed_corpus"
-rm -rf "$out/seeds"
-"$out/seed_corpus" "$out/seeds"
+out="$build/fuzz"
+cmake -S "$src/tests/fuzz" -B "$out" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None \
+  -DVISCERA_SOURCE="$src" -DVISCERA_BUILD="$build" > /dev/null
+cmake --build "$out" -j "$(nproc)"
 
-# New inputs go to the first directory; the seeds are read only.
-"$out/decoders_fuzz" -max_total_time="$seconds" -print_final_stats=1 "$out/corpus" "$out/seeds" 2>&1 | tail -15
-echo "decoders_fuzz: 1 passed, 0 failed"
+# Decoders: each seed must decode as its own type (seed_corpus checks), then the fuzzer mutates them.
+rm -rf "$out/seeds-decoders"; mkdir -p "$out/corpus-decoders"
+"$out/seed_corpus" "$out/seeds-decoders"
+"$out/decoders_fuzz" -max_total_time="$seconds" -print_final_stats=1 "$out/corpus-decoders" "$out/seeds-decoders" 2>&1 | tail -8
+
+# Readers: the first byte picks the reader (readers_fuzz.cpp), the rest is the shipped file.
+seeds="$out/seeds-readers"; rm -rf "$seeds"; mkdir -p "$seeds" "$out/corpus-readers"
+seed() {  # selector file
+  { printf "\\$(printf '%03o' "$1")"; head -c 200000 "$2"; } > "$seeds/$1-$(basename "$2")"
+}
+for f in "$src"/data/scenes/*.json; do seed 0 "$f"; seed 8 "$f"; done
+for f in "$src"/data/materials/*.json; do seed 1 "$f"; done
+seed 3 "$src/data/meshes/liver.msh"
+seed 4 "$src/data/meshes/heart_imstk-unity.vtk"
+seed 5 "$src/data/meshes/volumetricTongue0.vtu"
+seed 6 "$src/data/titin-passive-muscle/dataset.json"
+for f in "$src"/data/titin-passive-muscle/*.csv; do seed 7 "$f"; done
+printf '\002{"model": "m", "fitted_to": "d", "units": "SI", "mechanisms": ["broadband_relaxation", "strain_stiffening"], "modulus_pa": 1000, "viscosity_pa_s": 10, "relaxation_time_s": [0.1, 10], "relaxation_modulus_pa": [100, 50], "stiffening_b": 3}' > "$seeds/2-model.json"
+"$out/readers_fuzz" -max_total_time="$seconds" -max_len=262144 -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
+  "$out/corpus-readers" "$seeds" 2>&1 | tail -8
+echo "fuzz: decoders_fuzz and readers_fuzz: 2 passed, 0 failed"

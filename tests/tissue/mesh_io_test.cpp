@@ -155,3 +155,13 @@ TEST(MeshIo, MalformedFilesGiveOneClearErrorNamingFileAndField) {
   std::filesystem::create_directories(test::tmp_path("folder.vtu"));
   EXPECT_NE(expect_error(test::tmp_path("folder.vtu")).find("folder.vtu: is a directory"), std::string::npos);
 }
+
+TEST(MeshIo, EveryKindOfWhitespaceSeparatesTokens) {
+  // A form feed or vertical tab between tokens (found by the readers' fuzzer: before, one part of
+  // the tokenizer skipped it and the other did not, and skipping an unknown section never ended).
+  std::string text = gmsh_v2();
+  text.replace(text.find("$PhysicalNames"), 0, "$Comments\n\f\vnote\f$EndComments\n");
+  text.replace(text.find("1 0 0"), 1, "1\f");
+  const TetMesh m = read_tet_mesh(test::write_file("whitespace.msh", text));
+  EXPECT_EQ(m.tet_count(), 2u);
+}

@@ -9,6 +9,12 @@
 
 namespace viscera::tissue {
 
+namespace {
+// One definition of whitespace for skipping and for ending a token: with two (a form feed was
+// "space" to one and not to the other) a token could be empty and a scan never advance.
+bool is_space(char c) { return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+}  // namespace
+
 TextCursor::TextCursor(std::string source, std::string text)
     : source_(std::move(source)), text_(std::move(text)) {}
 
@@ -29,11 +35,8 @@ long TextCursor::next_line() {
 void TextCursor::skip_space() {
   while (pos_ < text_.size()) {
     const char c = text_[pos_];
-    if (c == '\n') {
-      ++line_;
-    } else if (c != ' ' && c != '\t' && c != '\r') {
-      break;
-    }
+    if (c == '\n') ++line_;
+    else if (!is_space(c)) break;
     ++pos_;
   }
 }
@@ -51,7 +54,7 @@ std::string_view TextCursor::token(std::string_view field) {
   skip_space();
   if (pos_ >= text_.size()) fail(field, "unexpected end of file (truncated?)");
   const std::size_t start = pos_;
-  while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+  while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
   return std::string_view(text_).substr(start, pos_ - start);
 }
 

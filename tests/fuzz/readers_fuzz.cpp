@@ -1,0 +1,85 @@
+// libFuzzer target for every reader of a file a user edits or hands over: scene, material,
+// data set (its dataset.json and its CSV), fitted model, and the Gmsh, legacy VTK and VTU mesh
+// readers. Whatever the bytes, a reader returns or throws InputError (one line naming the file);
+// any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan +
+// UBSan by tests/fuzz/run_fuzz.sh).
+//
+// The first byte picks the reader; the rest is the file. Files are written to a folder of this
+// process on tmpfs, since the readers take paths (as users give them).
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "common/input_error.hpp"
+#include "common/json_input.hpp"
+#include "dataset.hpp"
+#include "material/material_file.hpp"
+#include "mesh/mesh_reader.hpp"
+#include "model_file.hpp"
+#include "scene_file.hpp"
+
+namespace {
+
+const std::filesystem::path& folder() {
+  static const std::filesystem::path dir = [] {
+    const auto base = std::filesystem::exists("/dev/shm") ? std::filesystem::path("/dev/shm") : std::filesystem::temp_directory_path();
+    auto d = base / ("viscera-readers-fuzz-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::string write(const std::string& name, const std::uint8_t* data, std::size_t size) {
+  const auto path = folder() / name;
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  return path.string();
+}
+
+void write_text(const std::string& name, const std::string& text) { std::ofstream(folder() / name, std::ios::trunc) << text; }
+
+// A well-formed data set around the fuzzed file, so the fuzzer reaches past the first checks.
+const char* kDatasetJson =
+    R"({"name": "f", "mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000},
+        "tests": [{"file": "a.csv", "control": "strain"}, {"file": "b.csv", "control": "stress"}]})";
+const char* kCsv = "time_s,strain,stress_pa\n0,0,0\n1,0.01,10\n2,0.02,21\n";
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  const std::uint8_t pick = data[0] % 9;
+  ++data;
+  --size;
+  using namespace viscera;
+  try {
+    switch (pick) {
+      case 0: (void)runtime::read_scene_file(write("scene.json", data, size)); break;
+      case 1: (void)tissue::read_material_file(write("material.json", data, size)); break;
+      case 2: (void)lab::read_model(write("model.json", data, size)); break;
+      case 3: (void)tissue::read_gmsh(write("mesh.msh", data, size)); break;
+      case 4: (void)tissue::read_legacy_vtk(write("mesh.vtk", data, size)); break;
+      case 5: (void)tissue::read_vtu(write("mesh.vtu", data, size)); break;
+      case 6:
+        write("dataset.json", data, size);
+        write_text("a.csv", kCsv);
+        write_text("b.csv", kCsv);
+        (void)lab::read_dataset(folder().string());
+        break;
+      case 7:
+        write_text("dataset.json", kDatasetJson);
+        write("a.csv", data, size);
+        write_text("b.csv", kCsv);
+        (void)lab::read_dataset(folder().string());
+        break;
+      case 8: (void)tissue::parse_json(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"); break;
+    }
+  } catch (const tissue::InputError&) {
+    // the one error a reader may give
+  }
+  return 0;
+}
