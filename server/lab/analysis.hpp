@@ -45,6 +45,8 @@ struct SpecimenCheck {
 
 struct AnalyzeOptions {
   bool specimen = true;  ///< also simulate baseline and final on the tetrahedral specimen
+  /// Tests with more rows are decimated for the fit (decimation.hpp); the report says so.
+  std::size_t max_fit_points = 2000;
 };
 
 struct Analysis {
@@ -55,6 +57,7 @@ struct Analysis {
   std::vector<Mechanism> causes;  ///< accepted, strongest first
   double gain = 1.0;              ///< baseline held-out RMS / final held-out RMS
   std::string verdict;            ///< one paragraph: what is wrong, why, what still does not fit
+  std::vector<std::string> decimated;  ///< "file: N rows, fitted on M" for the tests decimated for the fit
   std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen
 };
 
@@ -64,7 +67,8 @@ double noise_level_pa(const TestData& t);
 /// Fits `structure` to all tests and, for every test, to the others (held-out prediction).
 ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d);
 
-/// The whole analysis; `progress` receives one line per stage.
+/// The whole analysis; `progress` receives one line per stage, with an estimate of the time the
+/// rest will take once the baseline's fits have been timed.
 Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {},
                  const AnalyzeOptions& options = {});
 

@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <chrono>
+#include <cstdio>
 #include <fstream>
+#include <iostream>
 
 #include "analysis.hpp"
 #include "common/input_error.hpp"
@@ -89,4 +92,50 @@ TEST(Dataset, TitinAnalysisNamesBroadbandRelaxationAndStrainStiffening) {
   EXPECT_EQ(a.causes[1], Mechanism::strain_stiffening);
   EXPECT_GT(a.gain, 2.0);
   std::cout << "[ figure ] titin: held-out RMS " << a.baseline.heldout_rms_pa << " -> " << a.final.heldout_rms_pa << " Pa (gain " << a.gain << ")\n";
+}
+
+// A logger's file: one titin test at 1.3 million rows (about 43 MB) instead of 100, the same
+// curve (interpolated) with its noise. The analysis decimates it for the fits, says so, finishes
+// well within the lab's two minutes, and names the causes it names on the original data.
+TEST(Dataset, AMillionRowTestIsDecimatedForTheFitAndGivesTheSameVerdict) {
+  const std::string dir = std::string(VISCERA_TEST_TMP) + "/large";
+  std::filesystem::create_directories(dir);
+  const std::string src = std::string(VISCERA_DATA_DIR) + "/titin-passive-muscle";
+  for (const char* f : {"dataset.json", "ramp_0.1s.csv", "ramp_1s.csv", "ramp_100s.csv"})
+    std::filesystem::copy_file(src + "/" + f, dir + "/" + f, std::filesystem::copy_options::overwrite_existing);
+  const Dataset original = read_dataset(src);
+  const TestData& t = original.tests[2];  // ramp_10s.csv
+  ASSERT_EQ(t.file, "ramp_10s.csv");
+  {
+    std::ofstream out(dir + "/ramp_10s.csv");
+    out << "time_s,strain,stress_pa,stress_sd_pa\n";
+    std::size_t j = 0;
+    const std::size_t n = 1'300'000;
+    char line[128];
+    for (std::size_t k = 0; k < n; ++k) {
+      const double time = t.time_s.front() + (t.time_s.back() - t.time_s.front()) * static_cast<double>(k) / static_cast<double>(n - 1);
+      while (j + 2 < t.time_s.size() && t.time_s[j + 1] < time) ++j;
+      const double a = (time - t.time_s[j]) / (t.time_s[j + 1] - t.time_s[j]);
+      const auto at = [&](const std::vector<double>& v) { return v[j] + a * (v[j + 1] - v[j]); };
+      std::snprintf(line, sizeof line, "%.7f,%.8f,%.4f,%.4f\n", time, at(t.strain), at(t.stress_pa), at(t.stress_sd_pa));
+      out << line;
+    }
+  }
+  EXPECT_GT(std::filesystem::file_size(dir + "/ramp_10s.csv"), 40'000'000u);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Dataset large = read_dataset(dir);
+  std::vector<std::string> lines;
+  const Analysis a = analyze(large, [&](const std::string& s) { lines.push_back(s); });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(seconds, 120.0);
+  ASSERT_EQ(a.decimated.size(), 1u);
+  EXPECT_NE(a.decimated[0].find("ramp_10s.csv: 1300000 rows, fitted on 2000"), std::string::npos) << a.decimated[0];
+  ASSERT_EQ(a.causes.size(), 2u);
+  EXPECT_EQ(a.causes[0], Mechanism::broadband_relaxation);
+  EXPECT_EQ(a.causes[1], Mechanism::strain_stiffening);
+  bool told_time = false;
+  for (const auto& l : lines) told_time |= l.find("s left") != std::string::npos;
+  EXPECT_TRUE(told_time) << "the progress lines give the time left";
+  std::cout << "[ figure ] a 1.3-million-row test (" << static_cast<double>(std::filesystem::file_size(dir + "/ramp_10s.csv")) / 1e6 << " MB): read and analysed in " << seconds
+            << " s, gain " << a.gain << "\n";
 }

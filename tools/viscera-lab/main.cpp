@@ -7,6 +7,7 @@
 #include <string>
 
 #include "analysis.hpp"
+#include "decimation.hpp"
 #include "common/input_error.hpp"
 #include "model_file.hpp"
 #include "report.hpp"
@@ -67,7 +68,7 @@ int main(int argc, char** argv) {
         }
       });
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      write_report(a, d, out, seconds);
+      write_report(a, decimate(d, AnalyzeOptions{}.max_fit_points), out, seconds);  // plots of what was fitted
       std::printf("%s\n", a.verdict.c_str());
       std::printf("causes:");
       for (Mechanism m : a.causes) std::printf(" %s", name(m));

@@ -57,6 +57,7 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
     j["specimen"].push_back(jc);
   }
   j["seconds"] = seconds;
+  j["decimated"] = a.decimated;
   std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
   write_model((fs::path(out_dir) / "model.json").string(), a.final.model, a.dataset);
 
@@ -64,6 +65,7 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
   md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences): " << a.noise_pa << " Pa. "
      << "Analysis time: " << seconds << " s.\n\n";
+  for (const auto& line : a.decimated) md << "Decimated for the fit and the plots: " << line << ".\n\n";
   md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out |\n|---|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < a.baseline.tests.size(); ++k)
     md << "| " << a.baseline.tests[k].file << " | " << a.baseline.tests[k].noise_pa << " | " << a.baseline.tests[k].fit_rms_pa << " | "
