@@ -85,11 +85,11 @@ protocol::MaterialInfo Organ::material_info() const {
   return m;
 }
 
-std::string Organ::describe_step() const {
+std::string Organ::describe_step(double rate_hz) const {
   char b[200];
-  std::snprintf(b, sizeof b, "explicit step %.3g s, forces on %d thread%s", integrator->dt_s(), scene.physics_threads,
+  std::snprintf(b, sizeof b, "explicit step %.3g s, forces on %d thread%s, ", integrator->dt_s(), scene.physics_threads,
                 scene.physics_threads > 1 ? "s" : "");
-  std::string out = b;
+  std::string out = b + tick_cost(integrator->dt_s(), substep_cost_s, rate_hz);
   const MassScaling& mass_scaling = integrator->mass_scaling();
   if (mass_scaling.scaled_elements > 0) {
     std::snprintf(b, sizeof b, " (mass scaling: +%.2f%% mass on %zu of %zu elements, each element's step >= %.3g s)",

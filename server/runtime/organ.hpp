@@ -31,8 +31,9 @@ struct Organ {
 
   /// The material as the scene state shows it.
   protocol::MaterialInfo material_info() const;
-  /// One line: the explicit step and, if any, the mass scaling that lengthened it.
-  std::string describe_step() const;
+  /// One line: the explicit step, what a tick at `rate_hz` costs, and, if any, the mass scaling that
+  /// lengthened the step.
+  std::string describe_step(double rate_hz) const;
 };
 
 /// Reads the scene's mesh and material and builds the organ. Throws InputError naming the file

@@ -345,9 +345,9 @@ struct SimulationServer::Impl {
         return refuse(e.what());
       }
       char text[160];
-      std::snprintf(text, sizeof text, "physics rate %.0f Hz (was %.0f Hz)", req.physics_rate_hz, scene.physics_rate_hz);
+      std::snprintf(text, sizeof text, "physics rate %.0f Hz (was %.0f Hz): ", req.physics_rate_hz, scene.physics_rate_hz);
       scene.physics_rate_hz = req.physics_rate_hz;
-      conclude(req, true, text, status);
+      conclude(req, true, text + tick_cost(organ->integrator->dt_s(), organ->substep_cost_s, scene.physics_rate_hz), status);
       return;
     }
     if (preparing) return refuse("busy: still preparing " + preparing->what);
@@ -406,7 +406,7 @@ struct SimulationServer::Impl {
       return;
     }
     if (new_scene) scenes = list_scenes(scene_dir);
-    conclude(done.request, true, (new_scene ? "loaded " : "changed to ") + done.what + " (" + organ->describe_step() + ")", status);
+    conclude(done.request, true, (new_scene ? "loaded " : "changed to ") + done.what + " (" + organ->describe_step(scene.physics_rate_hz) + ")", status);
   }
 
   /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
@@ -644,7 +644,7 @@ std::string SimulationServer::describe() const {
   std::snprintf(b, sizeof b, "scene %s: %zu nodes, %zu tets, model %s, %zu instruments, %.0f Hz, DDS domain %u, ",
                 impl_->scene.name.c_str(), impl_->organ->mesh->node_count(), impl_->organ->mesh->tet_count(),
                 std::string(impl_->organ->model->name()).c_str(), impl_->instruments.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
-  return b + impl_->organ->describe_step();
+  return b + impl_->organ->describe_step(impl_->scene.physics_rate_hz);
 }
 
 ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration_s, const std::function<void(const std::string&)>& status) {

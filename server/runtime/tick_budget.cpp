@@ -1,6 +1,7 @@
 #include "tick_budget.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "common/input_error.hpp"
 
@@ -13,6 +14,25 @@ long substeps_per_tick(double dt_s, double rate_hz) {
   // As ExplicitIntegrator::advance divides a tick: equal sub-steps no longer than dt.
   const double n = std::ceil(1.0 / (rate_hz * dt_s) * (1 - 1e-12));
   return n >= 1e15 ? static_cast<long>(1e15) : static_cast<long>(n);
+}
+
+namespace {
+/// Three significant digits, whole numbers from 1000 up (a figure measured on a shared machine).
+std::string figure(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, v >= 1000 ? "%.0f" : "%.3g", v);
+  return b;
+}
+}  // namespace
+
+std::string tick_cost(double dt_s, double substep_cost_s, double rate_hz) {
+  const long n = substeps_per_tick(dt_s, rate_hz);
+  const double tick_s = static_cast<double>(n) * substep_cost_s;
+  std::string s = std::to_string(n) + " sub-step" + (n == 1 ? "" : "s") + " of " + figure(1e6 * substep_cost_s) + " us = " + figure(1e3 * tick_s) +
+                  " ms per " + figure(1e3 / rate_hz) + " ms tick";
+  if (tick_s > 1.0 / rate_hz)
+    s += ", slower than real time: about " + figure(std::floor(1.0 / tick_s)) + " ticks/s (" + figure(100.0 / (tick_s * rate_hz)) + "% of real time)";
+  return s;
 }
 
 void check_tick_budget(double dt_s, double substep_cost_s, double rate_hz, const TickBudget& budget, const std::string& source,

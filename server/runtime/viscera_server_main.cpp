@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   cl.flag("scene", "FILE", "scene file (required)");
   cl.flag("scene-dir", "DIR", "scenes that clients may load by name (default: the scene file's directory)");
   cl.flag("duration", "S", "stop after S seconds; 0 runs until signalled", "0");
-  cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "33.3");
+  cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "100");
   cl.option_switch("quiet", "no status lines");
   std::string scene, scene_dir;
   double duration = 0;

@@ -57,6 +57,11 @@ TEST(TickBudget, AStepThatCannotRunOrNeedsTooManySubStepsIsRefused) {
             "a tick may take at most 33.3333 ms, which is 333 sub-steps on this machine (viscera-server --max-tick-ms)");
 }
 
+TEST(TickBudget, ATickLongerThanItsSlotIsNamedSlowerThanRealTime) {
+  EXPECT_EQ(tick_cost(4e-4, 1e-4, 1000), "3 sub-steps of 100 us = 0.3 ms per 1 ms tick");
+  EXPECT_EQ(tick_cost(2.5e-4, 1e-2, 1000), "4 sub-steps of 10000 us = 40 ms per 1 ms tick, slower than real time: about 25 ticks/s (2.5% of real time)");
+}
+
 TEST(TickBudget, TheLiverStepScalesAsOneOverTheRootOfItsModulusAndAStiffLiverIsRefusedAtOnce) {
   SceneSpec spec = liver();
   const TickBudget generous{1e9, 1'000'000'000};
