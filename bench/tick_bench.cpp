@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <string>
 
-#include "organ.hpp"
-#include "scene_file.hpp"
+#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/scene_file.hpp"
 
 namespace {
 

@@ -7,12 +7,12 @@
 #include <memory>
 #include <numeric>
 
-#include "integrator/explicit_integrator.hpp"
-#include "material/elasticity.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/refinement.hpp"
-#include "model/model_factory.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/refinement.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 using namespace viscera::tissue;
 

@@ -1,4 +1,4 @@
-#include "analysis.hpp"
+#include "viscera/lab/analysis.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,10 +7,11 @@
 #include <future>
 #include <sstream>
 
-#include "common/input_error.hpp"
-#include "decimation.hpp"
-#include "fit.hpp"
-#include "specimen_simulation.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/lab/decimation.hpp"
+#include "viscera/lab/fit.hpp"
+#include "viscera/lab/specimen_simulation.hpp"
 
 namespace viscera::lab {
 
@@ -95,7 +96,7 @@ double noise_level_pa(const TestData& t) {
 
 ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d) {
   if (d.tests.size() < 2)
-    throw tissue::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
+    throw common::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
   ModelEvaluation ev;
   std::vector<const TestData*> all;
   for (const auto& t : d.tests) all.push_back(&t);

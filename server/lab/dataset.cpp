@@ -1,4 +1,4 @@
-#include "dataset.hpp"
+#include "viscera/lab/dataset.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -10,13 +10,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 
 namespace viscera::lab {
 
-using tissue::InputError;
-using tissue::JsonObject;
+using common::InputError;
+using common::JsonObject;
+
+using common::InputError;
+using common::JsonObject;
 using nlohmann::json;
 
 const char* to_string(Mode m) { return m == Mode::uniaxial ? "uniaxial" : "simple_shear"; }
@@ -46,7 +49,7 @@ std::vector<std::string_view> split(std::string_view line) {
 }
 
 TestData read_csv(const std::string& path, const std::string& file, Control control) {
-  const std::string content = tissue::read_text_file(path, kMaxCsvBytes);
+  const std::string content = common::read_text_file(path, kMaxCsvBytes);
   std::string_view text(content);
   if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // a UTF-8 byte-order mark (spreadsheet exports)
   const auto next_line = [&]() -> std::optional<std::string_view> {
@@ -67,7 +70,7 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
     else if (header[c] == "stress_sd_pa") col_sd = static_cast<int>(c);
   }
   for (const auto& [col, name] : {std::pair{col_t, "time_s"}, std::pair{col_e, "strain"}, std::pair{col_s, "stress_pa"}})
-    if (col < 0) throw InputError(path, 1, name, "column missing (the first line, '" + tissue::printable(*first, 60) + "', must name the columns time_s,strain,stress_pa[,stress_sd_pa])");
+    if (col < 0) throw InputError(path, 1, name, "column missing (the first line, '" + common::printable(*first, 60) + "', must name the columns time_s,strain,stress_pa[,stress_sd_pa])");
   TestData t;
   t.file = file;
   t.control = control;
@@ -81,23 +84,23 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
       const std::string_view c = cells[static_cast<std::size_t>(col)];
       double v = 0;
       const auto [end, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
-      if (ec != std::errc() || end != c.data() + c.size()) throw InputError(path, row, name, "'" + tissue::printable(c) + "' is not a number");
-      if (!std::isfinite(v)) throw InputError(path, row, name, "'" + tissue::printable(c) + "' is not finite");
+      if (ec != std::errc() || end != c.data() + c.size()) throw InputError(path, row, name, "'" + common::printable(c) + "' is not a number");
+      if (!std::isfinite(v)) throw InputError(path, row, name, "'" + common::printable(c) + "' is not finite");
       return v;
     };
     const double time = value(col_t, "time_s"), strain = value(col_e, "strain"), stress = value(col_s, "stress_pa");
     if (!t.time_s.empty() && !(time > t.time_s.back()))
-      throw InputError(path, row, "time_s", tissue::short_number(time) + " s does not increase (previous row " + tissue::short_number(t.time_s.back()) + " s)");
+      throw InputError(path, row, "time_s", common::short_number(time) + " s does not increase (previous row " + common::short_number(t.time_s.back()) + " s)");
     if (std::abs(strain) > 5.0)
-      throw InputError(path, row, "strain", tissue::short_number(strain) + " cannot be right: strain is dimensionless (1 = 100%), not percent");
+      throw InputError(path, row, "strain", common::short_number(strain) + " cannot be right: strain is dimensionless (1 = 100%), not percent");
     if (std::abs(stress) > 1e9)
-      throw InputError(path, row, "stress_pa", tissue::short_number(stress) + " Pa cannot be right for soft tissue (stress in pascals?)");
+      throw InputError(path, row, "stress_pa", common::short_number(stress) + " Pa cannot be right for soft tissue (stress in pascals?)");
     t.time_s.push_back(time);
     t.strain.push_back(strain);
     t.stress_pa.push_back(stress);
     if (col_sd >= 0) {
       const double sd = value(col_sd, "stress_sd_pa");
-      if (sd < 0) throw InputError(path, row, "stress_sd_pa", tissue::short_number(sd) + " is negative");
+      if (sd < 0) throw InputError(path, row, "stress_sd_pa", common::short_number(sd) + " is negative");
       t.stress_sd_pa.push_back(sd);
     }
   }
@@ -110,12 +113,12 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
 std::string test_path(const std::string& folder, const std::string& file, const JsonObject& test) {
   namespace fs = std::filesystem;
   const fs::path name(file);
-  if (file.empty() || name.is_absolute()) test.fail("file", "'" + tissue::printable(file) + "' must be a file name relative to the data-set folder");
+  if (file.empty() || name.is_absolute()) test.fail("file", "'" + common::printable(file) + "' must be a file name relative to the data-set folder");
   const fs::path base = fs::weakly_canonical(fs::path(folder));
   const fs::path full = fs::weakly_canonical(base / name);
   const fs::path inside = full.lexically_relative(base);
   if (inside.empty() || *inside.begin() == "..")
-    test.fail("file", "'" + tissue::printable(file) + "' lies outside the data-set folder " + tissue::printable(folder, 200));
+    test.fail("file", "'" + common::printable(file) + "' lies outside the data-set folder " + common::printable(folder, 200));
   return full.string();
 }
 
@@ -142,15 +145,15 @@ void check_stress_units(const Dataset& d, const std::string& meta) {
     const double m = median(others), ratio = modulus[k] / m;
     if (m > 0 && modulus[k] > 0 && (ratio > kUnitRatio || ratio < 1 / kUnitRatio))
       throw InputError((std::filesystem::path(d.folder) / d.tests[k].file).string(), 0, "stress_pa",
-                       "apparent modulus " + tissue::short_number(modulus[k]) + " Pa is " + tissue::short_number(ratio) +
-                           " times the other tests' (" + tissue::short_number(m) + " Pa): is this test in another unit (kPa, MPa)?");
+                       "apparent modulus " + common::short_number(modulus[k]) + " Pa is " + common::short_number(ratio) +
+                           " times the other tests' (" + common::short_number(m) + " Pa): is this test in another unit (kPa, MPa)?");
   }
   const double m = median(modulus);
   if (m > 0 && m < kSoftestPa)
-    throw InputError(meta, 0, "tests", "apparent modulus " + tissue::short_number(m) + " Pa (peak stress / peak strain) is below any tissue (" +
-                                           tissue::short_number(kSoftestPa) + " Pa): are the stresses in kPa? The unit is Pa");
+    throw InputError(meta, 0, "tests", "apparent modulus " + common::short_number(m) + " Pa (peak stress / peak strain) is below any tissue (" +
+                                           common::short_number(kSoftestPa) + " Pa): are the stresses in kPa? The unit is Pa");
   if (m > kStiffestPa)
-    throw InputError(meta, 0, "tests", "apparent modulus " + tissue::short_number(m) + " Pa is above bone's (" + tissue::short_number(kStiffestPa) +
+    throw InputError(meta, 0, "tests", "apparent modulus " + common::short_number(m) + " Pa is above bone's (" + common::short_number(kStiffestPa) +
                                            " Pa): are the stresses or strains in another unit?");
 }
 
@@ -159,7 +162,7 @@ void check_stress_units(const Dataset& d, const std::string& meta) {
 Dataset read_dataset(const std::string& folder) {
   const std::string meta = (std::filesystem::path(folder) / "dataset.json").string();
   if (!std::filesystem::exists(meta)) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");
-  const json j = tissue::read_json_file(meta);
+  const json j = common::read_json_file(meta);
   const JsonObject top(j, meta);
   top.require_known({"name", "mode", "specimen", "tests", "max_test_duration_s"});
   Dataset d;
@@ -184,7 +187,7 @@ Dataset read_dataset(const std::string& folder) {
     const double span = added.time_s.back() - added.time_s.front();
     if (span > max_duration_s)
       throw InputError((std::filesystem::path(folder) / file).string(), 0, "time_s",
-                       "the test spans " + tissue::short_number(span) + " s, more than " + tissue::short_number(max_duration_s) +
+                       "the test spans " + common::short_number(span) + " s, more than " + common::short_number(max_duration_s) +
                            " s: is the time in another unit? (a longer test is declared with \"max_test_duration_s\" in dataset.json)");
   }
   check_stress_units(d, meta);

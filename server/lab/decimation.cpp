@@ -1,10 +1,10 @@
-#include "decimation.hpp"
+#include "viscera/lab/decimation.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "analysis.hpp"
+#include "viscera/lab/analysis.hpp"
 
 namespace viscera::lab {
 

@@ -1,4 +1,4 @@
-#include "fit.hpp"
+#include "viscera/lab/fit.hpp"
 
 #include <cmath>
 #include <limits>

@@ -1,9 +1,9 @@
-#include "material_model.hpp"
+#include "viscera/lab/material_model.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "viscoelastic/standard_linear_solids.hpp"
+#include "viscera/tissue/viscoelastic/standard_linear_solids.hpp"
 
 namespace viscera::lab {
 

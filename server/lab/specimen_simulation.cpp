@@ -1,15 +1,16 @@
-#include "specimen_simulation.hpp"
+#include "viscera/lab/specimen_simulation.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 
-#include "common/input_error.hpp"
-#include "gps/gps_model.hpp"
-#include "integrator/implicit_integrator.hpp"
-#include "material/elasticity.hpp"
-#include "mesh/box_mesh.hpp"
-#include "mesh/boundary_surface.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
 
 namespace viscera::lab {
 

@@ -1,8 +1,8 @@
-#include "contact_compliance.hpp"
+#include "viscera/runtime/contact_compliance.hpp"
 
 #include <pthread.h>
 
-#include "integrator/implicit_integrator.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
 
 namespace viscera::runtime {
 

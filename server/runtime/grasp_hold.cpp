@@ -1,4 +1,4 @@
-#include "grasp_hold.hpp"
+#include "viscera/runtime/grasp_hold.hpp"
 
 namespace viscera::runtime {
 

@@ -1,4 +1,4 @@
-#include "mesh_publisher.hpp"
+#include "viscera/runtime/mesh_publisher.hpp"
 
 #include <pthread.h>
 

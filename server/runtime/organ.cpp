@@ -1,17 +1,19 @@
-#include "organ.hpp"
+#include "viscera/runtime/organ.hpp"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
 
-#include "common/input_error.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/refinement.hpp"
-#include "model/model_factory.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/refinement.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 namespace viscera::runtime {
+
+using common::InputError;
 
 using namespace viscera::tissue;
 

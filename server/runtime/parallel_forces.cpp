@@ -1,4 +1,4 @@
-#include "parallel_forces.hpp"
+#include "viscera/runtime/parallel_forces.hpp"
 
 #include <chrono>
 #include <cmath>

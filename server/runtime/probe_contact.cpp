@@ -1,4 +1,4 @@
-#include "probe_contact.hpp"
+#include "viscera/runtime/probe_contact.hpp"
 
 #include <algorithm>
 #include <cmath>

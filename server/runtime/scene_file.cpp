@@ -1,4 +1,4 @@
-#include "scene_file.hpp"
+#include "viscera/runtime/scene_file.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -6,17 +6,19 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 
 namespace viscera::runtime {
 
+using common::JsonObject;
+
 using nlohmann::json;
-using tissue::InputError;
-using tissue::JsonObject;
+using common::InputError;
+using common::JsonObject;
 
 SceneSpec read_scene_file(const std::string& path) {
-  const json j = tissue::read_json_file(path);
+  const json j = common::read_json_file(path);
   const JsonObject top(j, path);
   const auto dir = std::filesystem::path(path).parent_path();
   top.require_known({"name", "domain_id", "physics_rate_hz", "mesh_rate_hz", "max_tool_speed_m_s", "organ", "instruments"});
@@ -54,8 +56,8 @@ SceneSpec read_scene_file(const std::string& path) {
     s.fix_axis = f[0].get<std::string>();
     s.fix_side = f[1].get<std::string>();
     s.fix_fraction = f[2].get<double>();
-    if (s.fix_axis != "x" && s.fix_axis != "y" && s.fix_axis != "z") o.fail("fix_slab", "axis '" + tissue::printable(s.fix_axis) + "' is not x, y or z");
-    if (s.fix_side != "min" && s.fix_side != "max") o.fail("fix_slab", "side '" + tissue::printable(s.fix_side) + "' is not min or max");
+    if (s.fix_axis != "x" && s.fix_axis != "y" && s.fix_axis != "z") o.fail("fix_slab", "axis '" + common::printable(s.fix_axis) + "' is not x, y or z");
+    if (s.fix_side != "min" && s.fix_side != "max") o.fail("fix_slab", "side '" + common::printable(s.fix_side) + "' is not min or max");
     if (!(s.fix_fraction > 0 && s.fix_fraction <= 1)) o.fail("fix_slab", "fraction must lie in (0, 1]");
   }
   const json& instruments = top.array("instruments", 1);

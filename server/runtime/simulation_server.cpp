@@ -1,4 +1,4 @@
-#include "simulation_server.hpp"
+#include "viscera/runtime/simulation_server.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -13,16 +13,20 @@
 
 #include <pthread.h>
 
-#include "common/input_error.hpp"
-#include "grasp_hold.hpp"
-#include "mesh_publisher.hpp"
-#include "organ.hpp"
-#include "probe_contact.hpp"
-#include "tick_grid.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/runtime/grasp_hold.hpp"
+#include "viscera/runtime/mesh_publisher.hpp"
+#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/probe_contact.hpp"
+#include "viscera/runtime/tick_grid.hpp"
 #include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/messages.hpp"
 
 namespace viscera::runtime {
+
+using common::InputError;
+using common::short_number;
 
 namespace proto = viscera::protocol;
 using namespace viscera::tissue;

@@ -1,14 +1,17 @@
-#include "tick_budget.hpp"
+#include "viscera/runtime/tick_budget.hpp"
 
 #include <cmath>
 #include <cstdio>
 
-#include "common/input_error.hpp"
+#include "viscera/common/input_error.hpp"
 
 namespace viscera::runtime {
 
-using tissue::InputError;
-using tissue::short_number;
+using common::InputError;
+using common::short_number;
+
+using common::InputError;
+using common::short_number;
 
 long substeps_per_tick(double dt_s, double rate_hz) {
   // As ExplicitIntegrator::advance divides a tick: equal sub-steps no longer than dt.

@@ -9,9 +9,9 @@
 
 #include <unistd.h>
 
-#include "common/command_line.hpp"
-#include "common/input_error.hpp"
-#include "simulation_server.hpp"
+#include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/runtime/simulation_server.hpp"
 #include "viscera/protocol/dds.hpp"
 
 namespace {
@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
       std::quick_exit(0);
     }
     return 0;
-  } catch (const viscera::tissue::InputError& e) {
+  } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
     return 2;
   } catch (const viscera::protocol::DdsError& e) {

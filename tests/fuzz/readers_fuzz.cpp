@@ -14,13 +14,13 @@
 #include <fstream>
 #include <string>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
-#include "dataset.hpp"
-#include "material/material_file.hpp"
-#include "mesh/mesh_reader.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
+#include "viscera/lab/dataset.hpp"
+#include "viscera/tissue/material/material_file.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "model_file.hpp"
-#include "scene_file.hpp"
+#include "viscera/runtime/scene_file.hpp"
 
 namespace {
 
@@ -76,9 +76,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         write_text("b.csv", kCsv);
         (void)lab::read_dataset(folder().string());
         break;
-      case 8: (void)tissue::parse_json(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"); break;
+      case 8: (void)common::parse_json(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"); break;
     }
-  } catch (const tissue::InputError&) {
+  } catch (const common::InputError&) {
     // the one error a reader may give
   }
   return 0;

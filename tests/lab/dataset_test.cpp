@@ -7,8 +7,8 @@
 #include <fstream>
 #include <iostream>
 
-#include "analysis.hpp"
-#include "common/input_error.hpp"
+#include "viscera/lab/analysis.hpp"
+#include "viscera/common/input_error.hpp"
 
 using namespace viscera::lab;
 
@@ -24,7 +24,7 @@ std::string make(const std::string& name, const std::string& json, const std::st
 std::string error_of(const std::string& dir) {
   try {
     read_dataset(dir);
-  } catch (const viscera::tissue::InputError& e) {
+  } catch (const viscera::common::InputError& e) {
     return e.what();
   }
   return "no error";

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <map>
 
-#include "analysis.hpp"
-#include "specimen_simulation.hpp"
+#include "viscera/lab/analysis.hpp"
+#include "viscera/lab/specimen_simulation.hpp"
 #include "synthetic_data.hpp"
 
 using namespace viscera::lab;

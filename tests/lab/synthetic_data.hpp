@@ -5,7 +5,7 @@
 // control, RK4 at 1/200 of the sampling interval). The lab only ever sees the written folder.
 #include <string>
 
-#include "dataset.hpp"
+#include "viscera/lab/dataset.hpp"
 
 namespace viscera::lab::test {
 

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "grasp_hold.hpp"
+#include "viscera/runtime/grasp_hold.hpp"
 
 using namespace viscera::runtime;
 

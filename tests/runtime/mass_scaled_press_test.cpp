@@ -8,10 +8,11 @@
 
 #include <cmath>
 
-#include "common/input_error.hpp"
-#include "organ.hpp"
-#include "probe_contact.hpp"
-#include "scene_file.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/probe_contact.hpp"
+#include "viscera/runtime/scene_file.hpp"
 
 using namespace viscera::runtime;
 using namespace viscera::tissue;

@@ -7,12 +7,12 @@
 #include <cmath>
 #include <random>
 
-#include "integrator/explicit_integrator.hpp"
-#include "material/elasticity.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "model/model_factory.hpp"
-#include "parallel_forces.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/runtime/parallel_forces.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 using namespace viscera::runtime;
 using namespace viscera::tissue;

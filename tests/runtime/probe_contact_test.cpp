@@ -4,7 +4,7 @@
 // reach, and the broad phase still finds the contact on a plate stretched well beyond rest.
 #include <gtest/gtest.h>
 
-#include "probe_contact.hpp"
+#include "viscera/runtime/probe_contact.hpp"
 
 using namespace viscera::runtime;
 using viscera::tissue::Triangle;

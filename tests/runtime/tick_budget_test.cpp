@@ -2,7 +2,7 @@
 // material scales as sqrt(density / E), a tick of 1/rate takes ceil(1 / (rate dt)) sub-steps, and a
 // scene or material whose tick needs more than the budget allows is refused before it runs, with
 // the step, the sub-steps and the limit in the message.
-#include "tick_budget.hpp"
+#include "viscera/runtime/tick_budget.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,9 +13,9 @@
 #include <functional>
 #include <limits>
 
-#include "common/input_error.hpp"
-#include "organ.hpp"
-#include "scene_file.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/scene_file.hpp"
 
 namespace viscera::runtime {
 namespace {
@@ -23,7 +23,7 @@ namespace {
 std::string error_of(const std::function<void()>& f) {
   try {
     f();
-  } catch (const tissue::InputError& e) {
+  } catch (const common::InputError& e) {
     return e.what();
   }
   return "no error";
@@ -85,7 +85,7 @@ TEST(TickBudget, TheLiverStepScalesAsOneOverTheRootOfItsModulusAndAStiffLiverIsR
   const long needed = substeps_per_tick(soft->integrator->dt_s(), spec.physics_rate_hz);
   spec.material = liver().material;
   EXPECT_NO_THROW(build_organ(spec, {1e9, needed}));
-  EXPECT_THROW(build_organ(spec, {1e9, needed - 1}), tissue::InputError);
+  EXPECT_THROW(build_organ(spec, {1e9, needed - 1}), common::InputError);
   // A measured sub-step is a positive time of the order of a force evaluation.
   EXPECT_GT(soft->substep_cost_s, 0);
   EXPECT_LT(soft->substep_cost_s, 0.1);

@@ -1,7 +1,7 @@
 // The physics loop's schedule against what a fixed 1 kHz grid means, worked out by hand for each
 // case, and over long runs of made-up tick costs against the grid's two invariants: no tick starts
 // before its slot (no bursts), and every slot that has ended holds a tick or is counted missed.
-#include "tick_grid.hpp"
+#include "viscera/runtime/tick_grid.hpp"
 
 #include <gtest/gtest.h>
 

@@ -8,10 +8,10 @@
 #include <cmath>
 #include <functional>
 
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_model.hpp"
-#include "integrator/implicit_integrator.hpp"
-#include "mesh/box_mesh.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

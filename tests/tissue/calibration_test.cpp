@@ -2,9 +2,9 @@
 // route agrees with the pseudo-inverse route.
 #include <gtest/gtest.h>
 
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_calibration.hpp"
-#include "gps/gps_model.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_calibration.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

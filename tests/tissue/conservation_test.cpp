@@ -2,11 +2,12 @@
 // symplectic Euler; the energy-consistent GPS conserves energy, the paper form does not.
 #include <gtest/gtest.h>
 
-#include "common/input_error.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_model.hpp"
-#include "integrator/explicit_integrator.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

@@ -4,17 +4,18 @@
 
 #include <Eigen/Dense>
 
-#include "common/input_error.hpp"
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_model.hpp"
-#include "integrator/explicit_integrator.hpp"
-#include "integrator/implicit_integrator.hpp"
-#include "integrator/mass_scaling.hpp"
-#include "material/material_file.hpp"
-#include "mesh/box_mesh.hpp"
-#include "mesh/refinement.hpp"
-#include "model/model_factory.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/integrator/mass_scaling.hpp"
+#include "viscera/tissue/material/material_file.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/mesh/refinement.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

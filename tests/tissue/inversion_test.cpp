@@ -2,8 +2,8 @@
 // same edge lengths) and stays inverted; the signed-volume term brings it back.
 #include <gtest/gtest.h>
 
-#include "gps/gps_model.hpp"
-#include "integrator/explicit_integrator.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

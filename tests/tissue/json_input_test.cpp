@@ -6,12 +6,13 @@
 #include <functional>
 #include <sys/stat.h>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
-#include "material/material_file.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
+#include "viscera/tissue/material/material_file.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
+using namespace viscera::common;
 namespace test = viscera::tissue::test;
 
 namespace {

@@ -1,11 +1,12 @@
 // Elasticity matrices against their defining compliances.
 #include <gtest/gtest.h>
 
-#include "common/input_error.hpp"
-#include "material/elasticity.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
+using namespace viscera::common;
 namespace test = viscera::tissue::test;
 
 TEST(Elasticity, IsotropicComplianceHasOneOverEAndPoisson) {

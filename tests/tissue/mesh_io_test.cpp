@@ -6,12 +6,13 @@
 
 #include <sys/stat.h>
 
-#include "common/input_error.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/vtu_writer.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/vtu_writer.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
+using namespace viscera::common;
 namespace test = viscera::tissue::test;
 
 namespace {

@@ -4,10 +4,10 @@
 #include <map>
 #include <set>
 
-#include "element/tet_geometry.hpp"
-#include "mesh/boundary_surface.hpp"
-#include "mesh/box_mesh.hpp"
-#include "mesh/refinement.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/mesh/refinement.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

@@ -2,8 +2,8 @@
 // body; linear FE produces spurious forces, exactly -K (R - I) X.
 #include <gtest/gtest.h>
 
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_model.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

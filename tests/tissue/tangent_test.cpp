@@ -1,8 +1,8 @@
 // Element tangents against central finite differences of the forces (an independent path).
 #include <gtest/gtest.h>
 
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_model.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;

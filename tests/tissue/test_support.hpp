@@ -8,10 +8,10 @@
 
 #include <Eigen/Geometry>
 
-#include "material/elasticity.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/mesh_validation.hpp"
-#include "mesh/tet_mesh.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/mesh_validation.hpp"
+#include "viscera/tissue/mesh/tet_mesh.hpp"
 
 namespace viscera::tissue::test {
 

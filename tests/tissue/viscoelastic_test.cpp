@@ -5,21 +5,22 @@
 #include <cmath>
 #include <random>
 
-#include "common/input_error.hpp"
-#include "gps/fung_map.hpp"
-#include "gps/gps_model.hpp"
-#include "integrator/implicit_integrator.hpp"
-#include "mesh/box_mesh.hpp"
-#include "model/model_factory.hpp"
-#include "integrator/explicit_integrator.hpp"
-#include "material/material_file.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/gps/fung_map.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/material/material_file.hpp"
 #include "test_support.hpp"
-#include "viscoelastic/constant_q.hpp"
-#include "viscoelastic/constant_q_fit.hpp"
-#include "viscoelastic/figure2.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/tissue/viscoelastic/constant_q.hpp"
+#include "viscera/tissue/viscoelastic/constant_q_fit.hpp"
+#include "viscera/tissue/viscoelastic/figure2.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 using namespace viscera::tissue;
+using namespace viscera::common;
 namespace test = viscera::tissue::test;
 
 namespace {

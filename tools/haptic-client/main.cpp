@@ -18,7 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/command_line.hpp"
+#include "viscera/common/command_line.hpp"
 #include "scripted_device.hpp"
 #include "trajectory_device.hpp"
 #include "viscera/client/client.hpp"

@@ -12,7 +12,7 @@
 #include <optional>
 #include <thread>
 
-#include "common/command_line.hpp"
+#include "viscera/common/command_line.hpp"
 #include "viscera/client/client.hpp"
 
 namespace {

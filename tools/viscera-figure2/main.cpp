@@ -2,12 +2,13 @@
 #include <cstdio>
 #include <fstream>
 
-#include "common/command_line.hpp"
-#include "common/input_error.hpp"
-#include "common/svg_plot.hpp"
-#include "viscoelastic/figure2.hpp"
+#include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/plot/svg_plot.hpp"
+#include "viscera/tissue/viscoelastic/figure2.hpp"
 
 using namespace viscera::tissue;
+using namespace viscera::common;
 
 int main(int argc, char** argv) {
   try {

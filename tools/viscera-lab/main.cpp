@@ -6,9 +6,9 @@
 #include <cstring>
 #include <string>
 
-#include "analysis.hpp"
-#include "decimation.hpp"
-#include "common/input_error.hpp"
+#include "viscera/lab/analysis.hpp"
+#include "viscera/lab/decimation.hpp"
+#include "viscera/common/input_error.hpp"
 #include "model_file.hpp"
 #include "report.hpp"
 
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     return usage_error("unknown command '" + positional[0] + "'");
-  } catch (const viscera::tissue::InputError& e) {
+  } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "viscera-lab: %s\n", e.what());
     return 2;
   }

@@ -4,8 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 
 namespace viscera::lab {
 
@@ -30,13 +30,13 @@ void write_model(const std::string& path, const MaterialModel& m, const std::str
   if (m.has(Mechanism::first_load_softening)) j["softening_d"] = m.softening_d;
   std::ofstream out(path);
   out << j.dump(2) << "\n";
-  if (!out) throw tissue::InputError(path, 0, "", "cannot write");
+  if (!out) throw common::InputError(path, 0, "", "cannot write");
 }
 
 MaterialModel read_model(const std::string& path) {
-  const json j = tissue::read_json_file(path);
-  if (!j.is_object()) throw tissue::InputError(path, 0, "", "not a JSON object (a model.json written by viscera-lab analyze)");
-  const tissue::JsonObject top(j, path);
+  const json j = common::read_json_file(path);
+  if (!j.is_object()) throw common::InputError(path, 0, "", "not a JSON object (a model.json written by viscera-lab analyze)");
+  const common::JsonObject top(j, path);
   top.require_known({"model", "fitted_to", "units", "mechanisms", "modulus_pa", "viscosity_pa_s", "relaxation_time_s", "relaxation_modulus_pa",
                      "stiffening_b", "compression_ratio", "softening_d"});
   // Each value in the range a fit can produce (finite; open ends checked where they matter).
@@ -51,7 +51,7 @@ MaterialModel read_model(const std::string& path) {
   MaterialModel m;
   for (const auto& s : top.array("mechanisms")) {
     Mechanism k;
-    if (!s.is_string() || !parse_mechanism(s.get<std::string>(), &k)) top.fail("mechanisms", tissue::show_json(s) + " is not a known mechanism");
+    if (!s.is_string() || !parse_mechanism(s.get<std::string>(), &k)) top.fail("mechanisms", common::show_json(s) + " is not a known mechanism");
     m.mechanisms |= 1u << static_cast<unsigned>(k);
   }
   m.modulus_pa = top.number("modulus_pa", 0.0, big);

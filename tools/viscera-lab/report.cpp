@@ -5,8 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/svg_plot.hpp"
-#include "fit.hpp"
+#include "viscera/plot/svg_plot.hpp"
+#include "viscera/lab/fit.hpp"
 #include "model_file.hpp"
 
 namespace viscera::lab {

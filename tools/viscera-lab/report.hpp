@@ -2,7 +2,7 @@
 // Writes OUT_DIR/report.json, report.md (with SVG plots per test) and model.json.
 #include <string>
 
-#include "analysis.hpp"
+#include "viscera/lab/analysis.hpp"
 
 namespace viscera::lab {
 

@@ -7,19 +7,21 @@
 #include <iostream>
 #include <sstream>
 
-#include "common/command_line.hpp"
-#include "common/input_error.hpp"
-#include "integrator/explicit_integrator.hpp"
-#include "integrator/implicit_integrator.hpp"
-#include "material/elasticity.hpp"
-#include "material/material_file.hpp"
-#include "mesh/boundary_surface.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/vtu_writer.hpp"
-#include "model/model_factory.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/material/material_file.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/vtu_writer.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 using namespace viscera::tissue;
+using namespace viscera::common;
 namespace fs = std::filesystem;
 
 namespace {

@@ -1,4 +1,4 @@
-#include "element/tet_geometry.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
 

@@ -1,9 +1,9 @@
-#include "fem/finite_element_model.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
-#include "fem/polar_decomposition.hpp"
+#include "viscera/tissue/fem/polar_decomposition.hpp"
 
 namespace viscera::tissue {
 

@@ -1,4 +1,4 @@
-#include "fem/polar_decomposition.hpp"
+#include "viscera/tissue/fem/polar_decomposition.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "gps/gps_calibration.hpp"
+#include "viscera/tissue/gps/gps_calibration.hpp"
 
 #include <Eigen/LU>
 #include <Eigen/QR>

@@ -1,14 +1,14 @@
-#include "gps/gps_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include "gps/fung_map.hpp"
-#include "gps/gps_calibration.hpp"
-#include "material/elasticity.hpp"
-#include "viscoelastic/standard_linear_solids.hpp"
+#include "viscera/tissue/gps/fung_map.hpp"
+#include "viscera/tissue/gps/gps_calibration.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/viscoelastic/standard_linear_solids.hpp"
 
 namespace viscera::tissue {
 

@@ -1,9 +1,9 @@
-#include "integrator/boundary_conditions.hpp"
+#include "viscera/tissue/integrator/boundary_conditions.hpp"
 
 #include <stdexcept>
 
-#include "element/tet_geometry.hpp"
-#include "mesh/boundary_surface.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
 
 namespace viscera::tissue {
 

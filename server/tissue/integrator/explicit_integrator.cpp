@@ -1,13 +1,16 @@
-#include "integrator/explicit_integrator.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include "common/input_error.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 
 namespace viscera::tissue {
+
+using common::short_number;
 
 ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
                                        BoundaryConditions bc, ExplicitOptions options)

@@ -1,11 +1,12 @@
-#include "integrator/implicit_integrator.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include "common/input_error.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 
 namespace viscera::tissue {
 

@@ -1,11 +1,11 @@
-#include "integrator/mass_scaling.hpp"
+#include "viscera/tissue/integrator/mass_scaling.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "integrator/stable_step.hpp"
+#include "viscera/tissue/integrator/stable_step.hpp"
 
 namespace viscera::tissue {
 

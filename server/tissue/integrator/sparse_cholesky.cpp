@@ -1,4 +1,4 @@
-#include "integrator/sparse_cholesky.hpp"
+#include "viscera/tissue/integrator/sparse_cholesky.hpp"
 
 #include <algorithm>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include "integrator/stable_step.hpp"
+#include "viscera/tissue/integrator/stable_step.hpp"
 
 #include <algorithm>
 #include <cmath>

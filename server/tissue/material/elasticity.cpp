@@ -1,4 +1,4 @@
-#include "material/elasticity.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -6,9 +6,11 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "common/input_error.hpp"
+#include "viscera/common/input_error.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 namespace {
 std::string num(double v) {

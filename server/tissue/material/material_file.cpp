@@ -1,10 +1,15 @@
-#include "material/material_file.hpp"
+#include "viscera/tissue/material/material_file.hpp"
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
-#include "material/elasticity.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
 
 namespace viscera::tissue {
+
+using common::short_number;
+using common::read_text_file;
+using common::parse_json;
+using common::JsonObject;
 
 namespace {
 // Ranges wide enough for any tissue and any material a study may want (bone is about 2e10 Pa),

@@ -1,4 +1,4 @@
-#include "mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
 
 #include <algorithm>
 #include <map>

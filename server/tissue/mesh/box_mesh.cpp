@@ -1,8 +1,8 @@
-#include "mesh/box_mesh.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
 
 #include <stdexcept>
 
-#include "element/tet_geometry.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
 

@@ -1,12 +1,15 @@
 // Gmsh .msh readers: legacy v1 ($NOD/$ELM), ASCII v2 ($MeshFormat 2.x) and ASCII v4.1.
 #include <string>
 
-#include "common/input_error.hpp"
-#include "mesh/mesh_builder.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/text_cursor.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/mesh/mesh_builder.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/text_cursor.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
+using common::printable;
 
 namespace {
 

@@ -1,9 +1,11 @@
-#include "mesh/mesh_builder.hpp"
+#include "viscera/tissue/mesh/mesh_builder.hpp"
 
-#include "common/input_error.hpp"
-#include "mesh/mesh_validation.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/mesh/mesh_validation.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 void MeshBuilder::add_node(long long id, const Vec3& p, long line) {
   if (!p.allFinite())

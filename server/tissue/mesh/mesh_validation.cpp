@@ -1,14 +1,16 @@
-#include "mesh/mesh_validation.hpp"
+#include "viscera/tissue/mesh/mesh_validation.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
 
-#include "common/input_error.hpp"
-#include "element/tet_geometry.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 double tet_quality(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
   const std::array<Vec3, 4> x{x0, x1, x2, x3};

@@ -1,8 +1,8 @@
-#include "mesh/refinement.hpp"
+#include "viscera/tissue/mesh/refinement.hpp"
 
 #include <unordered_map>
 
-#include "element/tet_geometry.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
 

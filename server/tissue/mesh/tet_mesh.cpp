@@ -1,6 +1,6 @@
-#include "mesh/tet_mesh.hpp"
+#include "viscera/tissue/mesh/tet_mesh.hpp"
 
-#include "element/tet_geometry.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
 

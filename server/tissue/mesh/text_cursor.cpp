@@ -1,13 +1,17 @@
-#include "mesh/text_cursor.hpp"
+#include "viscera/tissue/mesh/text_cursor.hpp"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
+using common::printable;
+using common::read_text_file;
 
 namespace {
 // One definition of whitespace for skipping and for ending a token: with two (a form feed was

@@ -7,13 +7,17 @@
 
 #include <pugixml.hpp>
 
-#include "common/input_error.hpp"
-#include "common/json_input.hpp"
-#include "mesh/mesh_builder.hpp"
-#include "mesh/mesh_reader.hpp"
-#include "mesh/text_cursor.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
+#include "viscera/tissue/mesh/mesh_builder.hpp"
+#include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/tissue/mesh/text_cursor.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
+using common::printable;
+using common::read_text_file;
 
 namespace {
 

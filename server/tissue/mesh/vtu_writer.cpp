@@ -1,14 +1,16 @@
-#include "mesh/vtu_writer.hpp"
+#include "viscera/tissue/mesh/vtu_writer.hpp"
 
 #include <cstdio>
 #include <fstream>
 
 #include <Eigen/Eigenvalues>
 
-#include "common/input_error.hpp"
-#include "element/tet_geometry.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 namespace {
 std::ofstream open_for_writing(const std::string& path) {

@@ -1,4 +1,4 @@
-#include "model/force_model.hpp"
+#include "viscera/tissue/model/force_model.hpp"
 
 #include <cmath>
 

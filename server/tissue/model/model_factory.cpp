@@ -1,10 +1,12 @@
-#include "model/model_factory.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
 
-#include "common/input_error.hpp"
-#include "fem/finite_element_model.hpp"
-#include "gps/gps_model.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 const std::vector<std::string>& force_model_names() {
   static const std::vector<std::string> names{"gps", "gps_energy", "corotational", "linear"};

@@ -1,4 +1,4 @@
-#include "viscoelastic/constant_q.hpp"
+#include "viscera/tissue/viscoelastic/constant_q.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscoelastic/constant_q_fit.hpp"
+#include "viscera/tissue/viscoelastic/constant_q_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,11 @@
 
 #include <Eigen/Dense>
 
-#include "common/input_error.hpp"
+#include "viscera/common/input_error.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 namespace {
 

@@ -1,15 +1,15 @@
-#include "viscoelastic/figure2.hpp"
+#include "viscera/tissue/viscoelastic/figure2.hpp"
 
 #include <cmath>
 
-#include "gps/gps_model.hpp"
-#include "integrator/explicit_integrator.hpp"
-#include "material/elasticity.hpp"
-#include "mesh/boundary_surface.hpp"
-#include "mesh/box_mesh.hpp"
-#include "viscoelastic/constant_q.hpp"
-#include "viscoelastic/shear_layer.hpp"
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/viscoelastic/constant_q.hpp"
+#include "viscera/tissue/viscoelastic/shear_layer.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 namespace viscera::tissue {
 

@@ -1,4 +1,4 @@
-#include "viscoelastic/shear_layer.hpp"
+#include "viscera/tissue/viscoelastic/shear_layer.hpp"
 
 #include <cmath>
 

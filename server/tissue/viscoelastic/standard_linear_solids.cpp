@@ -1,4 +1,4 @@
-#include "viscoelastic/standard_linear_solids.hpp"
+#include "viscera/tissue/viscoelastic/standard_linear_solids.hpp"
 
 #include <algorithm>
 #include <cmath>

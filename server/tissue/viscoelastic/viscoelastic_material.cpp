@@ -1,12 +1,14 @@
-#include "viscoelastic/viscoelastic_material.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 #include <cmath>
 #include <sstream>
 
-#include "common/input_error.hpp"
-#include "material/elasticity.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
 
 namespace viscera::tissue {
+
+using common::InputError;
 
 namespace {
 Mat6 volumetric_part(const Mat6& D) {

@@ -1,0 +1,75 @@
+#pragma once
+// viscera-lab's method (MODEL.md section 4): fit the baseline, show where it is wrong (per test,
+// on held-out tests), name the cause from candidate mechanisms whose held-out gain is clearly
+// above the noise of the data, extend the model, refit and measure the gain on held-out tests.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "viscera/lab/dataset.hpp"
+#include "viscera/lab/material_model.hpp"
+
+namespace viscera::lab {
+
+struct TestFigures {
+  std::string file;
+  double fit_rms_pa = 0.0;      ///< model fitted to all tests
+  double heldout_rms_pa = 0.0;  ///< model fitted to the other tests (leave one test out)
+  double noise_pa = 0.0;
+};
+
+struct ModelEvaluation {
+  MaterialModel model;  ///< fitted to all tests
+  std::vector<TestFigures> tests;
+  double fit_rms_pa = 0.0, heldout_rms_pa = 0.0;  ///< root mean square over tests
+};
+
+struct Candidate {
+  Mechanism mechanism;
+  int round = 0;                 ///< 1: tried on the baseline; 2..: on the extended model
+  double heldout_before_pa = 0.0, heldout_after_pa = 0.0;
+  bool accepted = false;
+  std::string evidence;          ///< the residual signature that points at it
+};
+
+/// A model run on the tetrahedral specimen (viscera's GPS, implicit, inertia) next to its
+/// material-point law.
+struct SpecimenCheck {
+  std::string model;
+  bool ran = false;
+  std::string note;
+  std::vector<std::string> files;
+  std::vector<double> specimen_rms_pa, law_rms_pa;
+  long steps = 0, newton_iterations = 0;
+};
+
+struct AnalyzeOptions {
+  bool specimen = true;  ///< also simulate baseline and final on the tetrahedral specimen
+  /// Tests with more rows are decimated for the fit (decimation.hpp); the report says so.
+  std::size_t max_fit_points = 2000;
+};
+
+struct Analysis {
+  std::string dataset;
+  double noise_pa = 0.0;
+  ModelEvaluation baseline, final;
+  std::vector<Candidate> candidates;
+  std::vector<Mechanism> causes;  ///< accepted, strongest first
+  double gain = 1.0;              ///< baseline held-out RMS / final held-out RMS
+  std::string verdict;            ///< one paragraph: what is wrong, why, what still does not fit
+  std::vector<std::string> decimated;  ///< "file: N rows, fitted on M" for the tests decimated for the fit
+  std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen
+};
+
+/// Noise of one test [Pa]: RMS of stress_sd_pa if given, else from second differences (MAD).
+double noise_level_pa(const TestData& t);
+
+/// Fits `structure` to all tests and, for every test, to the others (held-out prediction).
+ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d);
+
+/// The whole analysis; `progress` receives one line per stage, with an estimate of the time the
+/// rest will take once the baseline's fits have been timed.
+Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {},
+                 const AnalyzeOptions& options = {});
+
+}  // namespace viscera::lab

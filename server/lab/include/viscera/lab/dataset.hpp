@@ -1,0 +1,38 @@
+#pragma once
+// A measured data set (README "The data a user brings"): a folder with dataset.json and one CSV
+// per test (time_s, strain, stress_pa[, stress_sd_pa]). SI units: seconds, engineering strain,
+// pascals. Reading checks everything a file can get wrong and names file, line and field.
+#include <string>
+#include <vector>
+
+namespace viscera::lab {
+
+enum class Mode { uniaxial, simple_shear };
+enum class Control { strain, stress };
+
+struct Specimen {
+  double length_m = 0, width_m = 0, thickness_m = 0, density_kg_m3 = 0;
+};
+
+struct TestData {
+  std::string file;  ///< as named in dataset.json
+  Control control = Control::strain;
+  std::vector<double> time_s, strain, stress_pa, stress_sd_pa;  ///< sd empty if not given
+};
+
+struct Dataset {
+  std::string name, folder;
+  Mode mode = Mode::uniaxial;
+  Specimen specimen;
+  std::vector<TestData> tests;
+};
+
+/// Reads DATASET_DIR/dataset.json and its CSVs; throws common::InputError on bad input.
+Dataset read_dataset(const std::string& folder);
+/// Writes a data set in the same format (used by the synthetic generator).
+void write_dataset(const Dataset& d, const std::string& folder);
+
+const char* to_string(Mode m);
+const char* to_string(Control c);
+
+}  // namespace viscera::lab

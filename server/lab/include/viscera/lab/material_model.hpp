@@ -1,0 +1,63 @@
+#pragma once
+// The lab's family of 1D constitutive laws (a homogeneous specimen: uniaxial or simple shear),
+// built as the tissue core builds its GPS: an elastic shape s(eps) and a relaxation operator on it,
+//     sigma(t) = E s(t) + eta ds/dt + sum_l E_l h_l(t),   h_l = int exp(-(t-u)/tau_l) ds(u),
+// with memory variables h_l updated exactly for s linear between samples (tissue::MemoryStep's
+// recurrence). The baseline is what published simulators use: linear elasticity with Kelvin-Voigt
+// damping (s = eps, no h_l). Each named mechanism extends it:
+//   broadband_relaxation          E_l on log-spaced tau_l over the data's time scales (memory variables)
+//   strain_stiffening             Fung: s = (exp(B eps) - 1) / B
+//   tension_compression_asymmetry s = eps (eps >= 0), r eps (eps < 0)
+//   first_load_softening          s = eps on the virgin curve, (1 - d (1 - |eps|/m)) eps below the
+//                                 previous extreme m (Ogden-Roxburgh-like softening on reloading)
+// For given nonlinear parameters (B, r, d) the stress is linear in (E, eta, E_l) >= 0.
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "viscera/lab/dataset.hpp"
+
+namespace viscera::lab {
+
+enum class Mechanism { broadband_relaxation, strain_stiffening, tension_compression_asymmetry, first_load_softening };
+inline constexpr std::array<Mechanism, 4> kMechanisms{Mechanism::broadband_relaxation, Mechanism::strain_stiffening,
+                                                      Mechanism::tension_compression_asymmetry, Mechanism::first_load_softening};
+const char* name(Mechanism m);
+/// Parses a mechanism name; false if unknown.
+bool parse_mechanism(const std::string& s, Mechanism* out);
+
+struct MaterialModel {
+  unsigned mechanisms = 0;  ///< bit (1 << Mechanism)
+  double stiffening_b = 0.0;
+  double compression_ratio = 1.0;
+  double softening_d = 0.0;
+  double modulus_pa = 0.0;
+  double viscosity_pa_s = 0.0;
+  std::vector<double> relaxation_time_s;      ///< broadband only
+  std::vector<double> relaxation_modulus_pa;  ///< broadband only
+
+  bool has(Mechanism m) const { return mechanisms & (1u << static_cast<unsigned>(m)); }
+  /// "kelvin_voigt_linear" or "kelvin_voigt_linear + broadband_relaxation + ...".
+  std::string describe() const;
+  /// Number of free parameters (non-zero linear ones and the nonlinear ones).
+  int parameter_count() const;
+};
+
+/// Elastic shape s at every sample of a strain history (first-load softening needs the history).
+std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<double>& strain);
+
+/// Columns of the linear model at the samples: s, ds/dt (backward difference), h_l for each tau_l.
+Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t);
+
+/// Stress from the measured strain (the equation the fit minimises, for any control).
+std::vector<double> predict_stress(const MaterialModel& m, const TestData& t);
+
+/// Strain under the measured stress (stress-controlled tests): the law solved sample by sample.
+std::vector<double> predict_strain(const MaterialModel& m, const TestData& t);
+
+/// Log-spaced relaxation times, one per decade, covering the sampling intervals and durations.
+std::vector<double> relaxation_times_for(const Dataset& d);
+
+}  // namespace viscera::lab

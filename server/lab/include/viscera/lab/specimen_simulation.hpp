@@ -1,0 +1,53 @@
+#pragma once
+// A test simulated on the specimen itself: the specimen meshed with tetrahedra, the boundary
+// conditions of the mode, the measured loading history, inertia included, viscera's GPS with
+// memory variables, the implicit integrator (backward Euler, CHOLMOD) stepping between samples
+// with steps that start small after every sample and grow through long holds.
+//  - uniaxial: frictionless grips (x held at x = 0, the x = L face pulled along x, lateral free);
+//    nominal stress = reaction / (W T);
+//  - simple shear: base held, every node restricted to motion along x, top moved (or loaded)
+//    along x; shear stress = reaction / (L W).
+#include <string>
+#include <vector>
+
+#include "viscera/lab/dataset.hpp"
+#include "viscera/lab/material_model.hpp"
+
+namespace viscera::lab {
+
+/// The law's elastic shape on the specimen (Fung stiffening B, tension/compression asymmetry r):
+/// the GPS takes it in its energy form (conservative, symmetric tangent; gps/fung_map.hpp), whose
+/// constants are calibrated so that the specimen's instantaneous elastic response to the mode's
+/// loading matches the law's over the data's strain range (B on the tension side, r on the
+/// compression side): in 3D the edges across the load stiffen or soften too, so the same
+/// constants would not give the same curve.
+struct ShapeCalibration {
+  double law_b = 0, gps_b = 0;  ///< Fung's B (0: none)
+  double law_r = 1, gps_r = 1;  ///< compression ratio (1: symmetric)
+  double strain_lo = 0, strain_hi = 0;
+  double uncalibrated_mismatch = 0;  ///< relative RMS of the specimen's curve against the law's with the law's constants
+  double mismatch = 0;               ///< the same with the calibrated constants
+};
+ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& d);
+
+struct SpecimenResult {
+  bool supported = false;
+  std::string note;                 ///< why not, or what is approximated
+  std::vector<double> stress_pa;    ///< at the data times (strain control: predicted; stress control: imposed)
+  std::vector<double> strain;       ///< at the data times (stress control: predicted)
+  double rms_pa = 0.0;              ///< strain control: RMS stress error; stress control: RMS strain error x modulus
+  long steps = 0, newton_iterations = 0, step_cuts = 0;
+  ShapeCalibration shape;  ///< when the model stiffens or is asymmetric
+};
+
+/// Which models the GPS can represent: Kelvin-Voigt, memory variables (broadband), first-load
+/// softening (per edge, GpsViscoelasticity::first_load_softening), Fung stiffening and
+/// tension/compression asymmetry under uniaxial loading (the GPS's energy form, calibrated: see
+/// ShapeCalibration); not those two in simple shear (no isotropic solid has them).
+bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why);
+
+/// `calibration`: calibrate_elastic_shape(m, d), if already known (it is computed otherwise).
+SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t,
+                                 const ShapeCalibration* calibration = nullptr);
+
+}  // namespace viscera::lab

@@ -1,0 +1,53 @@
+#pragma once
+// Publishes the organ's deformed surface at 30-60 Hz from a thread of its own, so that encoding
+// and writing 100 kB-1 MB frames never delays the physics loop (TRANSPORT.md: "never write from
+// the physics thread"). The physics thread only offers its state: when a frame is due, it copies
+// the surface positions into a hand-over buffer, and if the publisher is still busy with that
+// buffer it skips the frame instead of waiting. The topology is published once, reliably and
+// transient local, so clients that join later still get it.
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <span>
+#include <thread>
+#include <vector>
+
+#include "viscera/tissue/mesh/tet_mesh.hpp"
+#include "viscera/protocol/dds.hpp"
+#include "viscera/protocol/messages.hpp"
+
+namespace viscera::runtime {
+
+class MeshPublisher {
+ public:
+  /// `surface_nodes[k]` is the mesh node of surface vertex k; `triangles` index surface vertices.
+  MeshPublisher(protocol::Participant& participant, protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
+                double rate_hz);
+  ~MeshPublisher();
+  MeshPublisher(const MeshPublisher&) = delete;
+  MeshPublisher& operator=(const MeshPublisher&) = delete;
+
+  /// Physics thread: hands over a snapshot if one is due at `now_ns`; never blocks.
+  void offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns);
+  std::uint64_t frames_published() const;
+  /// Frames that were due while the publisher was still writing the previous one.
+  std::uint64_t frames_skipped() const { return skipped_; }
+
+ private:
+  void publish_loop();
+
+  protocol::Writer topology_writer_, frame_writer_;
+  std::vector<std::int32_t> nodes_;
+  std::uint32_t mesh_id_;
+  std::int64_t period_ns_, next_due_ns_ = 0;
+  std::uint64_t offered_ = 0, skipped_ = 0;  // physics thread only
+
+  mutable std::mutex mutex_;
+  std::condition_variable ready_cv_;
+  protocol::MeshFrame pending_;  // guarded by mutex_
+  bool ready_ = false, stop_ = false;
+  std::uint64_t published_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace viscera::runtime

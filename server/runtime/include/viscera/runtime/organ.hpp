@@ -1,0 +1,50 @@
+#pragma once
+// The organ of a scene: its mesh, boundary surface, material, force model, explicit integrator
+// and contact compliance, all built from a scene file, and rebuilt with another material while
+// the server runs (session control). Building reads files and factorises; the server does it
+// off the physics thread and swaps the result in between ticks.
+#include <memory>
+
+#include "viscera/runtime/contact_compliance.hpp"
+#include "viscera/runtime/parallel_forces.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/material/material_file.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/runtime/scene_file.hpp"
+#include "viscera/runtime/tick_budget.hpp"
+#include "viscera/protocol/messages.hpp"
+
+namespace viscera::runtime {
+
+struct Organ {
+  SceneSpec scene;
+  tissue::Material material;
+  std::shared_ptr<tissue::TetMesh> mesh;
+  tissue::Box bounds;
+  tissue::BoundarySurface boundary;
+  std::unique_ptr<tissue::ForceModel> model;
+  std::unique_ptr<ParallelForces> parallel_forces;  ///< scene physics_threads > 1; used by the integrator
+  std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
+  std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
+  /// One explicit sub-step of this organ on this machine [s] (the median of five, timed when built).
+  double substep_cost_s = 0;
+
+  /// The material as the scene state shows it.
+  protocol::MaterialInfo material_info() const;
+  /// One line: the explicit step, what a tick at `rate_hz` costs, and, if any, the mass scaling that
+  /// lengthened the step.
+  std::string describe_step(double rate_hz) const;
+};
+
+/// Reads the scene's mesh and material and builds the organ. Throws InputError naming the file
+/// and field, also when a tick at the scene's physics rate would not fit `budget`.
+std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& budget = {});
+
+/// The same organ (mesh shared) with some material parameters changed. Throws InputError naming
+/// the parameter when the change does not apply (Young's modulus of a material that is not
+/// isotropic, Q of an elastic one), gives an invalid material, or a tick that would not fit
+/// `budget` at `rate_hz` (the rate the server runs at now).
+std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol::MaterialChange& change, double rate_hz,
+                                             const TickBudget& budget = {});
+
+}  // namespace viscera::runtime

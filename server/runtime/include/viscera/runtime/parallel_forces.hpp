@@ -1,0 +1,52 @@
+#pragma once
+// Internal forces of a tissue model on several threads. The elements are cut into a fixed number
+// of chunks; the calling thread computes chunk 0 straight into the force array, and it and the
+// helper threads take the other chunks as they come, each into the chunk's own buffer. The
+// buffers are added after in chunk order, so the forces are the same bit for bit whichever thread
+// computed which chunk (deterministic; they differ from one-thread evaluation only by rounding).
+// A helper that is late (the machine's other core busy) costs nothing but the buffers: the
+// calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
+// caller, waiting for a helper's chunk, spins briefly and then sleeps.
+#include <atomic>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+#include "viscera/tissue/model/force_model.hpp"
+
+namespace viscera::runtime {
+
+class ParallelForces {
+ public:
+  /// `threads` >= 2 (the calling thread and threads - 1 helpers); `chunks` >= threads.
+  ParallelForces(const tissue::ForceModel& model, int threads, int chunks = 4);
+  ~ParallelForces();
+  ParallelForces(const ParallelForces&) = delete;
+  ParallelForces& operator=(const ParallelForces&) = delete;
+
+  /// f += the model's internal forces at x, memory advanced (as ForceModel::add_forces).
+  tissue::ForceStats operator()(std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& memory);
+
+ private:
+  void helper();
+  /// Takes chunks of evaluation `generation` until none is left.
+  void take_chunks(std::uint64_t generation);
+
+  const tissue::ForceModel& model_;
+  const std::size_t chunks_;
+  // The evaluation in progress: written by the calling thread before it publishes the generation.
+  std::span<const tissue::Vec3> x_;
+  tissue::MemoryUpdate memory_;
+  std::vector<std::vector<tissue::Vec3>> buffers_;  // chunks 1 .. chunks-1
+  std::vector<tissue::ForceStats> stats_;
+  // next_: generation in the high 32 bits, next chunk in the low 32; taken by compare-exchange so
+  // a helper still in an old evaluation never takes a chunk of a new one.
+  std::atomic<std::uint64_t> next_{0};
+  std::atomic<std::uint64_t> go_{0};        // generation to work on; helpers wait on it
+  std::atomic<std::size_t> finished_{0};    // chunks 1.. finished in this generation
+  std::atomic<bool> stop_{false};
+  std::uint64_t generation_ = 0;
+  std::vector<std::thread> helpers_;
+};
+
+}  // namespace viscera::runtime

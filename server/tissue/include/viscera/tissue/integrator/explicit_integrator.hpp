@@ -1,0 +1,82 @@
+#pragma once
+// Explicit symplectic Euler (MODEL.md section 2): v += dt M^-1 (f_int + f_ext);
+// v *= exp(-alpha dt) (mass-proportional damping, integrated exactly); x += dt v.
+// The step is the computed critical step times a safety factor, never a guess.
+#include <functional>
+#include <vector>
+
+#include "viscera/tissue/integrator/boundary_conditions.hpp"
+#include "viscera/tissue/integrator/mass_scaling.hpp"
+#include "viscera/tissue/integrator/stable_step.hpp"
+#include "viscera/tissue/integrator/state.hpp"
+#include "viscera/tissue/model/force_model.hpp"
+
+namespace viscera::tissue {
+
+struct ExplicitOptions {
+  /// dt = safety x critical step (0 < s <= 1); with a stiff force field, s <= sqrt(3)/2 keeps the
+  /// bound (BoundaryConditions::force_field)
+  double safety_factor = 0.9;
+  double dt_s = 0.0;                  ///< if > 0, used instead (for studies; may be unstable)
+  double mass_damping_per_s = 0.0;    ///< alpha >= 0 [1/s]
+  double max_edge_strain = 2.0;       ///< |dL|/L0 above this means the run went unstable
+  /// Critical step from the global estimate (global_time_step) instead of the element bound.
+  bool global_stable_step = false;
+  /// Selective mass scaling (mass_scaling.hpp): this fraction of the organ's mass is added to the
+  /// elements with the shortest critical steps, as inertia only (weight stays m g). 0: none.
+  double added_mass_fraction = 0.0;
+};
+
+class ExplicitIntegrator {
+ public:
+  ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
+                     BoundaryConditions bc, ExplicitOptions options = {});
+
+  double dt_s() const { return dt_; }
+  const StableStep& critical_step() const { return critical_; }
+  /// Lumped masses of the inertia [kg] (with the added mass, if any).
+  const std::vector<double>& masses() const { return mass_; }
+  /// The mass scaling applied (none: no scaled elements, densities as given).
+  const MassScaling& mass_scaling() const { return scaling_; }
+
+  /// One step. On instability (edge strain above the limit, or NaN) throws SimulationError naming
+  /// the element and the time, and puts `state` back to the last step that passed the check.
+  void step(State& state);
+  /// Equal sub-steps, each at most dt_s(), until state.time_s has advanced by `duration_s`.
+  /// Returns the number of sub-steps. Between sub-steps it asks the interruption (if set) and
+  /// returns early when it says so, with the state at the last sub-step taken.
+  long advance(State& state, double duration_s);
+  /// Asked between the sub-steps of advance(): true stops it (a program that must stop at once).
+  void set_interruption(std::function<bool()> interrupted) { interrupted_ = std::move(interrupted); }
+
+  /// How internal forces are evaluated: by default model.add_forces on the calling thread; a caller
+  /// may split them over threads (server/runtime/parallel_forces.hpp). It must add the model's
+  /// forces to f (up to rounding) and advance the memory as add_forces does. Empty: the default.
+  using ForceEvaluation = std::function<ForceStats(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory)>;
+  void set_force_evaluation(ForceEvaluation evaluation) { evaluate_ = std::move(evaluation); }
+
+  /// The boundary conditions (their force field may be changed between steps).
+  BoundaryConditions& boundary_conditions() { return bc_; }
+  /// Kinetic energy [J] of a state.
+  double kinetic_energy(const State& state) const;
+
+ private:
+  void step_with(State& state, double dt);
+
+  const ForceModel& model_;
+  BoundaryConditions bc_;
+  ExplicitOptions options_;
+  std::vector<double> mass_;
+  std::vector<Vec3> inv_mass_;     // per coordinate; 0 where constrained
+  std::vector<Vec3> gravity_;      // m g per node
+  ForceEvaluation evaluate_;
+  std::function<bool()> interrupted_;
+  MassScaling scaling_;
+  StableStep critical_;
+  double dt_;
+  std::vector<Vec3> force_, x_prev_, v_prev_;
+  std::vector<double> field_stiffness_, field_damping_;
+  double t_prev_ = 0.0;
+};
+
+}  // namespace viscera::tissue

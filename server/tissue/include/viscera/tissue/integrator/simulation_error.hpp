@@ -1,0 +1,12 @@
+#pragma once
+#include <stdexcept>
+
+namespace viscera::tissue {
+
+/// Numerical failure detected while integrating (instability, non-convergence).
+class SimulationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace viscera::tissue

@@ -1,0 +1,41 @@
+#pragma once
+// From what a user states (elastic constants at a reference frequency, Q in shear and in bulk,
+// the band, the number of mechanisms) to what the GPS needs: the unrelaxed elasticity and the
+// memory-variable weights, shear and bulk sharing the relaxation frequencies. Also the
+// Kelvin-Voigt baseline matched at the reference frequency.
+#include <optional>
+#include <string>
+
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/viscoelastic/constant_q_fit.hpp"
+
+namespace viscera::tissue {
+
+struct ViscoelasticSpec {
+  enum class Model { constant_q, kelvin_voigt } model = Model::constant_q;
+  double shear_q = 4.8;
+  std::optional<double> bulk_q;  ///< none: the bulk response does not relax
+  double band_low_hz = 0.01, band_high_hz = 10.0;
+  int mechanisms = 3;
+  double reference_frequency_hz = 2.0;
+  double qlv_stiffening = 0.0;  ///< Fung's B (0: linear elastic response)
+  /// How the stiffening enters the GPS (GpsViscoelasticity::QlvForm): the published edge map or the
+  /// conservative energy form.
+  GpsViscoelasticity::QlvForm qlv_form = GpsViscoelasticity::QlvForm::edge_map;
+  double compression_ratio = 1.0;  ///< tension/compression asymmetry r (energy form only; 1: none)
+};
+
+struct ViscoelasticSetup {
+  Mat6 unrelaxed_elasticity;  ///< what the GPS is built with
+  GpsViscoelasticity gps;
+  ConstantQFit shear_fit;
+  std::optional<ConstantQFit> bulk_fit;  ///< none when the bulk is elastic or relaxes as the shear (bulk_q = shear_q)
+  std::string table;  ///< the fitted mechanisms, for the user
+};
+
+/// D_reference: elasticity at the reference frequency (|M| of the deviatoric and volumetric parts).
+/// Throws InputError naming `source` and the field for invalid values.
+ViscoelasticSetup make_viscoelastic(const Mat6& D_reference, const ViscoelasticSpec& spec,
+                                    const std::string& source = "viscoelasticity");
+
+}  // namespace viscera::tissue
