@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "viscera/common/percentile.hpp"
 #include "viscera/protocol/dds.hpp"
 
 namespace viscera::client {
@@ -301,11 +302,9 @@ LatencyStats Client::round_trip() const {
   LatencyStats s;
   s.samples = rtt_us_.size();
   if (rtt_us_.empty()) return s;
-  std::vector<double> v = rtt_us_;
-  std::sort(v.begin(), v.end());
-  s.p50_us = v[v.size() / 2];
-  s.p99_us = v[static_cast<std::size_t>(0.99 * static_cast<double>(v.size() - 1))];
-  s.max_us = v.back();
+  s.p50_us = common::percentile(rtt_us_, 0.5);
+  s.p99_us = common::percentile(rtt_us_, 0.99);
+  s.max_us = *std::max_element(rtt_us_.begin(), rtt_us_.end());
   return s;
 }
 

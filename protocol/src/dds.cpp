@@ -41,7 +41,7 @@ dds_qos_t* qos_for(Stream s) {
       break;
   }
   // A client that dies or goes silent loses its liveliness within this lease.
-  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(500));
+  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(kLivelinessLease.count()));
   return q;
 }
 }  // namespace

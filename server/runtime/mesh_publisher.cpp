@@ -6,14 +6,13 @@ namespace viscera::runtime {
 
 namespace proto = viscera::protocol;
 
-MeshPublisher::MeshPublisher(proto::Participant& participant, proto::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
+MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, proto::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
                              double rate_hz)
-    : topology_writer_(participant, proto::Stream::surface_topology),
-      frame_writer_(participant, proto::Stream::mesh_frame),
+    : stream_(std::move(stream)),
       nodes_(std::move(surface_nodes)),
       mesh_id_(topology.mesh_id),
       period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
-  topology_writer_.write(mesh_id_, proto::encode(topology));
+  stream_->write_topology(mesh_id_, proto::encode(topology));
   pending_.mesh_id = mesh_id_;
   pending_.positions.resize(3 * nodes_.size());
   thread_ = std::thread([this] {
@@ -69,7 +68,7 @@ void MeshPublisher::publish_loop() {
       ready_ = false;
     }
     try {
-      frame_writer_.write(mesh_id_, proto::encode(frame));
+      stream_->write_frame(mesh_id_, proto::encode(frame));
     } catch (const proto::DdsError&) {
       continue;  // a frame lost to the transport; the next one follows in 1/rate s
     }

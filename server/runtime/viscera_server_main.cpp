@@ -68,7 +68,9 @@ int main(int argc, char** argv) {
       std::printf("viscera-server: loading %s\n", scene.c_str());
       std::fflush(stdout);
     }
-    auto server = std::make_unique<viscera::runtime::SimulationServer>(viscera::runtime::read_scene_file(scene), scene_dir, budget);
+    const viscera::runtime::SceneSpec spec = viscera::runtime::read_scene_file(scene);
+    viscera::runtime::DdsEndpoints endpoints(spec.domain_id);
+    auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget);
     std::printf("viscera-server: %s\n", server->describe().c_str());
     std::fflush(stdout);
     g_running = true;

@@ -29,6 +29,10 @@ enum class Stream {
   event,               ///< reliable, keep last 64, volatile (server events and client annotations)
 };
 constexpr int kStreamCount = 8;
+
+/// The liveliness lease of every writer: a client or server silent this long is gone. The server
+/// also releases the instruments of an owner silent this long.
+inline constexpr std::chrono::milliseconds kLivelinessLease{500};
 const char* topic_name(Stream s);
 
 class Participant {

@@ -7,21 +7,22 @@
 // transient local, so clients that join later still get it.
 #include <condition_variable>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <span>
 #include <thread>
 #include <vector>
 
 #include "viscera/tissue/mesh/tet_mesh.hpp"
-#include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/messages.hpp"
+#include "viscera/runtime/server_endpoints.hpp"
 
 namespace viscera::runtime {
 
 class MeshPublisher {
  public:
   /// `surface_nodes[k]` is the mesh node of surface vertex k; `triangles` index surface vertices.
-  MeshPublisher(protocol::Participant& participant, protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
+  MeshPublisher(std::unique_ptr<MeshStream> stream, protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
                 double rate_hz);
   ~MeshPublisher();
   MeshPublisher(const MeshPublisher&) = delete;
@@ -36,7 +37,7 @@ class MeshPublisher {
  private:
   void publish_loop();
 
-  protocol::Writer topology_writer_, frame_writer_;
+  std::unique_ptr<MeshStream> stream_;
   std::vector<std::int32_t> nodes_;
   std::uint32_t mesh_id_;
   std::int64_t period_ns_, next_due_ns_ = 0;

@@ -12,6 +12,7 @@
 // made-up times. Not thread-safe; the physics thread owns it.
 #include <chrono>
 #include <cstdint>
+#include <thread>
 
 namespace viscera::runtime {
 
@@ -49,5 +50,19 @@ class TickGrid {
   Time slot_start_;
   std::uint64_t late_ = 0, missed_ = 0;
 };
+
+/// How long before a slot the physics thread stops sleeping and waits actively: the scheduler wakes
+/// a sleeping thread up to about 150 us late on the 2-vCPU VMs measured (docs/PERFORMANCE.md), which
+/// with a 0.9 ms tick (the 12k liver) makes it late.
+inline constexpr std::chrono::microseconds kSpinBeforeSlot{200};
+
+/// Waits until `next` on `Clock`: sleeps until kSpinBeforeSlot before it, then yields until it.
+template <class Clock>
+void wait_for_slot(typename Clock::time_point next) {
+  const auto now = Clock::now();
+  if (next <= now) return;
+  if (const auto early = next - kSpinBeforeSlot; early > now) std::this_thread::sleep_until(early);
+  while (Clock::now() < next) std::this_thread::yield();
+}
 
 }  // namespace viscera::runtime

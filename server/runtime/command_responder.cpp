@@ -1,0 +1,76 @@
+#include "viscera/runtime/command_responder.hpp"
+
+#include <Eigen/Geometry>
+
+namespace viscera::runtime {
+
+void add_grasp(ContactResult& result, const GraspHold::Reaction& r) {
+  result.force_on_tool += r.force_on_tool;
+  result.torque_on_tool += r.torque_on_tool;
+  result.in_contact = true;
+}
+
+std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance) {
+  if (!r.in_contact || r.deepest_triangle[0] < 0) return r.stiffness;
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> penalty(r.stiffness.data());
+  const double k_penalty = r.normal.dot(penalty * r.normal);
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const auto block = compliance.node(r.deepest_triangle[k]);
+    if (!block) return r.stiffness;
+    C += r.deepest_weights[k] * *block;
+  }
+  const double k = 1.0 / (1.0 / k_penalty + r.normal.dot(C * r.normal));
+  std::array<double, 9> out;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out[3 * i + j] = k * r.normal[i] * r.normal[j];
+  return out;
+}
+
+protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, const protocol::Command& command, const ContactResult& r,
+                              const std::array<double, 9>& stiffness, std::int64_t server_stamp_ns, std::int64_t step_time_ns) {
+  protocol::Force f;
+  f.instrument_id = instrument_id;
+  f.client_id = owner;
+  f.command_seq = command.seq;
+  f.command_client_stamp_ns = command.client_stamp_ns;
+  f.server_stamp_ns = server_stamp_ns;
+  f.step_time_ns = step_time_ns;
+  f.force = {r.force_on_tool.x(), r.force_on_tool.y(), r.force_on_tool.z()};
+  f.torque = {r.torque_on_tool.x(), r.torque_on_tool.y(), r.torque_on_tool.z()};
+  f.in_contact = r.in_contact;
+  f.contact_point = {r.point.x(), r.point.y(), r.point.z()};
+  f.contact_normal = {r.normal.x(), r.normal.y(), r.normal.z()};
+  f.stiffness = stiffness;
+  f.penetration_m = r.depth_m;
+  return f;
+}
+
+void CommandResponder::set_instruments(const std::vector<InstrumentSpec>& instruments, const std::vector<tissue::Triangle>& surface,
+                                       std::span<const Vec3> rest, double contact_stiffness_n_per_m) {
+  queries_.clear();
+  for (const auto& s : instruments) queries_[s.id] = std::make_unique<ProbeContact>(surface, rest, s.tip_radius_m, contact_stiffness_n_per_m);
+}
+
+void CommandResponder::publish(std::shared_ptr<const Snapshot> snapshot) {
+  std::lock_guard lock(mutex_);
+  snapshot_ = std::move(snapshot);
+}
+
+std::shared_ptr<const Snapshot> CommandResponder::latest() const {
+  std::lock_guard lock(mutex_);
+  return snapshot_;
+}
+
+ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c) const {
+  const auto snap = latest();
+  const Vec3 tip(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
+  ContactResult result = queries_.at(instrument_id)->query(tip, snap->x);
+  if (const auto g = snap->grasped.find(instrument_id); g != snap->grasped.end() && !g->second.empty()) {
+    const Eigen::Quaterniond q = Eigen::Quaterniond(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]).normalized();
+    add_grasp(result, g->second.query(tip, q, snap->x));
+  }
+  return result;
+}
+
+}  // namespace viscera::runtime

@@ -1,0 +1,30 @@
+#include "viscera/runtime/server_endpoints.hpp"
+
+namespace viscera::runtime {
+
+namespace proto = viscera::protocol;
+
+namespace {
+class DdsMeshStream final : public MeshStream {
+ public:
+  explicit DdsMeshStream(proto::Participant& p) : topology_(p, proto::Stream::surface_topology), frames_(p, proto::Stream::mesh_frame) {}
+  void write_topology(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) override { topology_.write(mesh_id, payload); }
+  void write_frame(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) override { frames_.write(mesh_id, payload); }
+
+ private:
+  proto::Writer topology_, frames_;
+};
+}  // namespace
+
+DdsEndpoints::DdsEndpoints(std::uint32_t domain_id)
+    : participant_(domain_id),
+      commands_(participant_, proto::Stream::instrument_command),
+      sessions_(participant_, proto::Stream::session_request),
+      forces_(participant_, proto::Stream::force_feedback),
+      scene_(participant_, proto::Stream::scene_state),
+      telemetry_(participant_, proto::Stream::telemetry),
+      events_(participant_, proto::Stream::event) {}
+
+std::unique_ptr<MeshStream> DdsEndpoints::open_mesh_stream() { return std::make_unique<DdsMeshStream>(participant_); }
+
+}  // namespace viscera::runtime

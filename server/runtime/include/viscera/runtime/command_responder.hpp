@@ -1,0 +1,58 @@
+#pragma once
+// How commands are answered: the command thread answers every command the moment it arrives with
+// the reaction at the commanded pose on the newest published state (a Snapshot), so the round trip
+// never waits for a physics step; the physics thread publishes a snapshot after every tick. The
+// answer carries the local force model (docs/PROTOCOL.md, "The local force model"): the contact's
+// force, point, normal and stiffness, the penalty in series with the tissue condensed onto it.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "viscera/protocol/messages.hpp"
+#include "viscera/runtime/contact_compliance.hpp"
+#include "viscera/runtime/grasp_hold.hpp"
+#include "viscera/runtime/probe_contact.hpp"
+#include "viscera/runtime/scene_file.hpp"
+
+namespace viscera::runtime {
+
+/// The organ after a tick and the tissue each grasper holds; never changed once published.
+struct Snapshot {
+  std::vector<Vec3> x;
+  std::map<std::uint32_t, GraspHold> grasped;
+};
+
+/// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.
+void add_grasp(ContactResult& result, const GraspHold::Reaction& reaction);
+
+/// The local force model's stiffness: the contact penalty in series with the tissue condensed onto
+/// the contact, along the contact normal (the contact is frictionless); the penalty alone (an upper
+/// bound) until the tissue's compliance at the contact is known.
+std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance);
+
+/// The force message answering `command` of `owner`'s instrument.
+protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, const protocol::Command& command, const ContactResult& r,
+                              const std::array<double, 9>& stiffness, std::int64_t server_stamp_ns, std::int64_t step_time_ns);
+
+class CommandResponder {
+ public:
+  /// The instruments of a new organ: one contact query each (it keeps scratch space), on the
+  /// organ's surface and rest positions.
+  void set_instruments(const std::vector<InstrumentSpec>& instruments, const std::vector<tissue::Triangle>& surface,
+                       std::span<const Vec3> rest, double contact_stiffness_n_per_m);
+  /// Physics thread, after each tick.
+  void publish(std::shared_ptr<const Snapshot> snapshot);
+  std::shared_ptr<const Snapshot> latest() const;
+  /// Command thread: the reaction on `instrument_id` at the commanded pose on the newest snapshot.
+  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command) const;
+
+ private:
+  std::map<std::uint32_t, std::unique_ptr<ProbeContact>> queries_;
+  mutable std::mutex mutex_;  // guards the snapshot pointer only
+  std::shared_ptr<const Snapshot> snapshot_;
+};
+
+}  // namespace viscera::runtime

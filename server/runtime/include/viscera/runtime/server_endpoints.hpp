@@ -1,0 +1,59 @@
+#pragma once
+// What the server reads from its clients and writes to them, as payloads (FlatBuffers, verified
+// by the server). DdsEndpoints is the real one, over Cyclone DDS (protocol/); a test or a lockstep
+// driver passes its own, so the server's logic runs without a network.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+
+#include "viscera/protocol/dds.hpp"
+
+namespace viscera::runtime {
+
+/// One organ's surface: its topology (late joiners get it) and its frames. A new scene opens a new
+/// stream and closes the old, so a late joiner gets only the current surface.
+class MeshStream {
+ public:
+  virtual ~MeshStream() = default;
+  virtual void write_topology(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) = 0;
+  virtual void write_frame(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) = 0;
+};
+
+class ServerEndpoints {
+ public:
+  using Take = std::function<void(const protocol::Received&)>;
+  virtual ~ServerEndpoints() = default;
+  /// Instrument commands that arrived, each passed to `f`; returns how many.
+  virtual int take_commands(const Take& f) = 0;
+  /// Blocks until a command may be there or the timeout passes.
+  virtual bool wait_commands(std::chrono::nanoseconds timeout) = 0;
+  virtual int take_session_requests(const Take& f) = 0;
+  virtual void write_force(std::uint32_t instrument_id, std::span<const std::uint8_t> payload) = 0;
+  virtual void write_scene(std::span<const std::uint8_t> payload) = 0;
+  virtual void write_telemetry(std::span<const std::uint8_t> payload) = 0;
+  virtual void write_event(std::span<const std::uint8_t> payload) = 0;
+  virtual std::unique_ptr<MeshStream> open_mesh_stream() = 0;
+};
+
+/// The server's endpoints on a DDS domain: one participant, the streams' QoS of docs/PROTOCOL.md.
+class DdsEndpoints final : public ServerEndpoints {
+ public:
+  explicit DdsEndpoints(std::uint32_t domain_id);
+  int take_commands(const Take& f) override { return commands_.take(f); }
+  bool wait_commands(std::chrono::nanoseconds timeout) override { return commands_.wait(timeout); }
+  int take_session_requests(const Take& f) override { return sessions_.take(f); }
+  void write_force(std::uint32_t instrument_id, std::span<const std::uint8_t> p) override { forces_.write(instrument_id, p); }
+  void write_scene(std::span<const std::uint8_t> p) override { scene_.write(0, p); }
+  void write_telemetry(std::span<const std::uint8_t> p) override { telemetry_.write(0, p); }
+  void write_event(std::span<const std::uint8_t> p) override { events_.write(0, p); }
+  std::unique_ptr<MeshStream> open_mesh_stream() override;
+
+ private:
+  protocol::Participant participant_;
+  protocol::Reader commands_, sessions_;
+  protocol::Writer forces_, scene_, telemetry_, events_;
+};
+
+}  // namespace viscera::runtime
