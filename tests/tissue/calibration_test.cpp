@@ -1,4 +1,4 @@
-// The GPS equals linear FE at small strain (MODEL.md section 1), and the paper's calibration
+// The GPS equals linear FE at small strain (docs/MODEL.md section 1), and the paper's calibration
 // route agrees with the pseudo-inverse route.
 #include <gtest/gtest.h>
 

@@ -77,7 +77,7 @@ TEST(ConstantQFit, FourMechanismsWithin8Percent) {
   const ConstantQFit o = fit_constant_q(paper_target(4));
   std::cout << "[ figure ] 4 mechanisms: Q " << o.q_min << ".." << o.q_max << " (max error " << 100 * o.max_relative_error << "%)\n";
   EXPECT_LT(o.max_relative_error, 0.08);
-  // The unrelaxed modulus sets the explicit step: about 1.5 |G(2 Hz)| (MODEL.md).
+  // The unrelaxed modulus sets the explicit step: about 1.5 |G(2 Hz)| (docs/MODEL.md).
   EXPECT_NEAR(o.solids.unrelaxed_modulus_pa / 1e3, 1.5, 0.1);
   EXPECT_NEAR(std::abs(o.solids.complex_modulus(2 * M_PI * 2.0)), 1e3, 1e-9);
 }

@@ -459,7 +459,7 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double d
 Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi,
                         const Vec6* dphi_de) const {
   // f = P t with P_e = (+Y_e at a, -Y_e at b), t = S h, h = H dL, dL = G dx,
-  // G_e = (-y_e at a, +y_e at b), y_e = Y_e / L_e. K = -df/dx (see MODEL.md section 1).
+  // G_e = (-y_e at a, +y_e at b), y_e = Y_e / L_e. K = -df/dx (see docs/MODEL.md section 1).
   const auto p = gather(x, e);
   Mat6 H = stiffness_scale * packed_hessian(e);
   if (bulk_extra != 0.0 && !bulk_.empty()) {

@@ -1,5 +1,5 @@
 #pragma once
-// Rendering the server's local contact model at the device rate (HAPTICS.md section 2): between
+// Rendering the server's local contact model at the device rate (docs/HAPTICS.md section 2): between
 // server updates and across network delay the client renders F(x) = F0 - K (x - x0), with x0 the
 // tip position the server computed F0 for and K = -dF/dx, pushing only out of the tissue (along
 // the contact normal) and never beyond the device's force limit.
@@ -30,7 +30,7 @@ struct FadePolicy {
 
 /// Renders at the device rate from the newest local model. When a new model arrives the force
 /// blends from the previous model to the new one over `blend_s` (linearly in time) instead of
-/// jumping (HAPTICS.md section 2), and is limited to the device's maximum afterwards.
+/// jumping (docs/HAPTICS.md section 2), and is limited to the device's maximum afterwards.
 class LocalForceRenderer {
  public:
   explicit LocalForceRenderer(double max_force_n, double blend_s = 0.003, FadePolicy fade = {})

@@ -1,6 +1,6 @@
 #pragma once
 // The one wrapper of Cyclone DDS's C API in viscera: RAII entities, the envelope topic per
-// stream with its QoS (TRANSPORT.md), and typed writes/takes of FlatBuffer payloads. No other
+// stream with its QoS (docs/PROTOCOL.md), and typed writes/takes of FlatBuffer payloads. No other
 // code calls dds_* directly.
 #include <atomic>
 #include <chrono>

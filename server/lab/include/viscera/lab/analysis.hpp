@@ -1,5 +1,5 @@
 #pragma once
-// viscera-lab's method (MODEL.md section 4): fit the baseline, show where it is wrong (per test,
+// viscera-lab's method (docs/MODEL.md section 4): fit the baseline, show where it is wrong (per test,
 // on held-out tests), name the cause from candidate mechanisms whose held-out gain is clearly
 // above the noise of the data, extend the model, refit and measure the gain on held-out tests.
 #include <functional>

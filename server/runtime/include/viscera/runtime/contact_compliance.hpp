@@ -1,6 +1,6 @@
 #pragma once
 // The organ's compliance at its surface nodes, for the local force model's stiffness
-// (HAPTICS.md section 2): a client renders F(x) = F0 - K (x - x0) between server updates, and K
+// (docs/HAPTICS.md section 2): a client renders F(x) = F0 - K (x - x0) between server updates, and K
 // must be the contact's stiffness, the tissue in series with the contact penalty, not the penalty
 // alone (which would feel like a rigid wall at every update and a soft organ in between).
 //

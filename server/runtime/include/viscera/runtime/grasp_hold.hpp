@@ -1,5 +1,5 @@
 #pragma once
-// The tissue held by a grasper's closed jaws (HAPTICS.md, "Grasper"): the surface nodes within the
+// The tissue held by a grasper's closed jaws (docs/HAPTICS.md, "Grasper"): the surface nodes within the
 // grasp radius of the tip when the jaws closed, each tied by a spring of stiffness k to the point
 // it had in the tool's frame then. The points move and turn with the tool, so lifting pulls the
 // tissue and twisting the tool twists it; the tool feels the springs' reaction as a force and as a

@@ -1,7 +1,7 @@
 #pragma once
 // Publishes the organ's deformed surface at 30-60 Hz from a thread of its own, so that encoding
-// and writing 100 kB-1 MB frames never delays the physics loop (TRANSPORT.md: "never write from
-// the physics thread"). The physics thread only offers its state: when a frame is due, it copies
+// and writing 100 kB-1 MB frames never delays the physics loop (docs/PROTOCOL.md: never write from
+// the physics thread). The physics thread only offers its state: when a frame is due, it copies
 // the surface positions into a hand-over buffer, and if the publisher is still busy with that
 // buffer it skips the frame instead of waiting. The topology is published once, reliably and
 // transient local, so clients that join later still get it.

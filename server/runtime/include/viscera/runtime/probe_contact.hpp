@@ -1,5 +1,5 @@
 #pragma once
-// Contact of a sphere-tipped probe with the organ's boundary triangles (HAPTICS.md, "Probe").
+// Contact of a sphere-tipped probe with the organ's boundary triangles (docs/HAPTICS.md, "Probe").
 // For every triangle, the closest point q to the tip centre c and the signed distance
 // s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r.
 // The contact is one penalty spring k at the deepest penetration d, its force k d shared among

@@ -1,6 +1,6 @@
 #pragma once
 // Geometry of one linear tetrahedron: volume, shape-function gradients, the linear FE
-// strain-displacement matrix and the edge-elongation Jacobian of MODEL.md section 1.
+// strain-displacement matrix and the edge-elongation Jacobian of docs/MODEL.md section 1.
 //
 // Conventions used everywhere in the core:
 //  - vertex order 0..3 with signed volume ((x1-x0) x (x2-x0)) . (x3-x0) / 6 > 0;
@@ -56,7 +56,7 @@ Mat6x12 strain_displacement(const Mat3& dm_inv);
 Mat12 linear_fe_stiffness(const std::array<Eigen::Vector3d, 4>& x, const Mat6& D);
 
 /// Edge-elongation Jacobian J (6x12): dL = J u for small u. Row e holds -n_e at vertex a and
-/// +n_e at vertex b, n_e = Y_e / |Y_e| (MODEL.md section 1).
+/// +n_e at vertex b, n_e = Y_e / |Y_e| (docs/MODEL.md section 1).
 Mat6x12 elongation_jacobian(const std::array<Eigen::Vector3d, 4>& x);
 
 /// Gradient of the signed volume with respect to the 12 vertex coordinates.

@@ -1,5 +1,5 @@
 #pragma once
-// Linear-tetrahedron finite elements, the two comparison models of MODEL.md section 1:
+// Linear-tetrahedron finite elements, the two comparison models of docs/MODEL.md section 1:
 //  - linear:       small-strain FE, f = -K (x - X). Not rotation invariant.
 //  - corotational: f = -R K (R^T x - X), R the rotation of the polar decomposition of F.
 // Both are evaluated stress-first (F, strain, D strain, P = R sigma, f_i = -V P grad N_i),

@@ -1,5 +1,5 @@
 #pragma once
-// Fung's exponential stiffening of an edge strain e (MODEL.md section 4), in two forms:
+// Fung's exponential stiffening of an edge strain e (docs/MODEL.md section 4), in two forms:
 //  - the edge map g(e) = (exp(B e) - 1) / B (the published QLV elastic response, applied to each
 //    edge: exact in 1D, but in a tetrahedron t = H g is not the gradient of an energy);
 //  - the energy map h(e) = e sqrt(phi(B e)), phi(x) = 2 (e^x - 1 - x) / x^2, chosen so that

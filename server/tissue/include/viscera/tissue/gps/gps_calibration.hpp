@@ -1,6 +1,6 @@
 #pragma once
 // Calibration of the generalized particle system's 36 constants per tetrahedron from linear FE
-// (MODEL.md section 1; the paper, section 3). Edge tensions t = C dL with C = diag(1/L0) H.
+// (docs/MODEL.md section 1; the paper, section 3). Edge tensions t = C dL with C = diag(1/L0) H.
 #include <array>
 
 #include "viscera/tissue/element/tet_geometry.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// The generalized particle system (the paper's Eq. (1), MODEL.md section 1): every edge of a
+// The generalized particle system (the paper's Eq. (1), docs/MODEL.md section 1): every edge of a
 // tetrahedron carries a tension that depends on all six edge elongations,
 //     t = C dL,   C = diag(1/L0) H   (36 constants per tet, calibrated to linear FE),
 // and pushes its ends with +t_e Y_e (vertex a) and -t_e Y_e (vertex b).
@@ -19,7 +19,7 @@ namespace viscera::tissue {
 
 enum class GpsVariant { paper, energy_consistent };
 
-/// Viscoelasticity of the GPS (MODEL.md section 3). With memory variables the elasticity matrices
+/// Viscoelasticity of the GPS (docs/MODEL.md section 3). With memory variables the elasticity matrices
 /// given to the model are the UNRELAXED ones; every tetrahedron keeps per mechanism a 6-vector
 /// zeta_l of filtered edge elongations (d zeta_l / dt = w_l (dL - zeta_l), updated exactly), and
 /// the tension becomes t = S [H_dev (dL - sum Y^s_l zeta_l) + H_vol (dL - sum Y^b_l zeta_l)].

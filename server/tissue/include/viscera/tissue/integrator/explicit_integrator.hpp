@@ -1,5 +1,5 @@
 #pragma once
-// Explicit symplectic Euler (MODEL.md section 2): v += dt M^-1 (f_int + f_ext);
+// Explicit symplectic Euler (docs/MODEL.md section 2): v += dt M^-1 (f_int + f_ext);
 // v *= exp(-alpha dt) (mass-proportional damping, integrated exactly); x += dt v.
 // The step is the computed critical step times a safety factor, never a guess.
 #include <functional>

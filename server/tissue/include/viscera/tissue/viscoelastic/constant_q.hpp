@@ -1,5 +1,5 @@
 #pragma once
-// Kjartansson's (1979) exact constant-Q model (MODEL.md section 3): complex modulus
+// Kjartansson's (1979) exact constant-Q model (docs/MODEL.md section 3): complex modulus
 // M(w) = M0 (i w / w0)^(2 gamma), gamma = arctan(1/Q) / pi, so that tan(delta) = 1/Q at every
 // frequency. M0 = |M| at the reference frequency w0.
 #include <complex>

@@ -1,6 +1,6 @@
 #pragma once
 // Fit of L standard linear solids (memory variables) to a constant Q over a frequency band
-// (MODEL.md section 3). Relaxation frequencies and weights are both optimised, for the smallest
+// (docs/MODEL.md section 3). Relaxation frequencies and weights are both optimised, for the smallest
 // largest relative error of Q over the band, so that 3 mechanisms reach about +-17% and 4 about
 // +-7% for Q = 4.8 over 0.01-10 Hz (fixed log-spaced placement: about -17%/+36% for 3).
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 // L standard linear solids in parallel, written with memory variables (Emmerich & Korn 1987;
-// MODEL.md section 3):
+// docs/MODEL.md section 3):
 //     sigma = M_U (eps - sum_l Y_l zeta_l),   d zeta_l / dt = w_l (eps - zeta_l).
 // Complex modulus M(w) = M_U (1 - sum_l Y_l w_l / (w_l + i w)); relaxed modulus
 // M_R = M_U (1 - sum_l Y_l). Closed-form relaxation and creep for the tests and the lab.
