@@ -308,4 +308,4 @@ LatencyStats Client::round_trip() const {
   return s;
 }
 
-}  // namespace viscera::client
+}  // namespace viscera::commonent

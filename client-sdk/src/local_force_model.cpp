@@ -81,4 +81,4 @@ double LocalForceRenderer::model_age_s(double t_s) const {
   return has_new_ ? t_s - arrived_s_ : std::numeric_limits<double>::infinity();
 }
 
-}  // namespace viscera::client
+}  // namespace viscera::commonent

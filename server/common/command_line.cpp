@@ -5,7 +5,7 @@
 #include <iostream>
 #include <sstream>
 
-namespace viscera::cli {
+namespace viscera::common {
 
 CommandLine::CommandLine(std::string program, std::string summary)
     : program_(std::move(program)), summary_(std::move(summary)) {}
@@ -23,7 +23,7 @@ void CommandLine::option_switch(const std::string& name, const std::string& help
 
 std::string CommandLine::help() const {
   std::ostringstream s;
-  s << "Usage: " << program_ << " [options]\n\n" << summary_ << "\n\nOptions:\n";
+  s << "Usage: " << (usage_.empty() ? program_ + " [options]" : usage_) << "\n\n" << summary_ << "\n\nOptions:\n";
   for (const auto& name : order_) {
     const Flag& f = flags_.at(name);
     std::string left = "  --" + name + (f.is_switch ? "" : " " + f.value_name);
@@ -124,4 +124,4 @@ std::vector<double> CommandLine::numbers(const std::string& name, std::size_t co
   return out;
 }
 
-}  // namespace viscera::cli
+}  // namespace viscera::common

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "viscera/lab/golden_section.hpp"
+
 #include <Eigen/Dense>
 
 namespace viscera::lab {
@@ -101,26 +103,14 @@ void search(MaterialModel& m, const Problem& p, const Nonlinear& q) {
       best_u = u;
     }
   }
-  double a = std::max(ulo, best_u - (uhi - ulo) / (grid - 1)), b = std::min(uhi, best_u + (uhi - ulo) / (grid - 1));
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c = b - g * (b - a), d = a + g * (b - a);
-  *q.value = at(c);
-  double fc = solve_linear(m, p);
-  *q.value = at(d);
-  double fd = solve_linear(m, p);
-  for (int it = 0; it < 30; ++it) {
-    if (fc < fd) {
-      b = d, d = c, fd = fc, c = b - g * (b - a);
-      *q.value = at(c);
-      fc = solve_linear(m, p);
-    } else {
-      a = c, c = d, fc = fd, d = a + g * (b - a);
-      *q.value = at(d);
-      fd = solve_linear(m, p);
-    }
-  }
-  *q.value = at(fc < fd ? c : d);
-  if (std::min(fc, fd) > best) *q.value = at(best_u);
+  const double a = std::max(ulo, best_u - (uhi - ulo) / (grid - 1)), b = std::min(uhi, best_u + (uhi - ulo) / (grid - 1));
+  const Minimum refined = golden_section(
+      [&](double u) {
+        *q.value = at(u);
+        return solve_linear(m, p);
+      },
+      a, b, 0.0, 30);
+  *q.value = at(refined.f > best ? best_u : refined.x);
   solve_linear(m, p);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "viscera/lab/golden_section.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
@@ -117,22 +118,6 @@ std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, do
   return stress;
 }
 
-/// Golden-section search of a unimodal f on [lo, hi]; returns the argument of the minimum.
-double golden_section(const std::function<double(double)>& f, double lo, double hi, double tolerance) {
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-  double f1 = f(x1), f2 = f(x2);
-  for (int it = 0; it < 40 && hi - lo > tolerance; ++it) {
-    if (f1 < f2) {
-      hi = x2, x2 = x1, f2 = f1;
-      x1 = hi - g * (hi - lo), f1 = f(x1);
-    } else {
-      lo = x1, x1 = x2, f1 = f2;
-      x2 = lo + g * (hi - lo), f2 = f(x2);
-    }
-  }
-  return f1 < f2 ? x1 : x2;
-}
 
 }  // namespace
 
@@ -179,10 +164,11 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   // stretched specimen are compressed (and those of a compressed one stretched).
   for (int round = 0; round < 2; ++round) {
     if (stiffens && !tension.empty())
-      c.gps_b = golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, 1.5 * c.law_b, 1e-4 * c.law_b);
+      c.gps_b = golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, 1.5 * c.law_b, 1e-4 * c.law_b).x;
     if (asymmetric && !compression.empty())
       c.gps_r = std::exp(golden_section([&](double lr) { return mismatch(c.gps_b, std::exp(lr), compression); }, std::log(c.law_r / 4),
-                                        std::log(c.law_r * 4), 1e-4));
+                                        std::log(c.law_r * 4), 1e-4)
+                             .x);
     if (!(stiffens && asymmetric)) break;
   }
   c.mismatch = mismatch(c.gps_b, c.gps_r, all);

@@ -30,7 +30,7 @@ void on_signal(int sig) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  viscera::cli::CommandLine cl("viscera-server",
+  viscera::common::CommandLine cl("viscera-server",
       "Runs the tissue simulation of a scene (organ mesh, material, instruments; docs/SCENE.md) at its physics rate\n"
       "and serves instruments over Cyclone DDS (domain from the scene; configuration from CYCLONEDDS_URI, see\n"
       "deploy/cyclonedds.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n"
@@ -51,12 +51,12 @@ int main(int argc, char** argv) {
     if (cl.has("scene-dir")) {
       scene_dir = cl.text("scene-dir");
       if (!std::filesystem::is_directory(scene_dir))
-        throw viscera::cli::UsageError("--scene-dir: '" + scene_dir + "' is not a directory");
+        throw viscera::common::UsageError("--scene-dir: '" + scene_dir + "' is not a directory");
     }
     duration = cl.number_in("duration", 0.0, 1e9);
     budget.max_tick_s = 1e-3 * cl.number_in("max-tick-ms", 0.1, 10000);
     quiet = cl.has("quiet");
-  } catch (const viscera::cli::UsageError& e) {
+  } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
     return 2;
   }

@@ -104,7 +104,7 @@ struct Options {
   bool quiet = false, watch_mesh = false, reconnect = false;
 };
 
-Options parse(viscera::cli::CommandLine& cl) {
+Options parse(viscera::common::CommandLine& cl) {
   Options o;
   o.domain = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
   o.client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
@@ -118,14 +118,14 @@ Options parse(viscera::cli::CommandLine& cl) {
   o.fade.stale_after_s = cl.number_in("stale-after", 0.001, 5);
   o.script = cl.text("script");
   o.frame = cl.text("frame");
-  if (o.script != "press" && o.script != "grasp") throw viscera::cli::UsageError("--script: '" + o.script + "' is not press or grasp");
-  if (o.frame != "scene" && o.frame != "organ-top") throw viscera::cli::UsageError("--frame: '" + o.frame + "' is not scene or organ-top");
+  if (o.script != "press" && o.script != "grasp") throw viscera::common::UsageError("--script: '" + o.script + "' is not press or grasp");
+  if (o.frame != "scene" && o.frame != "organ-top") throw viscera::common::UsageError("--frame: '" + o.frame + "' is not scene or organ-top");
   if (cl.has("trajectory")) {  // before connecting: a bad file fails at once
     o.trajectory_file = cl.text("trajectory");
     try {
       o.trajectory = viscera::haptic::read_trajectory(o.trajectory_file);
     } catch (const std::runtime_error& e) {
-      throw viscera::cli::UsageError(e.what());
+      throw viscera::common::UsageError(e.what());
     }
   }
   o.duration_s = cl.has("duration") ? cl.number_in("duration", 0.1, 36000) : o.trajectory.empty() ? 4.0 : o.trajectory.back().t_s;
@@ -292,7 +292,7 @@ void write_report(const Options& o, const std::string& scene, const std::string&
 }  // namespace
 
 int main(int argc, char** argv) {
-  viscera::cli::CommandLine cl("haptic-client",
+  viscera::common::CommandLine cl("haptic-client",
       "A haptic device client: claims an instrument of a running viscera-server and drives it from a virtual device.\n"
       "Script 'press': the probe starts 1 cm above the organ at the centre of its top and moves down until the\n"
       "server reports contact, presses DEPTH further by mid-run and comes back to the contact height by the end.\n"
@@ -356,7 +356,7 @@ int main(int argc, char** argv) {
       return 4;
     }
     return 0;
-  } catch (const viscera::cli::UsageError& e) {
+  } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "haptic-client: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

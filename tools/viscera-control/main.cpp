@@ -70,7 +70,7 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
 }  // namespace
 
 int main(int argc, char** argv) {
-  viscera::cli::CommandLine cl("viscera-control",
+  viscera::common::CommandLine cl("viscera-control",
       "Session control of a running viscera-server. ACTION is one of\n"
       "  pause           the organ stops; forces are still answered from its frozen state\n"
       "  resume, reset   reset: the organ back at rest, graspers let go\n"
@@ -98,15 +98,15 @@ int main(int argc, char** argv) {
     if (!cl.parse(argc, argv)) return 0;
     const auto& rest = cl.positional();
     const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, health, events or annotate TEXT";
-    if (rest.empty()) throw viscera::cli::UsageError("missing ACTION (" + actions + ")");
+    if (rest.empty()) throw viscera::common::UsageError("missing ACTION (" + actions + ")");
     const std::string action = rest[0];
     const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false}, {"load", true}, {"material", false},
                                                {"rate", true},   {"show", false},   {"health", false}, {"events", false}, {"annotate", true}};
     const auto k = known.find(action);
-    if (k == known.end()) throw viscera::cli::UsageError("ACTION '" + action + "' is not " + actions);
+    if (k == known.end()) throw viscera::common::UsageError("ACTION '" + action + "' is not " + actions);
     if (k->second != (rest.size() == 2))
-      throw viscera::cli::UsageError(k->second ? action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
-    if (action == "annotate" && rest[1].size() > 1024) throw viscera::cli::UsageError("TEXT is " + std::to_string(rest[1].size()) + " bytes (at most 1024)");
+      throw viscera::common::UsageError(k->second ? action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
+    if (action == "annotate" && rest[1].size() > 1024) throw viscera::common::UsageError("TEXT is " + std::to_string(rest[1].size()) + " bytes (at most 1024)");
     viscera::protocol::MaterialChange change;
     const auto material_flag = [&](const char* name, double lo, double hi, std::optional<double>& out) {
       if (cl.has(name)) out = cl.number_in(name, lo, hi);
@@ -117,20 +117,20 @@ int main(int argc, char** argv) {
     material_flag("shear-q", 0.5, 1e4, change.shear_q);
     material_flag("damping-per-s", 0.0, 1e4, change.damping_per_s);
     if ((action == "material") != !change.empty())
-      throw viscera::cli::UsageError(action == "material" ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
+      throw viscera::common::UsageError(action == "material" ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
                                                           : "material flags are for the material action");
     if (action == "load") {
       const std::string& n = rest[1];
       const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' &&
                          std::all_of(n.begin(), n.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
-      if (!plain) throw viscera::cli::UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
+      if (!plain) throw viscera::common::UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
     }
     double rate_hz = 0;
     if (action == "rate") {
       char* end = nullptr;
       rate_hz = std::strtod(rest[1].c_str(), &end);
       if (*end || !(rate_hz >= 10 && rate_hz <= 10000) || rate_hz != std::floor(rate_hz))
-        throw viscera::cli::UsageError("rate '" + rest[1] + "' is not a whole number of hertz in [10, 10000]");
+        throw viscera::common::UsageError("rate '" + rest[1] + "' is not a whole number of hertz in [10, 10000]");
     }
     const double duration = cl.number_in("duration", 0.1, 1e6);
     const auto timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
                 scene->preparing.c_str());
     for (const auto& u : scene->unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
     return 0;
-  } catch (const viscera::cli::UsageError& e) {
+  } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-control: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -12,7 +12,7 @@ using namespace viscera::common;
 
 int main(int argc, char** argv) {
   try {
-    viscera::cli::CommandLine cl("viscera-figure2",
+    viscera::common::CommandLine cl("viscera-figure2",
         "Reproduces Figure 2 of Gross & Buess (2001): a 10 cm block (rho 1e3 kg/m^3, |G| = 1e3 Pa at 2 Hz,\n"
         "Q = 4.8) sheared by 1 Pa for 1 s, then released. Writes the top displacement [m] of the exact\n"
         "constant-Q solution, the memory-variable simulations (1D column and 3D GPS block) and a\n"
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
                                {"Kelvin-Voigt (one relaxation time)", r.time_s, mm(r.kelvin_voigt_m), "#1f77b4", "10 5", 1.6}}});
     std::printf("wrote %s and %s\n", csv.c_str(), cl.text("svg").c_str());
     return 0;
-  } catch (const viscera::cli::UsageError& e) {
+  } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-figure2: %s\n", e.what());
     return 2;
   } catch (const InputError& e) {

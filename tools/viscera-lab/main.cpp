@@ -6,6 +6,7 @@
 #include <cstring>
 #include <string>
 
+#include "viscera/common/command_line.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/decimation.hpp"
 #include "viscera/common/input_error.hpp"
@@ -14,49 +15,35 @@
 
 using namespace viscera::lab;
 
-namespace {
-const char* kHelp =
-    "Usage: viscera-lab analyze DATASET_DIR --out OUT_DIR\n"
-    "       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR\n\n"
-    "analyze: fits the baseline (linear elasticity + Kelvin-Voigt damping) to the data set, shows where it is wrong\n"
-    "  (per test, and on tests left out of the fit), names the cause among broadband_relaxation, strain_stiffening,\n"
-    "  tension_compression_asymmetry and first_load_softening (accepted only if the held-out gain is clearly above the\n"
-    "  noise of the data), extends the model, refits, and writes OUT_DIR/report.json, report.md (with SVG plots) and\n"
-    "  model.json.\n"
-    "predict: runs a fitted model.json on another data set and writes OUT_DIR/report.json with per-test RMS errors.\n\n"
-    "Data set format: README.md, section \"The data a user brings\". Units are SI.\n\n"
-    "Options:\n  --out DIR   output folder (required)\n  --quiet     no progress lines\n  --help      this text\n";
-
-int usage_error(const std::string& what) {
-  std::fprintf(stderr, "viscera-lab: %s (see --help)\n", what.c_str());
-  return 2;
-}
-}  // namespace
-
 int main(int argc, char** argv) {
-  std::vector<std::string> positional;
-  std::string out;
-  bool quiet = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    } else if (a == "--out") {
-      if (i + 1 >= argc) return usage_error("--out needs a folder");
-      out = argv[++i];
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (a.starts_with("--")) {
-      return usage_error("unknown option " + a);
-    } else {
-      positional.push_back(a);
-    }
-  }
-  if (positional.empty()) return usage_error("missing command (analyze or predict)");
-  if (out.empty()) return usage_error("--out OUT_DIR is required");
+  viscera::common::CommandLine cl("viscera-lab",
+      "analyze: fits the baseline (linear elasticity + Kelvin-Voigt damping) to the data set, shows where it is wrong\n"
+      "  (per test, and on tests left out of the fit), names the cause among broadband_relaxation, strain_stiffening,\n"
+      "  tension_compression_asymmetry and first_load_softening (accepted only if the held-out gain is clearly above the\n"
+      "  noise of the data), extends the model, refits, and writes OUT_DIR/report.json, report.md (with SVG plots) and\n"
+      "  model.json.\n"
+      "predict: runs a fitted model.json on another data set and writes OUT_DIR/report.json with per-test RMS errors.\n\n"
+      "Data set format: README.md, section \"The data a user brings\". Units are SI. Progress lines go to stderr.");
+  cl.usage("viscera-lab analyze DATASET_DIR --out OUT_DIR\n       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR");
+  cl.flag("out", "DIR", "output folder (required)");
+  cl.option_switch("quiet", "no progress lines");
+  cl.allow_positional(3);
+  const auto usage_error = [](const std::string& what) {
+    std::fprintf(stderr, "viscera-lab: %s (see --help)\n", what.c_str());
+    return 2;
+  };
   try {
-    const auto t0 = std::chrono::steady_clock::now();
+    if (!cl.parse(argc, argv)) return 0;
+  } catch (const viscera::common::UsageError& e) {
+    std::fprintf(stderr, "viscera-lab: %s\n", e.what());
+    return 2;
+  }
+  const auto& positional = cl.positional();
+  if (positional.empty()) return usage_error("missing command (analyze or predict)");
+  if (!cl.has("out")) return usage_error("--out OUT_DIR is required");
+  const std::string out = cl.text("out");
+  const bool quiet = cl.has("quiet");
+  try {    const auto t0 = std::chrono::steady_clock::now();
     if (positional[0] == "analyze") {
       if (positional.size() != 2) return usage_error("analyze takes one DATASET_DIR");
       const Dataset d = read_dataset(positional[1]);

@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::int32_t> fixed_nodes(const viscera::cli::CommandLine& cl, const TetMesh& mesh) {
+std::vector<std::int32_t> fixed_nodes(const viscera::common::CommandLine& cl, const TetMesh& mesh) {
   std::vector<std::int32_t> fixed;
   const auto box_of = [&](const std::string& flag) {
     const auto v = cl.numbers(flag, 6);
@@ -39,18 +39,18 @@ std::vector<std::int32_t> fixed_nodes(const viscera::cli::CommandLine& cl, const
     const std::string spec = cl.text("fix-slab");
     const auto c1 = spec.find(','), c2 = spec.find(',', c1 + 1);
     if (c1 == std::string::npos || c2 == std::string::npos)
-      throw viscera::cli::UsageError("--fix-slab: expected AXIS,SIDE,FRACTION such as y,max,0.1; got '" + spec + "'");
+      throw viscera::common::UsageError("--fix-slab: expected AXIS,SIDE,FRACTION such as y,max,0.1; got '" + spec + "'");
     const std::string axis = spec.substr(0, c1), side = spec.substr(c1 + 1, c2 - c1 - 1);
     const int a = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
-    if (a < 0) throw viscera::cli::UsageError("--fix-slab: axis '" + axis + "' is not x, y or z");
-    if (side != "min" && side != "max") throw viscera::cli::UsageError("--fix-slab: side '" + side + "' is not min or max");
+    if (a < 0) throw viscera::common::UsageError("--fix-slab: axis '" + axis + "' is not x, y or z");
+    if (side != "min" && side != "max") throw viscera::common::UsageError("--fix-slab: side '" + side + "' is not min or max");
     double fraction = 0;
     try {
       fraction = std::stod(spec.substr(c2 + 1));
     } catch (...) {
-      throw viscera::cli::UsageError("--fix-slab: fraction '" + spec.substr(c2 + 1) + "' is not a number");
+      throw viscera::common::UsageError("--fix-slab: fraction '" + spec.substr(c2 + 1) + "' is not a number");
     }
-    if (!(fraction > 0 && fraction <= 1)) throw viscera::cli::UsageError("--fix-slab: fraction must lie in (0, 1]");
+    if (!(fraction > 0 && fraction <= 1)) throw viscera::common::UsageError("--fix-slab: fraction must lie in (0, 1]");
     Box b = bounding_box(mesh);
     const double extent = b.hi[a] - b.lo[a];
     if (side == "min") b.hi[a] = b.lo[a] + fraction * extent;
@@ -67,7 +67,7 @@ std::vector<std::int32_t> fixed_nodes(const viscera::cli::CommandLine& cl, const
       } catch (...) {
       }
       if (i < 0 || i >= static_cast<long>(mesh.node_count()))
-        throw viscera::cli::UsageError("--fix-nodes: '" + part + "' is not a node index in [0, " + std::to_string(mesh.node_count() - 1) + "]");
+        throw viscera::common::UsageError("--fix-nodes: '" + part + "' is not a node index in [0, " + std::to_string(mesh.node_count() - 1) + "]");
       fixed.push_back(static_cast<std::int32_t>(i));
     }
   }
@@ -83,7 +83,7 @@ double max_displacement(const State& s, const TetMesh& mesh) {
 }
 
 int run(int argc, char** argv) {
-  viscera::cli::CommandLine cl("viscera-sim",
+  viscera::common::CommandLine cl("viscera-sim",
       "Runs an organ mesh under gravity with a fixed region and writes VTU frames for ParaView.\n"
       "Units are SI: metres, seconds, pascals, kilograms.");
   cl.flag("mesh", "PATH", "tetrahedral mesh (.msh Gmsh v1/v2/v4.1, .vtk legacy, .vtu)");
@@ -111,7 +111,7 @@ int run(int argc, char** argv) {
   const std::string mesh_path = cl.text("mesh");
   auto mesh = std::make_shared<TetMesh>(read_tet_mesh(mesh_path));
   const double scale = cl.number("scale");
-  if (!(scale > 0)) throw viscera::cli::UsageError("--scale must be positive");
+  if (!(scale > 0)) throw viscera::common::UsageError("--scale must be positive");
   scale_mesh(*mesh, scale);
 
   Material material;
@@ -120,7 +120,7 @@ int run(int argc, char** argv) {
   } else {
     material.name = "command line";
     material.density_kg_m3 = cl.number("density");
-    if (!(material.density_kg_m3 > 0)) throw viscera::cli::UsageError("--density must be positive");
+    if (!(material.density_kg_m3 > 0)) throw viscera::common::UsageError("--density must be positive");
     material.elasticity = elasticity_matrix(IsotropicElasticity{cl.number("youngs-modulus"), cl.number("poisson-ratio")}, "command line");
   }
   const double volume = cl.number_in("volume-term", 0.0, 0.999);
@@ -143,7 +143,7 @@ int run(int argc, char** argv) {
   const double frame_rate = cl.number_in("frame-rate", 1e-3, 1e4);
   const std::string integrator_name = cl.text("integrator");
   if (integrator_name != "explicit" && integrator_name != "implicit")
-    throw viscera::cli::UsageError("--integrator: '" + integrator_name + "' is not explicit or implicit");
+    throw viscera::common::UsageError("--integrator: '" + integrator_name + "' is not explicit or implicit");
 
   const Box box = bounding_box(*mesh);
   const Vec3 size = box.hi - box.lo;
@@ -223,7 +223,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
-  } catch (const viscera::cli::UsageError& e) {
+  } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-sim: %s\n", e.what());
     return 2;
   } catch (const InputError& e) {

@@ -30,4 +30,4 @@ class Device {
   virtual void render(const protocol::Vector3& force_n, bool in_contact) = 0;
 };
 
-}  // namespace viscera::client
+}  // namespace viscera::commonent

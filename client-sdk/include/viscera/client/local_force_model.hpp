@@ -62,4 +62,4 @@ class LocalForceRenderer {
   double resume_s_ = 0, resume_gain_ = 1;  // a model after a fade: when it came, and the gain then
 };
 
-}  // namespace viscera::client
+}  // namespace viscera::commonent

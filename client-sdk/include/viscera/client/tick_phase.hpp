@@ -37,4 +37,4 @@ class TickPhase {
   std::int64_t period_ns_, offset_ns_, max_step_ns_;
 };
 
-}  // namespace viscera::client
+}  // namespace viscera::commonent

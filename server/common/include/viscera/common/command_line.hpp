@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace viscera::cli {
+namespace viscera::common {
 
 class UsageError : public std::runtime_error {
  public:
@@ -23,6 +23,8 @@ class CommandLine {
             std::optional<std::string> default_value = std::nullopt);
   void option_switch(const std::string& name, const std::string& help);
 
+  /// The usage line of --help (default "PROGRAM [options]"), e.g. "viscera-lab analyze DIR --out DIR".
+  void usage(std::string line) { usage_ = std::move(line); }
   /// Accepts up to n arguments that are not flags (default none: they are errors).
   void allow_positional(std::size_t n) { max_positional_ = n; }
   const std::vector<std::string>& positional() const { return positional_; }
@@ -46,7 +48,7 @@ class CommandLine {
     std::optional<std::string> default_value;
     bool is_switch = false;
   };
-  std::string program_, summary_;
+  std::string program_, summary_, usage_;
   std::vector<std::string> order_;
   std::map<std::string, Flag> flags_;
   std::map<std::string, std::string> values_;
@@ -54,4 +56,4 @@ class CommandLine {
   std::size_t max_positional_ = 0;
 };
 
-}  // namespace viscera::cli
+}  // namespace viscera::common
