@@ -3,11 +3,11 @@
 // sub-steps, with the internal forces on one thread and on the scene's threads. No DDS, no
 // instruments: what the tick costs before anything else shares the cores (docs/PERFORMANCE.md).
 // Run: build/bench/tick_bench [--benchmark_filter=liver-12k]
-#include <benchmark/benchmark.h>
-
 #include <cmath>
 #include <cstdint>
 #include <string>
+
+#include <benchmark/benchmark.h>
 
 #include "viscera/runtime/organ.hpp"
 #include "viscera/runtime/scene_file.hpp"

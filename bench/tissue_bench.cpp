@@ -1,11 +1,11 @@
 // Force evaluation and a full explicit step for liver2 at three refinement levels, for every model,
 // in one run; plus the machine's streaming read bandwidth for the same working-set sizes, so the
 // distance to the memory limit is visible (docs/PERFORMANCE.md). Run: bench/run.sh
-#include <benchmark/benchmark.h>
-
 #include <map>
 #include <memory>
 #include <numeric>
+
+#include <benchmark/benchmark.h>
 
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
@@ -65,8 +65,8 @@ void count_tets(benchmark::State& st, const Level* level) {
   const double tets = static_cast<double>(level->mesh->tet_count());
   st.counters["tets"] = tets;
   st.counters["tet_updates_per_s"] = benchmark::Counter(tets * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
-  st.counters["ns_per_tet"] = benchmark::Counter(tets * static_cast<double>(st.iterations()),
-                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["ns_per_tet"] =
+      benchmark::Counter(tets * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 void force(benchmark::State& st, std::string model_name, const Level* level) {

@@ -61,8 +61,10 @@ struct Client::Impl {
     if (scene_stale.exchange(false)) last_scene.reset();  // a restarted server publishes its own
     scene.take([&](const proto::Received& r) {
       std::string why;
-      if (auto s = proto::decode_scene(r.payload, &why)) last_scene = *s;
-      else ++rejected;
+      if (auto s = proto::decode_scene(r.payload, &why))
+        last_scene = *s;
+      else
+        ++rejected;
     });
   }
 };
@@ -96,7 +98,8 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
       const auto it = std::find_if(s->instruments.begin(), s->instruments.end(), [&](const auto& i) { return i.instrument_id == instrument_id; });
       if (it == s->instruments.end()) {
         std::string list;
-        for (const auto& i : s->instruments) list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.grasper ? " (grasper)" : " (probe)");
+        for (const auto& i : s->instruments)
+          list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.grasper ? " (grasper)" : " (probe)");
         return {false, "scene " + s->name + " has no instrument " + std::to_string(instrument_id) + " (its instruments: " + list + ")"};
       }
       if (it->owner_client_id == client_id_) return {true, {}};
@@ -226,8 +229,10 @@ std::optional<proto::SurfaceTopology> Client::surface() {
   }
   impl_->topology->take([&](const proto::Received& r) {
     std::string why;
-    if (auto t = proto::decode_surface_topology(r.payload, &why)) impl_->surface = std::move(*t);
-    else ++rejected_;
+    if (auto t = proto::decode_surface_topology(r.payload, &why))
+      impl_->surface = std::move(*t);
+    else
+      ++rejected_;
   });
   return impl_->surface;
 }
@@ -254,8 +259,10 @@ std::vector<proto::Event> Client::poll_events() {
   std::vector<proto::Event> out;
   impl_->events->take([&](const proto::Received& r) {
     std::string why;
-    if (auto e = proto::decode_event(r.payload, &why)) out.push_back(std::move(*e));
-    else ++rejected_;
+    if (auto e = proto::decode_event(r.payload, &why))
+      out.push_back(std::move(*e));
+    else
+      ++rejected_;
   });
   return out;
 }
@@ -265,8 +272,10 @@ std::vector<proto::TelemetryReport> Client::poll_telemetry() {
   std::vector<proto::TelemetryReport> out;
   impl_->telemetry->take([&](const proto::Received& r) {
     std::string why;
-    if (auto t = proto::decode_telemetry(r.payload, &why)) out.push_back(*t);
-    else ++rejected_;
+    if (auto t = proto::decode_telemetry(r.payload, &why))
+      out.push_back(*t);
+    else
+      ++rejected_;
   });
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.server_stamp_ns < b.server_stamp_ns; });
   return out;
@@ -279,7 +288,8 @@ void Client::annotate(const std::string& text) {
     // A new writer's first sample reaches only the readers discovered by then.
     impl_->annotations->wait_for_readers(std::chrono::seconds(1));
   }
-  impl_->annotations->write(client_id_, proto::encode(proto::Event{client_id_, proto::EventKind::annotation, 0, client_id_, 0, proto::now_ns(), text}));
+  impl_->annotations->write(client_id_,
+                            proto::encode(proto::Event{client_id_, proto::EventKind::annotation, 0, client_id_, 0, proto::now_ns(), text}));
   impl_->annotations->wait_for_acks(std::chrono::seconds(1));
 }
 
@@ -308,4 +318,4 @@ LatencyStats Client::round_trip() const {
   return s;
 }
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

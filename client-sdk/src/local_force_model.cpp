@@ -77,8 +77,6 @@ RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s)
   return r;
 }
 
-double LocalForceRenderer::model_age_s(double t_s) const {
-  return has_new_ ? t_s - arrived_s_ : std::numeric_limits<double>::infinity();
-}
+double LocalForceRenderer::model_age_s(double t_s) const { return has_new_ ? t_s - arrived_s_ : std::numeric_limits<double>::infinity(); }
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

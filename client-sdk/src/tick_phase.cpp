@@ -23,4 +23,4 @@ std::chrono::nanoseconds TickPhase::correction(std::int64_t next_ns, std::int64_
   return std::chrono::nanoseconds(std::clamp(c, -max_step_ns_, max_step_ns_));
 }
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

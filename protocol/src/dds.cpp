@@ -46,8 +46,7 @@ dds_qos_t* qos_for(Stream s) {
 }
 }  // namespace
 
-DdsError::DdsError(const std::string& what, int32_t code)
-    : std::runtime_error("DDS: " + what + ": " + dds_strretcode(code)) {}
+DdsError::DdsError(const std::string& what, int32_t code) : std::runtime_error("DDS: " + what + ": " + dds_strretcode(code)) {}
 
 const char* topic_name(Stream s) {
   switch (s) {
@@ -63,8 +62,7 @@ const char* topic_name(Stream s) {
   return "?";
 }
 
-Participant::Participant(std::uint32_t domain_id)
-    : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")) {}
+Participant::Participant(std::uint32_t domain_id) : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")) {}
 
 Participant::~Participant() { dds_delete(handle_); }
 
@@ -151,9 +149,7 @@ int Reader::take(const std::function<void(const Received&)>& f) {
   return total;
 }
 
-bool Reader::wait(std::chrono::nanoseconds timeout) {
-  return dds_waitset_wait(waitset_, nullptr, 0, timeout.count()) > 0;
-}
+bool Reader::wait(std::chrono::nanoseconds timeout) { return dds_waitset_wait(waitset_, nullptr, 0, timeout.count()) > 0; }
 
 int Reader::alive_writers() const {
   dds_liveliness_changed_status_t st{};

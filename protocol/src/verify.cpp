@@ -2,6 +2,8 @@
 #include <cctype>
 #include <cmath>
 
+#include "viscera/protocol/messages.hpp"
+
 #include "event_generated.h"
 #include "force_feedback_generated.h"
 #include "instrument_command_generated.h"
@@ -9,7 +11,6 @@
 #include "session_generated.h"
 #include "surface_mesh_generated.h"
 #include "telemetry_generated.h"
-#include "viscera/protocol/messages.hpp"
 
 namespace viscera::protocol {
 
@@ -17,7 +18,7 @@ namespace fb = viscera::wire;  // the flatc-generated types
 
 namespace {
 
-constexpr double kMaxPositionM = 10.0;      // a scene is metres across, not kilometres
+constexpr double kMaxPositionM = 10.0;  // a scene is metres across, not kilometres
 constexpr double kMaxForceN = 1e4;
 
 fb::Vec3 to_fb(const Vector3& v) { return fb::Vec3(v[0], v[1], v[2]); }
@@ -63,8 +64,8 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const auto& k = f.stiffness;
   const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
-  return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns,
-                                           &force, &torque, model, f.step_time_ns, f.penetration_m));
+  return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force,
+                                           &torque, model, f.step_time_ns, f.penetration_m));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -80,16 +81,16 @@ std::vector<std::uint8_t> encode(const SessionRequest& r) {
     if (r.material.damping_per_s) m.add_damping_per_s(*r.material.damping_per_s);
     material = m.Finish();
   }
-  return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id, r.request_seq, name,
-                                            material, r.physics_rate_hz));
+  return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id, r.request_seq, name, material,
+                                            r.physics_rate_hz));
 }
 
 std::vector<std::uint8_t> encode(const Scene& s) {
   flatbuffers::FlatBufferBuilder b(512);
   std::vector<flatbuffers::Offset<fb::InstrumentState>> inst;
   for (const auto& i : s.instruments)
-    inst.push_back(fb::CreateInstrumentState(b, i.instrument_id, i.grasper ? fb::InstrumentKind::grasper : fb::InstrumentKind::probe,
-                                             i.tip_radius_m, i.owner_client_id));
+    inst.push_back(fb::CreateInstrumentState(b, i.instrument_id, i.grasper ? fb::InstrumentKind::grasper : fb::InstrumentKind::probe, i.tip_radius_m,
+                                             i.owner_client_id));
   const auto name = b.CreateString(s.name);
   const auto list = b.CreateVector(inst);
   const fb::Vec3 lo = to_fb(s.bounds_min), hi = to_fb(s.bounds_max);
@@ -100,19 +101,19 @@ std::vector<std::uint8_t> encode(const Scene& s) {
   const auto preparing = b.CreateString(s.preparing);
   std::vector<flatbuffers::Offset<fb::RequestOutcome>> outcomes;
   for (const auto& o : s.recent_requests)
-    outcomes.push_back(fb::CreateRequestOutcome(b, o.client_id, o.request_seq, static_cast<fb::SessionAction>(o.action), o.accepted,
-                                                b.CreateString(o.message)));
+    outcomes.push_back(
+        fb::CreateRequestOutcome(b, o.client_id, o.request_seq, static_cast<fb::SessionAction>(o.action), o.accepted, b.CreateString(o.message)));
   const auto recent = b.CreateVector(outcomes);
   const auto unreadable = b.CreateVectorOfStrings(s.unreadable_scenes);
-  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent,
-                                        unreadable));
+  return finish(
+      b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent, unreadable));
 }
 
 std::vector<std::uint8_t> encode(const TelemetryReport& t) {
   flatbuffers::FlatBufferBuilder b(128);
-  return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us,
-                                       t.jitter_p99_us, t.late_ticks, t.rejected_messages, t.missed_slots, t.rejected_malformed,
-                                       t.rejected_not_owner, t.rejected_unknown_instrument));
+  return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us, t.jitter_p99_us,
+                                       t.late_ticks, t.rejected_messages, t.missed_slots, t.rejected_malformed, t.rejected_not_owner,
+                                       t.rejected_unknown_instrument));
 }
 
 std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
@@ -134,8 +135,7 @@ std::vector<std::uint8_t> encode(const MeshFrame& m) {
 std::vector<std::uint8_t> encode(const Event& e) {
   flatbuffers::FlatBufferBuilder b(128 + e.text.size());
   const auto text = b.CreateString(e.text);
-  b.Finish(fb::CreateEvent(b, e.source_client_id, static_cast<fb::EventKind>(e.kind), e.instrument_id, e.client_id, e.sim_time_s,
-                           e.stamp_ns, text),
+  b.Finish(fb::CreateEvent(b, e.source_client_id, static_cast<fb::EventKind>(e.kind), e.instrument_id, e.client_id, e.sim_time_s, e.stamp_ns, text),
            fb::EventIdentifier());
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
@@ -229,8 +229,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());
     f.contact_normal = from_fb(lm->normal());
-    if (const auto* k = lm->stiffness())
-      f.stiffness = {k->m00(), k->m01(), k->m02(), k->m10(), k->m11(), k->m12(), k->m20(), k->m21(), k->m22()};
+    if (const auto* k = lm->stiffness()) f.stiffness = {k->m00(), k->m01(), k->m02(), k->m10(), k->m11(), k->m12(), k->m20(), k->m21(), k->m22()};
   }
   if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point) || !std::isfinite(f.penetration_m) ||
       std::abs(f.penetration_m) > kMaxPositionM) {
@@ -273,8 +272,7 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
       *why = "set_material without material";
       return std::nullopt;
     }
-    const auto take = [&](flatbuffers::Optional<double> v, const char* field, double lo, double hi, bool open_hi,
-                          std::optional<double>& out) {
+    const auto take = [&](flatbuffers::Optional<double> v, const char* field, double lo, double hi, bool open_hi, std::optional<double>& out) {
       if (!v.has_value()) return true;
       const double x = *v;
       if (!std::isfinite(x) || x < lo || (open_hi ? x >= hi : x > hi)) {
@@ -316,8 +314,13 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
   s.bounds_max = from_fb(m->organ_bounds_max());
   s.generation = m->generation();
   if (const auto* mat = m->material()) {
-    s.material = {mat->name() ? mat->name()->str() : "", mat->youngs_modulus_pa(), mat->poisson_ratio(), mat->density_kg_m3(), mat->shear_q(),
-                  mat->damping_per_s(), mat->added_mass_fraction()};
+    s.material = {mat->name() ? mat->name()->str() : "",
+                  mat->youngs_modulus_pa(),
+                  mat->poisson_ratio(),
+                  mat->density_kg_m3(),
+                  mat->shear_q(),
+                  mat->damping_per_s(),
+                  mat->added_mass_fraction()};
     const auto& x = s.material;
     if (!std::isfinite(x.youngs_modulus_pa + x.poisson_ratio + x.density_kg_m3 + x.shear_q + x.damping_per_s + x.added_mass_fraction)) {
       *why = "material numbers not finite";
@@ -331,8 +334,8 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
     for (const auto* n : *m->unreadable_scenes()) s.unreadable_scenes.push_back(n->str());
   if (m->recent_requests())
     for (const auto* o : *m->recent_requests())
-      s.recent_requests.push_back({o->client_id(), o->request_seq(), static_cast<Action>(o->action()), o->accepted(),
-                                   o->message() ? o->message()->str() : ""});
+      s.recent_requests.push_back(
+          {o->client_id(), o->request_seq(), static_cast<Action>(o->action()), o->accepted(), o->message() ? o->message()->str() : ""});
   if (!finite(s.bounds_min) || !finite(s.bounds_max) || !std::isfinite(s.physics_rate_hz)) {
     *why = "scene numbers not finite";
     return std::nullopt;
@@ -343,11 +346,23 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
 std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> bytes, std::string* why) {
   const auto* m = verified_root<fb::Telemetry>(bytes, why);
   if (!m) return std::nullopt;
-  TelemetryReport t{m->server_stamp_ns(), m->steps(), m->overruns(), m->rejected_messages(), m->physics_rate_hz(),
-                    m->step_time_p50_us(), m->step_time_p99_us(), m->step_time_max_us(), m->tick_jitter_p99_us(), m->missed_slots(),
-                    m->rejected_malformed(), m->rejected_not_owner(), m->rejected_unknown_instrument()};
-  const std::pair<const char*, double> figures[] = {{"physics_rate_hz", t.physics_rate_hz},     {"step_time_p50_us", t.step_p50_us},
-                                                    {"step_time_p99_us", t.step_p99_us},        {"step_time_max_us", t.step_max_us},
+  TelemetryReport t{m->server_stamp_ns(),
+                    m->steps(),
+                    m->overruns(),
+                    m->rejected_messages(),
+                    m->physics_rate_hz(),
+                    m->step_time_p50_us(),
+                    m->step_time_p99_us(),
+                    m->step_time_max_us(),
+                    m->tick_jitter_p99_us(),
+                    m->missed_slots(),
+                    m->rejected_malformed(),
+                    m->rejected_not_owner(),
+                    m->rejected_unknown_instrument()};
+  const std::pair<const char*, double> figures[] = {{"physics_rate_hz", t.physics_rate_hz},
+                                                    {"step_time_p50_us", t.step_p50_us},
+                                                    {"step_time_p99_us", t.step_p99_us},
+                                                    {"step_time_max_us", t.step_max_us},
                                                     {"tick_jitter_p99_us", t.jitter_p99_us}};
   for (const auto& [name, v] : figures)
     if (!std::isfinite(v) || v < 0) {
@@ -428,8 +443,8 @@ std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::stri
     *why = "sim_time_s not finite or negative";
     return std::nullopt;
   }
-  return Event{m->source_client_id(), static_cast<EventKind>(k), m->instrument_id(), m->client_id(), m->sim_time_s(), m->stamp_ns(),
-               m->text() ? m->text()->str() : ""};
+  return Event{m->source_client_id(), static_cast<EventKind>(k),        m->instrument_id(), m->client_id(), m->sim_time_s(),
+               m->stamp_ns(),         m->text() ? m->text()->str() : ""};
 }
 
 }  // namespace viscera::protocol

@@ -7,11 +7,9 @@
 
 namespace viscera::common {
 
-CommandLine::CommandLine(std::string program, std::string summary)
-    : program_(std::move(program)), summary_(std::move(summary)) {}
+CommandLine::CommandLine(std::string program, std::string summary) : program_(std::move(program)), summary_(std::move(summary)) {}
 
-void CommandLine::flag(const std::string& name, const std::string& value_name, const std::string& help,
-                       std::optional<std::string> default_value) {
+void CommandLine::flag(const std::string& name, const std::string& value_name, const std::string& help, std::optional<std::string> default_value) {
   order_.push_back(name);
   flags_[name] = {value_name, help, std::move(default_value), false};
 }
@@ -27,8 +25,10 @@ std::string CommandLine::help() const {
   for (const auto& name : order_) {
     const Flag& f = flags_.at(name);
     std::string left = "  --" + name + (f.is_switch ? "" : " " + f.value_name);
-    if (left.size() < 34) left.resize(34, ' ');
-    else left += "\n" + std::string(34, ' ');
+    if (left.size() < 34)
+      left.resize(34, ' ');
+    else
+      left += "\n" + std::string(34, ' ');
     s << left << f.help;
     if (f.default_value) s << " (default: " << *f.default_value << ")";
     s << "\n";
@@ -73,9 +73,7 @@ bool CommandLine::parse(int argc, char** argv) {
   return true;
 }
 
-bool CommandLine::has(const std::string& name) const {
-  return values_.count(name) || (flags_.count(name) && flags_.at(name).default_value);
-}
+bool CommandLine::has(const std::string& name) const { return values_.count(name) || (flags_.count(name) && flags_.at(name).default_value); }
 
 std::string CommandLine::text(const std::string& name) const {
   if (const auto it = values_.find(name); it != values_.end()) return it->second;
@@ -88,8 +86,7 @@ namespace {
 double parse_number(const std::string& name, const std::string& t) {
   double v = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v))
-    throw UsageError("--" + name + ": '" + t + "' is not a finite number");
+  if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) throw UsageError("--" + name + ": '" + t + "' is not a finite number");
   return v;
 }
 }  // namespace

@@ -5,8 +5,7 @@
 namespace viscera::common {
 
 namespace {
-std::string compose(const std::string& source, long line, const std::string& field,
-                    const std::string& message) {
+std::string compose(const std::string& source, long line, const std::string& field, const std::string& message) {
   std::string s = source;
   if (line > 0) s += ":" + std::to_string(line);
   if (!field.empty()) s += ": " + field;
@@ -15,10 +14,7 @@ std::string compose(const std::string& source, long line, const std::string& fie
 }  // namespace
 
 InputError::InputError(std::string source, long line, std::string field, const std::string& message)
-    : std::runtime_error(compose(source, line, field, message)),
-      source_(std::move(source)),
-      line_(line),
-      field_(std::move(field)) {}
+    : std::runtime_error(compose(source, line, field, message)), source_(std::move(source)), line_(line), field_(std::move(field)) {}
 
 std::string short_number(double v) {
   char b[32];

@@ -6,8 +6,9 @@
 #include <cstring>
 #include <fstream>
 #include <set>
-#include <sys/stat.h>
 #include <vector>
+
+#include <sys/stat.h>
 
 #include "viscera/common/input_error.hpp"
 
@@ -102,8 +103,10 @@ class CheckedDomBuilder {
     std::string p;
     for (const Frame& f : frames_) {
       if (&f == &frames_.back() && f.object) break;  // the key being read is appended by the caller
-      if (f.object) p += (p.empty() ? "" : ".") + f.key;
-      else p += "[" + std::to_string(f.index - 1) + "]";
+      if (f.object)
+        p += (p.empty() ? "" : ".") + f.key;
+      else
+        p += "[" + std::to_string(f.index - 1) + "]";
     }
     return p;
   }
@@ -136,14 +139,11 @@ std::string show_json(const json& value, std::size_t max_chars) {
   return printable(value.dump(-1, ' ', false, json::error_handler_t::replace), max_chars);
 }
 
-JsonObject::JsonObject(const json& value, std::string source, std::string path)
-    : value_(value), source_(std::move(source)), path_(std::move(path)) {
+JsonObject::JsonObject(const json& value, std::string source, std::string path) : value_(value), source_(std::move(source)), path_(std::move(path)) {
   if (!value_.is_object()) throw InputError(source_, 0, path_.empty() ? "JSON" : path_, show_json(value_) + " is not an object");
 }
 
-std::string JsonObject::field(std::string_view key) const {
-  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-}
+std::string JsonObject::field(std::string_view key) const { return path_.empty() ? std::string(key) : path_ + "." + std::string(key); }
 
 void JsonObject::fail(std::string_view key, const std::string& message) const { throw InputError(source_, 0, field(key), message); }
 
@@ -166,9 +166,7 @@ double JsonObject::number(const char* key, double lo, double hi) const {
   return x;
 }
 
-double JsonObject::number(const char* key, double lo, double hi, double fallback) const {
-  return has(key) ? number(key, lo, hi) : fallback;
-}
+double JsonObject::number(const char* key, double lo, double hi, double fallback) const { return has(key) ? number(key, lo, hi) : fallback; }
 
 long long JsonObject::integer(const char* key, long long lo, long long hi) const {
   const double x = number(key, static_cast<double>(lo), static_cast<double>(hi));

@@ -1,17 +1,17 @@
 #include "viscera/lab/analysis.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <chrono>
 #include <future>
 #include <sstream>
 
 #include "viscera/common/input_error.hpp"
-#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/lab/decimation.hpp"
 #include "viscera/lab/fit.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 
 namespace viscera::lab {
 
@@ -50,29 +50,39 @@ std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) 
         hold_drift += r - (t.stress_pa[k - 1] - y[k - 1]);
         ++hold_n;
       }
-      if (std::abs(e) > 0.7 * max_strain) big += r, ++big_n;
-      else if (std::abs(e) > 0.2 * max_strain) mid += r, ++mid_n;
+      if (std::abs(e) > 0.7 * max_strain)
+        big += r, ++big_n;
+      else if (std::abs(e) > 0.2 * max_strain)
+        mid += r, ++mid_n;
       if (e < -0.05 * max_strain) comp += r * (e < 0 ? -1 : 1), ++comp_n;
       if (e > 0.05 * max_strain) tens += r, ++tens_n;
       const double peak = e >= 0 ? peak_t : peak_c;
       if (std::abs(e) > 0.3 * max_strain) {
-        if (std::abs(e) >= peak) virgin += r * (e >= 0 ? 1 : -1), ++virgin_n;
-        else reload += r * (e >= 0 ? 1 : -1), ++reload_n;
+        if (std::abs(e) >= peak)
+          virgin += r * (e >= 0 ? 1 : -1), ++virgin_n;
+        else
+          reload += r * (e >= 0 ? 1 : -1), ++reload_n;
       }
-      if (e >= 0) peak_t = std::max(peak_t, e);
-      else peak_c = std::max(peak_c, -e);
+      if (e >= 0)
+        peak_t = std::max(peak_t, e);
+      else
+        peak_c = std::max(peak_c, -e);
     }
   }
   const auto mean = [](double s, double n) { return n > 0 ? s / n : 0.0; };
   switch (m) {
     case Mechanism::broadband_relaxation:
-      return fmt("during holds the measured stress keeps changing against the model: mean drift %.3g Pa per sample over %.0f hold samples", mean(hold_drift, hold_n), hold_n);
+      return fmt("during holds the measured stress keeps changing against the model: mean drift %.3g Pa per sample over %.0f hold samples",
+                 mean(hold_drift, hold_n), hold_n);
     case Mechanism::strain_stiffening:
-      return fmt("secant stiffness grows with strain: mean residual %.3g Pa above 70%% of the largest strain, %.3g Pa at 20-70%%", mean(big, big_n), mean(mid, mid_n));
+      return fmt("secant stiffness grows with strain: mean residual %.3g Pa above 70%% of the largest strain, %.3g Pa at 20-70%%", mean(big, big_n),
+                 mean(mid, mid_n));
     case Mechanism::tension_compression_asymmetry:
-      return fmt("tension and compression differ: mean residual %.3g Pa in tension, %.3g Pa (sign-corrected) in compression", mean(tens, tens_n), mean(comp, comp_n));
+      return fmt("tension and compression differ: mean residual %.3g Pa in tension, %.3g Pa (sign-corrected) in compression", mean(tens, tens_n),
+                 mean(comp, comp_n));
     case Mechanism::first_load_softening:
-      return fmt("first loading stiffer than reloading: mean residual %.3g Pa on virgin loading, %.3g Pa on reloading", mean(virgin, virgin_n), mean(reload, reload_n));
+      return fmt("first loading stiffer than reloading: mean residual %.3g Pa on virgin loading, %.3g Pa on reloading", mean(virgin, virgin_n),
+                 mean(reload, reload_n));
   }
   return "";
 }
@@ -95,8 +105,7 @@ double noise_level_pa(const TestData& t) {
 }
 
 ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d) {
-  if (d.tests.size() < 2)
-    throw common::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
+  if (d.tests.size() < 2) throw common::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
   ModelEvaluation ev;
   std::vector<const TestData*> all;
   for (const auto& t : d.tests) all.push_back(&t);
@@ -200,13 +209,13 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
       s.mechanisms |= 1u << static_cast<unsigned>(m);
       const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       say(std::string("round ") + std::to_string(round) + ": trying " + name(m) + " (candidate " + std::to_string(evaluated + 1) + " of at most " +
-          std::to_string(at_most) + (evaluated > 0 ? fmt("; at most about %.0f s left", spent / evaluated * (at_most - evaluated)) : std::string()) + ")");
+          std::to_string(at_most) + (evaluated > 0 ? fmt("; at most about %.0f s left", spent / evaluated * (at_most - evaluated)) : std::string()) +
+          ")");
       const ModelEvaluation ev = evaluate(s, d);
       ++evaluated;
       Candidate c{m, round, current.heldout_rms_pa, ev.heldout_rms_pa, false, evidence(m, current.model, d)};
       const double reduction = current.heldout_rms_pa * current.heldout_rms_pa - ev.heldout_rms_pa * ev.heldout_rms_pa;
-      const bool above_noise = reduction > kNoiseFraction * a.noise_pa * a.noise_pa &&
-                               ev.heldout_rms_pa < (1.0 - kMinGain) * current.heldout_rms_pa;
+      const bool above_noise = reduction > kNoiseFraction * a.noise_pa * a.noise_pa && ev.heldout_rms_pa < (1.0 - kMinGain) * current.heldout_rms_pa;
       say(fmt("  held-out RMS %.4g -> %.4g Pa (noise %.4g Pa)", current.heldout_rms_pa, ev.heldout_rms_pa, a.noise_pa) +
           (above_noise ? ": gain above noise" : ": no gain above noise"));
       if (above_noise && reduction > best_gain) {
@@ -239,8 +248,8 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
   } else {
     v << "The baseline misses: ";
     for (std::size_t k = 0; k < a.causes.size(); ++k) v << (k ? ", " : "") << name(a.causes[k]);
-    v << ". Adding them lowers the held-out RMS error from " << a.baseline.heldout_rms_pa << " Pa to "
-      << a.final.heldout_rms_pa << " Pa (gain " << a.gain << "x; noise " << a.noise_pa << " Pa).";
+    v << ". Adding them lowers the held-out RMS error from " << a.baseline.heldout_rms_pa << " Pa to " << a.final.heldout_rms_pa << " Pa (gain "
+      << a.gain << "x; noise " << a.noise_pa << " Pa).";
   }
   const double excess = a.final.heldout_rms_pa / std::max(a.noise_pa, 1e-300);
   if (excess > 2.0)

@@ -64,13 +64,20 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
   const auto header = split(*first);
   int col_t = -1, col_e = -1, col_s = -1, col_sd = -1;
   for (std::size_t c = 0; c < header.size(); ++c) {
-    if (header[c] == "time_s") col_t = static_cast<int>(c);
-    else if (header[c] == "strain") col_e = static_cast<int>(c);
-    else if (header[c] == "stress_pa") col_s = static_cast<int>(c);
-    else if (header[c] == "stress_sd_pa") col_sd = static_cast<int>(c);
+    if (header[c] == "time_s")
+      col_t = static_cast<int>(c);
+    else if (header[c] == "strain")
+      col_e = static_cast<int>(c);
+    else if (header[c] == "stress_pa")
+      col_s = static_cast<int>(c);
+    else if (header[c] == "stress_sd_pa")
+      col_sd = static_cast<int>(c);
   }
   for (const auto& [col, name] : {std::pair{col_t, "time_s"}, std::pair{col_e, "strain"}, std::pair{col_s, "stress_pa"}})
-    if (col < 0) throw InputError(path, 1, name, "column missing (the first line, '" + common::printable(*first, 60) + "', must name the columns time_s,strain,stress_pa[,stress_sd_pa])");
+    if (col < 0)
+      throw InputError(
+          path, 1, name,
+          "column missing (the first line, '" + common::printable(*first, 60) + "', must name the columns time_s,strain,stress_pa[,stress_sd_pa])");
   TestData t;
   t.file = file;
   t.control = control;
@@ -90,7 +97,8 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
     };
     const double time = value(col_t, "time_s"), strain = value(col_e, "strain"), stress = value(col_s, "stress_pa");
     if (!t.time_s.empty() && !(time > t.time_s.back()))
-      throw InputError(path, row, "time_s", common::short_number(time) + " s does not increase (previous row " + common::short_number(t.time_s.back()) + " s)");
+      throw InputError(path, row, "time_s",
+                       common::short_number(time) + " s does not increase (previous row " + common::short_number(t.time_s.back()) + " s)");
     if (std::abs(strain) > 5.0)
       throw InputError(path, row, "strain", common::short_number(strain) + " cannot be right: strain is dimensionless (1 = 100%), not percent");
     if (std::abs(stress) > 1e9)
@@ -150,11 +158,13 @@ void check_stress_units(const Dataset& d, const std::string& meta) {
   }
   const double m = median(modulus);
   if (m > 0 && m < kSoftestPa)
-    throw InputError(meta, 0, "tests", "apparent modulus " + common::short_number(m) + " Pa (peak stress / peak strain) is below any tissue (" +
-                                           common::short_number(kSoftestPa) + " Pa): are the stresses in kPa? The unit is Pa");
+    throw InputError(meta, 0, "tests",
+                     "apparent modulus " + common::short_number(m) + " Pa (peak stress / peak strain) is below any tissue (" +
+                         common::short_number(kSoftestPa) + " Pa): are the stresses in kPa? The unit is Pa");
   if (m > kStiffestPa)
-    throw InputError(meta, 0, "tests", "apparent modulus " + common::short_number(m) + " Pa is above bone's (" + common::short_number(kStiffestPa) +
-                                           " Pa): are the stresses or strains in another unit?");
+    throw InputError(meta, 0, "tests",
+                     "apparent modulus " + common::short_number(m) + " Pa is above bone's (" + common::short_number(kStiffestPa) +
+                         " Pa): are the stresses or strains in another unit?");
 }
 
 }  // namespace
@@ -171,8 +181,7 @@ Dataset read_dataset(const std::string& folder) {
   d.mode = top.choice("mode", {"uniaxial", "simple_shear"}, "") == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
   const JsonObject s = top.object("specimen");
   s.require_known({"length_m", "width_m", "thickness_m", "density_kg_m3"});
-  d.specimen = {s.number("length_m", 1e-6, 10), s.number("width_m", 1e-6, 10), s.number("thickness_m", 1e-6, 10),
-                s.number("density_kg_m3", 1, 1e5)};
+  d.specimen = {s.number("length_m", 1e-6, 10), s.number("width_m", 1e-6, 10), s.number("thickness_m", 1e-6, 10), s.number("density_kg_m3", 1, 1e5)};
   // Longer tests exist (creep over days) but are rare; a span beyond a day is more often a time
   // column in another unit, so it must be declared.
   const double max_duration_s = top.number("max_test_duration_s", 1e-3, 1e9, 86400.0);
@@ -199,8 +208,10 @@ void write_dataset(const Dataset& d, const std::string& folder) {
   json j;
   j["name"] = d.name;
   j["mode"] = to_string(d.mode);
-  j["specimen"] = {{"length_m", d.specimen.length_m}, {"width_m", d.specimen.width_m},
-                   {"thickness_m", d.specimen.thickness_m}, {"density_kg_m3", d.specimen.density_kg_m3}};
+  j["specimen"] = {{"length_m", d.specimen.length_m},
+                   {"width_m", d.specimen.width_m},
+                   {"thickness_m", d.specimen.thickness_m},
+                   {"density_kg_m3", d.specimen.density_kg_m3}};
   j["tests"] = json::array();
   for (const auto& t : d.tests) {
     j["tests"].push_back({{"file", t.file}, {"control", to_string(t.control)}});

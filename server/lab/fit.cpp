@@ -3,9 +3,9 @@
 #include <cmath>
 #include <limits>
 
-#include "viscera/lab/golden_section.hpp"
-
 #include <Eigen/Dense>
+
+#include "viscera/lab/golden_section.hpp"
 
 namespace viscera::lab {
 

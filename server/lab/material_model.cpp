@@ -52,8 +52,10 @@ std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<doub
       const double peak = e >= 0 ? max_t : max_c;
       const double a = std::abs(e);
       if (a < peak) v *= 1.0 - m.softening_d * (1.0 - a / peak);
-      if (e >= 0) max_t = std::max(max_t, a);
-      else max_c = std::max(max_c, a);
+      if (e >= 0)
+        max_t = std::max(max_t, a);
+      else
+        max_c = std::max(max_c, a);
     }
     s[k] = v;
   }
@@ -130,8 +132,7 @@ std::vector<double> relaxation_times_for(const Dataset& d) {
     longest = std::max(longest, t.time_s.back() - t.time_s.front());
   }
   std::vector<double> taus;
-  for (double e = std::floor(std::log10(std::max(shortest, 1e-4))); e <= std::ceil(std::log10(longest)); e += 1.0)
-    taus.push_back(std::pow(10.0, e));
+  for (double e = std::floor(std::log10(std::max(shortest, 1e-4))); e <= std::ceil(std::log10(longest)); e += 1.0) taus.push_back(std::pow(10.0, e));
   return taus;
 }
 

@@ -4,14 +4,14 @@
 #include <cmath>
 #include <functional>
 
-#include "viscera/lab/golden_section.hpp"
 #include "viscera/common/input_error.hpp"
-#include "viscera/tissue/integrator/simulation_error.hpp"
+#include "viscera/lab/golden_section.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
-#include "viscera/tissue/mesh/box_mesh.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
 
 namespace viscera::lab {
 
@@ -20,9 +20,10 @@ using namespace viscera::tissue;
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
   const bool shaped = m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry);
   if (shaped && mode == Mode::simple_shear) {
-    *why = "the law's elastic shape differs between positive and negative shear (exp(B gamma), or a compression ratio); an "
-           "isotropic solid's shear stress is odd in the shear strain (mirror symmetry), so the GPS cannot represent it: "
-           "not simulated on the specimen";
+    *why =
+        "the law's elastic shape differs between positive and negative shear (exp(B gamma), or a compression ratio); an "
+        "isotropic solid's shear stress is odd in the shear strain (mirror symmetry), so the GPS cannot represent it: "
+        "not simulated on the specimen";
     return false;
   }
   *why = shaped ? "the elastic shape (Fung stiffening, tension/compression asymmetry) in the GPS's energy form, its constants "
@@ -66,9 +67,12 @@ Rig make_rig(const Dataset& d) {
     if (!rig.shear) {
       if (X.x() < eps) {
         bc.fixed_axes.push_back({n, 0});
-        if (X.y() < eps && X.z() < eps) bc.fixed_axes.push_back({n, 1}), bc.fixed_axes.push_back({n, 2});
-        else if (X.z() < eps) bc.fixed_axes.push_back({n, 2});  // on the y axis: no rotation about x, z
-        else if (X.y() < eps) bc.fixed_axes.push_back({n, 1});  // on the z axis: no rotation about y
+        if (X.y() < eps && X.z() < eps)
+          bc.fixed_axes.push_back({n, 1}), bc.fixed_axes.push_back({n, 2});
+        else if (X.z() < eps)
+          bc.fixed_axes.push_back({n, 2});  // on the y axis: no rotation about x, z
+        else if (X.y() < eps)
+          bc.fixed_axes.push_back({n, 1});  // on the z axis: no rotation about y
       }
       if (X.x() > sp.length_m - eps) rig.moving.push_back(n);
     } else {
@@ -118,7 +122,6 @@ std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, do
   return stress;
 }
 
-
 }  // namespace
 
 ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& d) {
@@ -166,9 +169,9 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
     if (stiffens && !tension.empty())
       c.gps_b = golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, 1.5 * c.law_b, 1e-4 * c.law_b).x;
     if (asymmetric && !compression.empty())
-      c.gps_r = std::exp(golden_section([&](double lr) { return mismatch(c.gps_b, std::exp(lr), compression); }, std::log(c.law_r / 4),
-                                        std::log(c.law_r * 4), 1e-4)
-                             .x);
+      c.gps_r = std::exp(
+          golden_section([&](double lr) { return mismatch(c.gps_b, std::exp(lr), compression); }, std::log(c.law_r / 4), std::log(c.law_r * 4), 1e-4)
+              .x);
     if (!(stiffens && asymmetric)) break;
   }
   c.mismatch = mismatch(c.gps_b, c.gps_r, all);

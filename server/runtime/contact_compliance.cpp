@@ -14,7 +14,8 @@ ContactCompliance::ContactCompliance(const ForceModel& model, std::vector<double
   for (std::size_t i = 0; i < blocks_.size(); ++i) state_[i] = 0;
   bc.force_field = nullptr;  // instruments are not part of the organ's own stiffness
   bc.gravity_m_s2 = Vec3::Zero();
-  worker_ = std::thread([this, &model, density = std::move(density_kg_m3), bc = std::move(bc)]() mutable { work(model, std::move(density), std::move(bc)); });
+  worker_ = std::thread(
+      [this, &model, density = std::move(density_kg_m3), bc = std::move(bc)]() mutable { work(model, std::move(density), std::move(bc)); });
 }
 
 ContactCompliance::~ContactCompliance() {

@@ -8,10 +8,7 @@ namespace proto = viscera::protocol;
 
 MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, proto::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
                              double rate_hz)
-    : stream_(std::move(stream)),
-      nodes_(std::move(surface_nodes)),
-      mesh_id_(topology.mesh_id),
-      period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
+    : stream_(std::move(stream)), nodes_(std::move(surface_nodes)), mesh_id_(topology.mesh_id), period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
   stream_->write_topology(mesh_id_, proto::encode(topology));
   pending_.mesh_id = mesh_id_;
   pending_.positions.resize(3 * nodes_.size());

@@ -52,13 +52,15 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
   Box slab = organ.bounds;
   const double extent = organ.bounds.hi[a] - organ.bounds.lo[a];
-  if (s.fix_side == "min") slab.hi[a] = organ.bounds.lo[a] + s.fix_fraction * extent;
-  else slab.lo[a] = organ.bounds.hi[a] - s.fix_fraction * extent;
+  if (s.fix_side == "min")
+    slab.hi[a] = organ.bounds.lo[a] + s.fix_fraction * extent;
+  else
+    slab.lo[a] = organ.bounds.hi[a] - s.fix_fraction * extent;
   bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, slab);
   const std::vector<double> density(organ.mesh->tet_count(), material.density_kg_m3);
   // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
-  organ.integrator = std::make_unique<ExplicitIntegrator>(*organ.model, density, bc,
-                                                          ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
+  organ.integrator = std::make_unique<ExplicitIntegrator>(
+      *organ.model, density, bc, ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
   check_tick_budget(organ.integrator->dt_s(), 0, rate_hz, budget, source, field);
   if (s.physics_threads > 1) {
     organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, s.physics_threads);
@@ -81,7 +83,8 @@ protocol::MaterialInfo Organ::material_info() const {
     m.poisson_ratio = material.isotropic->poisson_ratio;
   }
   m.density_kg_m3 = material.density_kg_m3;
-  if (material.viscoelasticity && material.viscoelasticity->model == ViscoelasticSpec::Model::constant_q) m.shear_q = material.viscoelasticity->shear_q;
+  if (material.viscoelasticity && material.viscoelasticity->model == ViscoelasticSpec::Model::constant_q)
+    m.shear_q = material.viscoelasticity->shear_q;
   m.damping_per_s = scene.damping_per_s;
   m.added_mass_fraction = integrator->mass_scaling().added_mass_fraction;
   return m;
@@ -95,8 +98,7 @@ std::string Organ::describe_step(double rate_hz) const {
   const MassScaling& mass_scaling = integrator->mass_scaling();
   if (mass_scaling.scaled_elements > 0) {
     std::snprintf(b, sizeof b, " (mass scaling: +%.2f%% mass on %zu of %zu elements, each element's step >= %.3g s)",
-                  100 * mass_scaling.added_mass_fraction, mass_scaling.scaled_elements, model->element_count(),
-                  mass_scaling.min_element_step_s);
+                  100 * mass_scaling.added_mass_fraction, mass_scaling.scaled_elements, model->element_count(), mass_scaling.min_element_step_s);
     out += b;
   }
   return out;
@@ -139,8 +141,11 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   if (change.damping_per_s) next->scene.damping_per_s = *change.damping_per_s;
   const std::string mark = " (changed at run time)";
   if ((change.youngs_modulus_pa || change.poisson_ratio || change.shear_q || change.density_kg_m3) && !m.name.ends_with(mark)) m.name += mark;
-  const char* changed = change.youngs_modulus_pa ? "youngs_modulus_pa" : change.poisson_ratio ? "poisson_ratio" : change.density_kg_m3 ? "density_kg_m3"
-                        : change.shear_q ? "shear_q" : "damping_per_s";
+  const char* changed = change.youngs_modulus_pa ? "youngs_modulus_pa"
+                        : change.poisson_ratio   ? "poisson_ratio"
+                        : change.density_kg_m3   ? "density_kg_m3"
+                        : change.shear_q         ? "shear_q"
+                                                 : "damping_per_s";
   build_physics(*next, rate_hz, budget, source, changed);
   return next;
 }

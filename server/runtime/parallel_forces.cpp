@@ -6,9 +6,10 @@
 #include <stdexcept>
 
 #include <pthread.h>
-#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
+
+#include <sched.h>
 
 namespace viscera::runtime {
 
@@ -16,8 +17,7 @@ using tissue::ElementPart;
 using tissue::ForceStats;
 using tissue::Vec3;
 
-ParallelForces::ParallelForces(const tissue::ForceModel& model, int threads, int chunks)
-    : model_(model), chunks_(static_cast<std::size_t>(chunks)) {
+ParallelForces::ParallelForces(const tissue::ForceModel& model, int threads, int chunks) : model_(model), chunks_(static_cast<std::size_t>(chunks)) {
   if (threads < 2 || chunks < threads) throw std::invalid_argument("ParallelForces: needs threads >= 2 and chunks >= threads");
   buffers_.assign(chunks_ - 1, std::vector<Vec3>(model.node_count()));
   stats_.resize(chunks_);

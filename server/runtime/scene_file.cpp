@@ -13,9 +13,9 @@ namespace viscera::runtime {
 
 using common::JsonObject;
 
-using nlohmann::json;
 using common::InputError;
 using common::JsonObject;
+using nlohmann::json;
 
 SceneSpec read_scene_file(const std::string& path) {
   const json j = common::read_json_file(path);
@@ -32,9 +32,8 @@ SceneSpec read_scene_file(const std::string& path) {
   s.mesh_rate_hz = top.number("mesh_rate_hz", 0, 240, 60);
   s.max_tool_speed_m_s = top.number("max_tool_speed_m_s", 1e-3, 100, 0.5);
   const JsonObject o = top.object("organ");
-  o.require_known({"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction", "physics_threads",
-                   "volume_term", "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m",
-                   "grasp_stiffness_n_per_m", "fix_slab"});
+  o.require_known({"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction", "physics_threads", "volume_term",
+                   "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab"});
   s.mesh = (dir / o.text("mesh")).string();
   s.material = (dir / o.text("material")).string();
   s.model = o.choice("model", {"gps", "gps_energy", "corotational", "linear"}, "gps_energy");
@@ -56,7 +55,8 @@ SceneSpec read_scene_file(const std::string& path) {
     s.fix_axis = f[0].get<std::string>();
     s.fix_side = f[1].get<std::string>();
     s.fix_fraction = f[2].get<double>();
-    if (s.fix_axis != "x" && s.fix_axis != "y" && s.fix_axis != "z") o.fail("fix_slab", "axis '" + common::printable(s.fix_axis) + "' is not x, y or z");
+    if (s.fix_axis != "x" && s.fix_axis != "y" && s.fix_axis != "z")
+      o.fail("fix_slab", "axis '" + common::printable(s.fix_axis) + "' is not x, y or z");
     if (s.fix_side != "min" && s.fix_side != "max") o.fail("fix_slab", "side '" + common::printable(s.fix_side) + "' is not min or max");
     if (!(s.fix_fraction > 0 && s.fix_fraction <= 1)) o.fail("fix_slab", "fraction must lie in (0, 1]");
   }

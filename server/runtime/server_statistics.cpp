@@ -24,8 +24,19 @@ void ServerStatistics::close_window(double seconds, ServerStats& stats) {
 }
 
 protocol::TelemetryReport telemetry_report(const ServerStats& s, std::int64_t stamp_ns) {
-  return {stamp_ns, s.ticks, s.late_ticks, s.rejected, s.rate_hz, s.step_p50_us, s.step_p99_us, s.step_max_us, s.jitter_p99_us, s.missed_slots,
-          s.rejected_malformed, s.rejected_not_owner, s.rejected_unknown_instrument};
+  return {stamp_ns,
+          s.ticks,
+          s.late_ticks,
+          s.rejected,
+          s.rate_hz,
+          s.step_p50_us,
+          s.step_p99_us,
+          s.step_max_us,
+          s.jitter_p99_us,
+          s.missed_slots,
+          s.rejected_malformed,
+          s.rejected_not_owner,
+          s.rejected_unknown_instrument};
 }
 
 std::string status_line(const ServerStats& s, bool paused, int instruments_in_use, double max_force_n) {

@@ -54,8 +54,8 @@ std::optional<std::string> SessionControl::start_scene(const protocol::SessionRe
     return std::string(e.what());
   }
   spec.domain_id = domain_id;  // the server stays on its domain
-  preparing_ = Preparing{std::async(std::launch::async, [spec, build = build_scene_] { return build(spec); }), request,
-                         "scene " + request.scene_name};
+  preparing_ =
+      Preparing{std::async(std::launch::async, [spec, build = build_scene_] { return build(spec); }), request, "scene " + request.scene_name};
   return std::nullopt;
 }
 

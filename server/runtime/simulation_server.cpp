@@ -37,7 +37,7 @@ struct SimulationServer::Impl {
   ServerEndpoints& endpoints;
   TickBudget budget;
   const std::atomic<bool>* stop = nullptr;  // run()'s stop flag: a long tick checks it between sub-steps
-  std::shared_ptr<Organ> organ;             // shared with a material change being prepared from it
+  std::shared_ptr<Organ> organ;  // shared with a material change being prepared from it
   std::mutex organ_mutex;
   State state;
   double sim_time_s = 0;
@@ -45,7 +45,7 @@ struct SimulationServer::Impl {
   bool paused = false;
 
   InstrumentTable instruments;  // both threads (thread-safe)
-  struct Tool {                 // physics thread only
+  struct Tool {  // physics thread only
     SimulatedTool tool;
     std::unique_ptr<ProbeContact> contact;
     ContactResult result;
@@ -62,10 +62,11 @@ struct SimulationServer::Impl {
       : scene(s),
         endpoints(e),
         budget(b),
-        session(std::move(dir), [b](const SceneSpec& spec) { return std::shared_ptr<Organ>(build_organ(spec, b)); },
-                [b](const std::shared_ptr<const Organ>& current, const proto::MaterialChange& change, double rate_hz) {
-                  return std::shared_ptr<Organ>(rebuild_with_material(*current, change, rate_hz, b));
-                }) {
+        session(
+            std::move(dir), [b](const SceneSpec& spec) { return std::shared_ptr<Organ>(build_organ(spec, b)); },
+            [b](const std::shared_ptr<const Organ>& current, const proto::MaterialChange& change, double rate_hz) {
+              return std::shared_ptr<Organ>(rebuild_with_material(*current, change, rate_hz, b));
+            }) {
     adopt(build_organ(s, budget), true);
     publish_scene();
   }
@@ -188,7 +189,8 @@ struct SimulationServer::Impl {
   }
 
   void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns) {
-    endpoints.write_force(id, proto::encode(force_message(id, owner, command, r, local_stiffness(r, *organ->compliance), proto::now_ns(), step_time_ns)));
+    endpoints.write_force(id,
+                          proto::encode(force_message(id, owner, command, r, local_stiffness(r, *organ->compliance), proto::now_ns(), step_time_ns)));
     ++forces_sent;
   }
 
@@ -301,7 +303,8 @@ struct SimulationServer::Impl {
     const auto refuse = [&](const std::string& why) { conclude(req, false, why, status); };
     if (req.action == proto::Action::set_physics_rate) {
       // Whole hertz, as in scene files: the tick grid's period is 1/rate.
-      if (req.physics_rate_hz != std::floor(req.physics_rate_hz)) return refuse("physics rate " + common::short_number(req.physics_rate_hz) + " Hz: whole hertz only");
+      if (req.physics_rate_hz != std::floor(req.physics_rate_hz))
+        return refuse("physics rate " + common::short_number(req.physics_rate_hz) + " Hz: whole hertz only");
       try {
         check_tick_budget(organ->integrator->dt_s(), organ->substep_cost_s, req.physics_rate_hz, budget, "set_physics_rate", "physics_rate_hz");
       } catch (const InputError& e) {
@@ -313,7 +316,8 @@ struct SimulationServer::Impl {
       conclude(req, true, text + tick_cost(organ->integrator->dt_s(), organ->substep_cost_s, scene.physics_rate_hz), status);
       return;
     }
-    const auto refused = req.action == proto::Action::load_scene ? session.start_scene(req, scene.domain_id) : session.start_material(req, organ, scene.physics_rate_hz);
+    const auto refused = req.action == proto::Action::load_scene ? session.start_scene(req, scene.domain_id)
+                                                                 : session.start_material(req, organ, scene.physics_rate_hz);
     if (refused) return refuse(*refused);
     if (status) status("client " + std::to_string(req.client_id) + " asked for " + session.preparing() + "; preparing it");
   }
@@ -337,12 +341,13 @@ struct SimulationServer::Impl {
   /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
   void conclude(const proto::SessionRequest& req, bool accepted, const std::string& message, const Status& status) {
     session.record(req, accepted, message);
-    const proto::EventKind kind = !accepted ? proto::EventKind::request_refused
-                                  : req.action == proto::Action::load_scene ? proto::EventKind::scene_loaded
+    const proto::EventKind kind = !accepted                                   ? proto::EventKind::request_refused
+                                  : req.action == proto::Action::load_scene   ? proto::EventKind::scene_loaded
                                   : req.action == proto::Action::set_material ? proto::EventKind::material_changed
-                                                                               : proto::EventKind::physics_rate_changed;
+                                                                              : proto::EventKind::physics_rate_changed;
     event(kind, 0, req.client_id, message.substr(0, 1000));
-    if (status) status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + (accepted ? "" : "refused: ") + message);
+    if (status)
+      status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + (accepted ? "" : "refused: ") + message);
     publish_scene();
   }
 
@@ -351,7 +356,8 @@ struct SimulationServer::Impl {
   void release_silent(const Status& status) {
     const auto released = instruments.release_silent(proto::now_ns(), std::chrono::nanoseconds(proto::kLivelinessLease).count());
     for (const auto& o : released) {
-      if (status) status("instrument " + std::to_string(o.instrument_id) + " released: client " + std::to_string(o.owner) + " silent for more than the lease");
+      if (status)
+        status("instrument " + std::to_string(o.instrument_id) + " released: client " + std::to_string(o.owner) + " silent for more than the lease");
       event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "owner silent for more than the lease");
     }
     if (!released.empty()) publish_scene();
@@ -421,9 +427,10 @@ struct SimulationServer::Impl {
 
 SimulationServer::SimulationServer(const SceneSpec& scene, ServerEndpoints& endpoints, const std::string& scene_dir, const TickBudget& budget)
     : impl_(std::make_unique<Impl>(scene, endpoints,
-                                   !scene_dir.empty()                                      ? scene_dir
-                                   : std::filesystem::path(scene.source).has_parent_path() ? std::filesystem::path(scene.source).parent_path().string()
-                                                                                           : std::string("."),
+                                   !scene_dir.empty() ? scene_dir
+                                   : std::filesystem::path(scene.source).has_parent_path()
+                                       ? std::filesystem::path(scene.source).parent_path().string()
+                                       : std::string("."),
                                    budget)) {}
 SimulationServer::~SimulationServer() = default;
 
@@ -478,7 +485,8 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     // A late tick is followed at once in its own slot; slots that passed with no tick are counted
     // missed and skipped, never made up in a burst (tick_grid.hpp).
     const auto now = clock::now();
-    next = clock::time_point(grid.tick_ended(now.time_since_epoch(), std::chrono::nanoseconds(static_cast<long long>(1e9 / s.scene.physics_rate_hz))));
+    next =
+        clock::time_point(grid.tick_ended(now.time_since_epoch(), std::chrono::nanoseconds(static_cast<long long>(1e9 / s.scene.physics_rate_hz))));
     s.stats.late_ticks = grid.late_ticks();
     s.stats.missed_slots = grid.missed_slots();
     wait_for_slot<clock>(next);

@@ -52,9 +52,10 @@ void check_tick_budget(double dt_s, double substep_cost_s, double rate_hz, const
   const double limit = std::floor(budget.max_tick_s / substep_cost_s);
   if (needed > limit)
     throw InputError(source, 0, field,
-                     step + " of " + short_number(1e6 * substep_cost_s) + " us each (measured here) = " + short_number(1e3 * needed * substep_cost_s) +
-                         " ms per tick; a tick may take at most " + short_number(1e3 * budget.max_tick_s) + " ms, which is " +
-                         short_number(limit) + " sub-steps on this machine (viscera-server --max-tick-ms)");
+                     step + " of " + short_number(1e6 * substep_cost_s) +
+                         " us each (measured here) = " + short_number(1e3 * needed * substep_cost_s) + " ms per tick; a tick may take at most " +
+                         short_number(1e3 * budget.max_tick_s) + " ms, which is " + short_number(limit) +
+                         " sub-steps on this machine (viscera-server --max-tick-ms)");
 }
 
 }  // namespace viscera::runtime

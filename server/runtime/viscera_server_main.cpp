@@ -11,8 +11,8 @@
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
-#include "viscera/runtime/simulation_server.hpp"
 #include "viscera/protocol/dds.hpp"
+#include "viscera/runtime/simulation_server.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -30,7 +30,8 @@ void on_signal(int sig) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  viscera::common::CommandLine cl("viscera-server",
+  viscera::common::CommandLine cl(
+      "viscera-server",
       "Runs the tissue simulation of a scene (organ mesh, material, instruments; docs/SCENE.md) at its physics rate\n"
       "and serves instruments over Cyclone DDS (domain from the scene; configuration from CYCLONEDDS_URI, see\n"
       "deploy/cyclonedds.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n"
@@ -50,8 +51,7 @@ int main(int argc, char** argv) {
     scene = cl.text("scene");
     if (cl.has("scene-dir")) {
       scene_dir = cl.text("scene-dir");
-      if (!std::filesystem::is_directory(scene_dir))
-        throw viscera::common::UsageError("--scene-dir: '" + scene_dir + "' is not a directory");
+      if (!std::filesystem::is_directory(scene_dir)) throw viscera::common::UsageError("--scene-dir: '" + scene_dir + "' is not a directory");
     }
     duration = cl.number_in("duration", 0.0, 1e9);
     budget.max_tick_s = 1e-3 * cl.number_in("max-tick-ms", 0.1, 10000);
@@ -80,12 +80,14 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     });
-    std::printf("viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected (malformed %llu, not owner %llu, unknown instrument %llu), %llu mesh frames\n",
-                static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.late_ticks), static_cast<unsigned long long>(stats.missed_slots),
-                static_cast<unsigned long long>(stats.physics_resets), static_cast<unsigned long long>(stats.forces_sent),
-                static_cast<unsigned long long>(stats.rejected), static_cast<unsigned long long>(stats.rejected_malformed),
-                static_cast<unsigned long long>(stats.rejected_not_owner), static_cast<unsigned long long>(stats.rejected_unknown_instrument),
-                static_cast<unsigned long long>(stats.mesh_frames));
+    std::printf(
+        "viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected "
+        "(malformed %llu, not owner %llu, unknown instrument %llu), %llu mesh frames\n",
+        static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.late_ticks),
+        static_cast<unsigned long long>(stats.missed_slots), static_cast<unsigned long long>(stats.physics_resets),
+        static_cast<unsigned long long>(stats.forces_sent), static_cast<unsigned long long>(stats.rejected),
+        static_cast<unsigned long long>(stats.rejected_malformed), static_cast<unsigned long long>(stats.rejected_not_owner),
+        static_cast<unsigned long long>(stats.rejected_unknown_instrument), static_cast<unsigned long long>(stats.mesh_frames));
     server.reset();  // leaves the DDS domain: clients see the server gone at once
     if (viscera::runtime::SimulationServer::abandoned_work() > 0) {
       // An organ still being built in the background is not waited for.

@@ -1,7 +1,7 @@
 // The local force model against its definition: linear in the displacement, push-only, clamped.
-#include <gtest/gtest.h>
-
 #include "viscera/client/local_force_model.hpp"
+
+#include <gtest/gtest.h>
 
 using namespace viscera;
 
@@ -37,7 +37,7 @@ TEST(LocalForceModel, PushesOnlyAndNeverBeyondTheDeviceLimit) {
 TEST(LocalForceRenderer, BlendsFromTheOldModelToTheNewOneWithoutAJump) {
   client::LocalForceRenderer renderer(10.0, 0.004);
   EXPECT_EQ(renderer.render({0, 0, 0}, 0.0).force[2], 0.0);  // no model yet
-  renderer.update(contact(), {0, 0, 0.01}, 1.000);            // 2 N at z = 1 cm, 200 N/m
+  renderer.update(contact(), {0, 0, 0.01}, 1.000);  // 2 N at z = 1 cm, 200 N/m
   const protocol::Vector3 x{0, 0, 0.01};
   EXPECT_NEAR(renderer.render(x, 1.0005).force[2], 2.0, 1e-12);  // the first model: no blending
   auto stiffer = contact();

@@ -2,11 +2,11 @@
 // simulated server: ticks at a fixed rate whose ends jitter, seen by a loop that starts at any phase.
 #include "viscera/client/tick_phase.hpp"
 
-#include <gtest/gtest.h>
-
 #include <cstdint>
 #include <cstdlib>
 #include <stdexcept>
+
+#include <gtest/gtest.h>
 
 using viscera::client::TickPhase;
 using namespace std::chrono_literals;

@@ -6,21 +6,22 @@
 //
 // The first byte picks the reader; the rest is the file. Files are written to a folder of this
 // process on tmpfs, since the readers take paths (as users give them).
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/lab/dataset.hpp"
+#include "viscera/runtime/scene_file.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
+
 #include "model_file.hpp"
-#include "viscera/runtime/scene_file.hpp"
 
 namespace {
 

@@ -22,7 +22,8 @@ void seed(const std::filesystem::path& dir, const std::string& name, const Messa
     std::fprintf(stderr, "seed_corpus: %s does not decode: %s\n", name.c_str(), why.c_str());
     ++failures;
   }
-  std::ofstream(dir / ("seed-" + name), std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(dir / ("seed-" + name), std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 }  // namespace
 

@@ -8,10 +8,11 @@
 #include <cstdlib>
 #include <thread>
 
+#include "viscera/protocol/dds.hpp"
+
 #include "force_feedback_generated.h"
 #include "instrument_command_generated.h"
 #include "session_generated.h"
-#include "viscera/protocol/dds.hpp"
 
 namespace v1 = viscera::wire_v1;
 namespace proto = viscera::protocol;

@@ -1,14 +1,14 @@
 // Data-set reading: the real titin data, and every kind of bad input named by file, line, field.
-#include <gtest/gtest.h>
-
-#include <filesystem>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
-#include "viscera/lab/analysis.hpp"
+#include <gtest/gtest.h>
+
 #include "viscera/common/input_error.hpp"
+#include "viscera/lab/analysis.hpp"
 
 using namespace viscera::lab;
 
@@ -29,7 +29,8 @@ std::string error_of(const std::string& dir) {
   }
   return "no error";
 }
-const std::string kJson = R"({"name": "x", "mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "strain"}, {"file": "b.csv", "control": "strain"}]})";
+const std::string kJson =
+    R"({"name": "x", "mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "strain"}, {"file": "b.csv", "control": "strain"}]})";
 const std::string kCsv = "time_s,strain,stress_pa\n0,0,0\n1,0.01,10\n2,0.02,20\n";
 }  // namespace
 
@@ -52,29 +53,44 @@ TEST(Dataset, BadInputNamesFileLineAndField) {
       {"percent", kJson, "time_s,strain,stress_pa\n0,0,0\n1,10,10\n2,20,20\n", "a.csv:3: strain: 10 cannot be right"},
       {"absurd", kJson, "time_s,strain,stress_pa\n0,0,0\n1,0.01,1e12\n2,0.02,20\n", "a.csv:3: stress_pa: 1e+12 Pa cannot be right"},
       // One test in kPa next to one in Pa (b.csv: 10 Pa at 1% strain, a modulus of 1 kPa; a.csv the same written in kPa).
-      {"one-test-kpa", kJson, "time_s,strain,stress_pa\n0,0,0\n1,0.01,0.01\n2,0.02,0.02\n", "a.csv: stress_pa: apparent modulus 1 Pa is 0.001 times the other tests' (1000 Pa)"},
+      {"one-test-kpa", kJson, "time_s,strain,stress_pa\n0,0,0\n1,0.01,0.01\n2,0.02,0.02\n",
+       "a.csv: stress_pa: apparent modulus 1 Pa is 0.001 times the other tests' (1000 Pa)"},
       // Every test in kPa: liver's 5 kPa written as 5.
-      {"all-kpa", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "strain"}]})",
-       "time_s,strain,stress_pa\n0,0,0\n1,0.01,0.05\n2,0.02,0.1\n", "dataset.json: tests: apparent modulus 5 Pa (peak stress / peak strain) is below any tissue"},
-      {"time-1e300", kJson, "time_s,strain,stress_pa\n0,0,0\n1e300,0.01,10\n2e300,0.02,20\n", "a.csv: time_s: the test spans 2e+300 s, more than 86400 s"},
-      {"outside", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "../../../../../../../../etc/passwd", "control": "strain"}]})",
+      {"all-kpa",
+       R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "strain"}]})",
+       "time_s,strain,stress_pa\n0,0,0\n1,0.01,0.05\n2,0.02,0.1\n",
+       "dataset.json: tests: apparent modulus 5 Pa (peak stress / peak strain) is below any tissue"},
+      {"time-1e300", kJson, "time_s,strain,stress_pa\n0,0,0\n1e300,0.01,10\n2e300,0.02,20\n",
+       "a.csv: time_s: the test spans 2e+300 s, more than 86400 s"},
+      {"outside",
+       R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "../../../../../../../../etc/passwd", "control": "strain"}]})",
        kCsv, "dataset.json: tests[0].file: '../../../../../../../../etc/passwd' lies outside the data-set folder"},
-      {"absolute", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "/etc/passwd", "control": "strain"}]})",
+      {"absolute",
+       R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "/etc/passwd", "control": "strain"}]})",
        kCsv, "tests[0].file: '/etc/passwd' must be a file name relative to the data-set folder"},
       {"bom", kJson, "\xEF\xBB\xBFtime_s,strain,stress_pa\n0,0,0\n1,0.01,10\n2,0.02,20\n", "no error"},
       {"bom-json", "\xEF\xBB\xBF" + kJson, kCsv, "no error"},
-      {"overflow", R"({"mode": "uniaxial", "specimen": {"length_m": 1e999}, "tests": []})", kCsv, "dataset.json:1: JSON: number overflow parsing '1e999'"},
+      {"overflow", R"({"mode": "uniaxial", "specimen": {"length_m": 1e999}, "tests": []})", kCsv,
+       "dataset.json:1: JSON: number overflow parsing '1e999'"},
       {"twice", R"({"mode": "uniaxial", "mode": "simple_shear", "specimen": {}, "tests": []})", kCsv, "dataset.json: mode: given twice"},
       {"header-binary", kJson, "\x01\x02time\n0,0,0\n", "a.csv:1: time_s: column missing (the first line, '\\x01\\x02time', must name"},
       {"mode", R"({"mode": "torsion", "specimen": {}, "tests": []})", kCsv, "dataset.json: mode: 'torsion'"},
-      {"dims", R"({"mode": "uniaxial", "specimen": {"length_m": 10000, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": []})", kCsv, "specimen.length_m: 10000 is outside [1e-06, 10]"},
-      {"control", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "force"}]})", kCsv, "tests[0].control: 'force'"},
-      {"missing", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "zz.csv", "control": "strain"}]})", kCsv, "zz.csv: cannot open file"},
+      {"dims", R"({"mode": "uniaxial", "specimen": {"length_m": 10000, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": []})",
+       kCsv, "specimen.length_m: 10000 is outside [1e-06, 10]"},
+      {"control",
+       R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "force"}]})",
+       kCsv, "tests[0].control: 'force'"},
+      {"missing",
+       R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "zz.csv", "control": "strain"}]})",
+       kCsv, "zz.csv: cannot open file"},
       {"garbage", kJson, "time_s,strain,stress_pa\n0,0,0\n1,abc,10\n2,0.02,20\n", "a.csv:3: strain: 'abc' is not a number"},
       // A misspelt field would otherwise be ignored without a word.
       {"unknown", R"({"mode": "uniaxial", "temperature_c": 37, "specimen": {}, "tests": []})", kCsv, "dataset.json: temperature_c: unknown field"},
-      {"unknown-specimen", R"({"mode": "uniaxial", "specimen": {"lenght_m": 0.01}, "tests": []})", kCsv, "dataset.json: specimen.lenght_m: unknown field"},
-      {"unknown-test", R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "contol": "strain"}]})", kCsv, "dataset.json: tests[0].contol: unknown field"},
+      {"unknown-specimen", R"({"mode": "uniaxial", "specimen": {"lenght_m": 0.01}, "tests": []})", kCsv,
+       "dataset.json: specimen.lenght_m: unknown field"},
+      {"unknown-test",
+       R"({"mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "contol": "strain"}]})",
+       kCsv, "dataset.json: tests[0].contol: unknown field"},
       {"mode-type", R"({"mode": 3, "specimen": {}, "tests": []})", kCsv, "dataset.json: mode: 3 is not a string"},
       {"array", R"([1, 2])", kCsv, "dataset.json: JSON: [1,2] is not an object"},
   };
@@ -136,6 +152,6 @@ TEST(Dataset, AMillionRowTestIsDecimatedForTheFitAndGivesTheSameVerdict) {
   bool told_time = false;
   for (const auto& l : lines) told_time |= l.find("s left") != std::string::npos;
   EXPECT_TRUE(told_time) << "the progress lines give the time left";
-  std::cout << "[ figure ] a 1.3-million-row test (" << static_cast<double>(std::filesystem::file_size(dir + "/ramp_10s.csv")) / 1e6 << " MB): read and analysed in " << seconds
-            << " s, gain " << a.gain << "\n";
+  std::cout << "[ figure ] a 1.3-million-row test (" << static_cast<double>(std::filesystem::file_size(dir + "/ramp_10s.csv")) / 1e6
+            << " MB): read and analysed in " << seconds << " s, gain " << a.gain << "\n";
 }

@@ -1,12 +1,13 @@
 // viscera-lab must find the effect hidden in synthetic data (or none), seeing only the folder.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <filesystem>
 #include <map>
 
+#include <gtest/gtest.h>
+
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
+
 #include "synthetic_data.hpp"
 
 using namespace viscera::lab;
@@ -24,8 +25,10 @@ TEST(HiddenEffect, NamedCorrectlyIn95PercentOf40SeedsWithGainAboveNoise) {
     std::string found = a.causes.empty() ? "none" : name(a.causes.front());
     const bool ok = (truth.effect == test::Effect::none) ? a.causes.empty() : (a.causes.size() == 1 && found == expected);
     ++total;
-    if (ok) ++correct;
-    else wrong[expected + " -> " + found + (a.causes.size() > 1 ? " (+more)" : "")]++;
+    if (ok)
+      ++correct;
+    else
+      wrong[expected + " -> " + found + (a.causes.size() > 1 ? " (+more)" : "")]++;
     if (!a.causes.empty()) {
       // A named cause must come with a held-out gain above noise.
       const double reduction = a.baseline.heldout_rms_pa * a.baseline.heldout_rms_pa - a.final.heldout_rms_pa * a.final.heldout_rms_pa;
@@ -202,10 +205,9 @@ TEST(Specimen, FirstLoadSofteningRunsPerEdgeInBothModes) {
       const double history_error = rms(spec, law) / rms(law, {});
       if (effect < 0.05) continue;  // monotonic ramps: only the noise dips below the extreme
       const double effect_error = rms(spec_effect, law_effect) / rms(law_effect, {});
-      std::cout << "[ figure ] seed " << seed << " (" << (d.mode == Mode::uniaxial ? "uniaxial" : "simple shear") << ", d = " << m.softening_d
-                << ") " << t.file << ": the softening changes the law's stress by " << 100 * effect
-                << "% RMS; the specimen's change differs from that by " << 100 * effect_error << "% of it; specimen vs law "
-                << 100 * history_error << "%\n";
+      std::cout << "[ figure ] seed " << seed << " (" << (d.mode == Mode::uniaxial ? "uniaxial" : "simple shear") << ", d = " << m.softening_d << ") "
+                << t.file << ": the softening changes the law's stress by " << 100 * effect << "% RMS; the specimen's change differs from that by "
+                << 100 * effect_error << "% of it; specimen vs law " << 100 * history_error << "%\n";
       ++reloading;
       EXPECT_LT(effect_error, 0.10) << t.file;
       if (d.mode == Mode::uniaxial) {

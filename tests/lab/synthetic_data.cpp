@@ -50,8 +50,10 @@ struct Shape {
     return s;
   }
   void advance(double e) {
-    if (e >= 0) peak_t = std::max(peak_t, e);
-    else peak_c = std::max(peak_c, -e);
+    if (e >= 0)
+      peak_t = std::max(peak_t, e);
+    else
+      peak_c = std::max(peak_c, -e);
   }
 };
 

@@ -14,7 +14,7 @@ const char* effect_name(Effect e);
 
 struct Truth {
   Effect effect = Effect::none;
-  double modulus_pa = 0, tau_s = 0;          // Kelvin-Voigt baseline: sigma = E (s + tau ds/dt)
+  double modulus_pa = 0, tau_s = 0;  // Kelvin-Voigt baseline: sigma = E (s + tau ds/dt)
   double spectrum_pa[2] = {0, 0}, spectrum_tau_s[2] = {1, 1};  // broadband: two off-grid relaxations
   double stiffening_b = 0, compression_ratio = 1, softening_d = 0;
   // Broadband, outside the lab's family: a continuous power-law relaxation E_p (1 + t/tau0)^-alpha

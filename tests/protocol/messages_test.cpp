@@ -1,11 +1,11 @@
 // Every decoder against good, truncated, garbage, wrong-schema and out-of-range payloads.
-#include <gtest/gtest.h>
+#include "viscera/protocol/messages.hpp"
 
 #include <cmath>
 #include <limits>
 #include <random>
 
-#include "viscera/protocol/messages.hpp"
+#include <gtest/gtest.h>
 
 using namespace viscera::protocol;
 
@@ -168,7 +168,7 @@ TEST(Messages, EventsRoundTripAndBadOnesAreRejected) {
   EXPECT_FALSE(decode_event(encode(e), &why));
   auto bytes = encode(Event{});
   EXPECT_FALSE(decode_event(std::span(bytes).first(bytes.size() - 6), &why));  // truncated
-  EXPECT_FALSE(decode_event(encode(good_command()), &why));                   // another schema
+  EXPECT_FALSE(decode_event(encode(good_command()), &why));  // another schema
 }
 
 TEST(Messages, RunTimeControlRequestsRoundTripAndBadOnesAreRejected) {

@@ -3,11 +3,12 @@
 // decode. Schema 1 is the frozen copy in tests/protocol/schema_v1 (namespace viscera::wire_v1).
 #include <gtest/gtest.h>
 
+#include "viscera/protocol/messages.hpp"  // schema 2 (current)
+
 #include "force_feedback_generated.h"  // schema 1, from tests/protocol/schema_v1
 #include "instrument_command_generated.h"
 #include "session_generated.h"
 #include "telemetry_generated.h"
-#include "viscera/protocol/messages.hpp"  // schema 2 (current)
 
 namespace v1 = viscera::wire_v1;
 using namespace viscera::protocol;

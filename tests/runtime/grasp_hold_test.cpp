@@ -3,12 +3,12 @@
 // of that force about the tip; only the nodes within the grasp radius are held; the forces on the
 // tissue are the opposite of the tool's; during a step each spring acts at the extension the step
 // will end at.
-#include <gtest/gtest.h>
+#include "viscera/runtime/grasp_hold.hpp"
 
 #include <cmath>
 #include <numbers>
 
-#include "viscera/runtime/grasp_hold.hpp"
+#include <gtest/gtest.h>
 
 using namespace viscera::runtime;
 

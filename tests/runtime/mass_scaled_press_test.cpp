@@ -4,15 +4,15 @@
 // enter statics; the two differ only by the inertia of the added mass), and a probe resting on the
 // surface leaves it as quiet as on the unscaled organ. Without a dashpot in the contact the held
 // force rings; with one it does not.
-#include <gtest/gtest.h>
-
 #include <cmath>
 
+#include <gtest/gtest.h>
+
 #include "viscera/common/input_error.hpp"
-#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/runtime/organ.hpp"
 #include "viscera/runtime/probe_contact.hpp"
 #include "viscera/runtime/scene_file.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 
 using namespace viscera::runtime;
 using namespace viscera::tissue;
@@ -20,16 +20,15 @@ using namespace viscera::tissue;
 namespace {
 
 struct PressRecord {
-  std::vector<double> force_n;     // |F| on the tool after each 1 ms tick
-  std::vector<double> speed_m_s;   // the fastest node's speed after each tick
+  std::vector<double> force_n;  // |F| on the tool after each 1 ms tick
+  std::vector<double> speed_m_s;  // the fastest node's speed after each tick
   double dt_s = 0;
 };
 
 PressRecord press(SceneSpec spec, double added_mass_fraction, double depth_m, double seconds) {
   spec.added_mass_fraction = added_mass_fraction;
   const auto organ = build_organ(spec);
-  const ProbeContact probe(organ->boundary.triangles, organ->mesh->nodes, 0.006, spec.contact_stiffness_n_per_m, 0.02,
-                           spec.contact_damping_s_per_m);
+  const ProbeContact probe(organ->boundary.triangles, organ->mesh->nodes, 0.006, spec.contact_stiffness_n_per_m, 0.02, spec.contact_damping_s_per_m);
   Vec3 tool_velocity = Vec3::Zero();
   const Box& b = organ->bounds;
   Vec3 tool(0.5 * (b.lo.x() + b.hi.x()), 0.5 * (b.lo.y() + b.hi.y()), b.hi.z() + 0.01);
@@ -84,7 +83,7 @@ TEST(MassScaledPress, TwelveThousandTetLiverStaysStableAndFeelsTheSameHeldForce)
   std::cout << "[ figure ] 12k liver, 3 cm press held: explicit step " << physical.dt_s << " -> " << scaled.dt_s
             << " s with +5% mass; held force over the last 0.5 s " << mp << " N (sd " << sp << ") without, " << ms << " N (sd " << ss
             << ") with the added mass\n";
-  EXPECT_GT(mp, 0.5);              // the press is felt
+  EXPECT_GT(mp, 0.5);  // the press is felt
   EXPECT_NEAR(ms, mp, 0.02 * mp);  // and the same with the added mass
   EXPECT_GT(scaled.dt_s, 2.5 * physical.dt_s);
 }
@@ -101,8 +100,8 @@ TEST(MassScaledPress, AProbeRestingOnTheSurfaceLeavesItAsQuietAsWithoutTheAddedM
   ASSERT_NO_THROW(physical = press(spec, 0.0, 0.0005, 2.0));
   const auto fastest_in_last_second = [](const PressRecord& r) { return *std::max_element(r.speed_m_s.end() - 1000, r.speed_m_s.end()); };
   const double vs = fastest_in_last_second(scaled), vp = fastest_in_last_second(physical);
-  std::cout << "[ figure ] 12k liver, probe resting 0.5 mm deep: fastest node over the last second " << vp << " m/s with the physical mass, "
-            << vs << " m/s with +5%\n";
+  std::cout << "[ figure ] 12k liver, probe resting 0.5 mm deep: fastest node over the last second " << vp << " m/s with the physical mass, " << vs
+            << " m/s with +5%\n";
   EXPECT_GT(vp, 0.0);
   EXPECT_LT(vs, 3 * vp);
 }
@@ -125,8 +124,8 @@ TEST(ContactSprings, TheHeldForceRingsLittleWithoutADashpotAndLessWithOne) {
       ringing[damped] = std::sqrt(change / 500);
       mean[damped] = held(r).first;
     }
-    std::cout << "[ figure ] " << name << " (+" << 100 * added_mass << "% mass), 3 cm press held: force " << mean[0]
-              << " N, rms change per tick " << ringing[0] << " N without a contact dashpot, " << ringing[1] << " N with alpha 1 s/m\n";
+    std::cout << "[ figure ] " << name << " (+" << 100 * added_mass << "% mass), 3 cm press held: force " << mean[0] << " N, rms change per tick "
+              << ringing[0] << " N without a contact dashpot, " << ringing[1] << " N with alpha 1 s/m\n";
     EXPECT_LT(ringing[0], 0.05 * mean[0]) << name;
     EXPECT_LT(ringing[1], ringing[0]) << name;
     EXPECT_NEAR(mean[1], mean[0], 0.01 * mean[0]) << name;  // a dashpot does not change the held force

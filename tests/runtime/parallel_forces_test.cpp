@@ -2,16 +2,17 @@
 // same model): equal to rounding, memory variables advanced the same, deterministic bit for bit
 // whatever the threads' timing, instability (NaN) still reported, and models that do not split
 // (corotational FE) still whole. An explicit run on two threads follows the one-thread run.
-#include <gtest/gtest.h>
+#include "viscera/runtime/parallel_forces.hpp"
 
 #include <cmath>
 #include <random>
+
+#include <gtest/gtest.h>
 
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
-#include "viscera/runtime/parallel_forces.hpp"
 #include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 using namespace viscera::runtime;

@@ -2,9 +2,9 @@
 // deepest penetration whatever the number of triangles under the tip, pushing out along the
 // normal even when the tip centre has passed below the surface (no tunnelling), nothing out of
 // reach, and the broad phase still finds the contact on a plate stretched well beyond rest.
-#include <gtest/gtest.h>
-
 #include "viscera/runtime/probe_contact.hpp"
+
+#include <gtest/gtest.h>
 
 using namespace viscera::runtime;
 using viscera::tissue::Triangle;
@@ -44,7 +44,7 @@ TEST(ProbeContact, OneSpringAtTheDeepestPenetrationWhateverTheMeshing) {
       for (const auto& v : f) on_plate += v;
       EXPECT_NEAR((on_plate + c.force_on_tool).norm(), 0.0, 1e-9) << "action and reaction";
     }
-    EXPECT_FALSE(contact.query(Vec3(0, 0, r + 1e-4), p.x).in_contact);     // just above
+    EXPECT_FALSE(contact.query(Vec3(0, 0, r + 1e-4), p.x).in_contact);  // just above
     EXPECT_FALSE(contact.query(Vec3(0, 0, -0.0201), p.x).in_contact);  // centre beyond the 2 cm depth limit
   }
 }
@@ -73,25 +73,25 @@ TEST(ProbeContact, HuntCrossleyDashpotGrowsWithDepthAndRateAndNeverPulls) {
   const ProbeContact contact(p.triangles, p.x, r, k, 0.02, alpha);
   const Vec3 tip(0.0003, -0.0002, r - depth);
   for (const double dt : {0.0, 4e-4})
-  for (const double u : {0.0, 0.4, -0.7, -5.0})
-    for (const double w : {0.0, -0.1}) {
-      const std::vector<Vec3> v(p.x.size(), Vec3(0.01, 0.0, u));  // sliding along the plate changes nothing
-      std::vector<Vec3> f(p.x.size(), Vec3::Zero());
-      std::vector<double> stiffness(p.x.size(), 0.0), damping(p.x.size(), 0.0);
-      const ContactResult res = contact.apply(tip, Vec3(0.02, 0, w), {p.x, v, f, stiffness, damping, dt});
-      const double expected = std::max(0.0, k * (depth + dt * (u - w)) + c * (u - w));
-      EXPECT_NEAR(res.force_on_tool.z(), expected, 1e-9) << "u " << u << " w " << w << " dt " << dt;
-      Vec3 on_plate = Vec3::Zero();
-      for (const auto& x : f) on_plate += x;
-      EXPECT_NEAR((on_plate + res.force_on_tool).norm(), 0.0, 1e-9);
-      double bound = 0, stiff = 0;
-      for (std::size_t i = 0; i < damping.size(); ++i) {
-        bound += damping[i];
-        stiff += stiffness[i];
+    for (const double u : {0.0, 0.4, -0.7, -5.0})
+      for (const double w : {0.0, -0.1}) {
+        const std::vector<Vec3> v(p.x.size(), Vec3(0.01, 0.0, u));  // sliding along the plate changes nothing
+        std::vector<Vec3> f(p.x.size(), Vec3::Zero());
+        std::vector<double> stiffness(p.x.size(), 0.0), damping(p.x.size(), 0.0);
+        const ContactResult res = contact.apply(tip, Vec3(0.02, 0, w), {p.x, v, f, stiffness, damping, dt});
+        const double expected = std::max(0.0, k * (depth + dt * (u - w)) + c * (u - w));
+        EXPECT_NEAR(res.force_on_tool.z(), expected, 1e-9) << "u " << u << " w " << w << " dt " << dt;
+        Vec3 on_plate = Vec3::Zero();
+        for (const auto& x : f) on_plate += x;
+        EXPECT_NEAR((on_plate + res.force_on_tool).norm(), 0.0, 1e-9);
+        double bound = 0, stiff = 0;
+        for (std::size_t i = 0; i < damping.size(); ++i) {
+          bound += damping[i];
+          stiff += stiffness[i];
+        }
+        EXPECT_NEAR(bound, std::sqrt(3.0) * c, 1e-9);  // shares and barycentric weights sum to 1
+        EXPECT_NEAR(stiff, std::sqrt(3.0) * k, 1e-9);
       }
-      EXPECT_NEAR(bound, std::sqrt(3.0) * c, 1e-9);  // shares and barycentric weights sum to 1
-      EXPECT_NEAR(stiff, std::sqrt(3.0) * k, 1e-9);
-    }
   // Without velocities (the command thread's query) the contact is the spring alone.
   EXPECT_NEAR(contact.query(tip, p.x).force_on_tool.z(), k * depth, 1e-9);
 }

@@ -3,10 +3,10 @@
 // carry the counts as they are.
 #include "viscera/runtime/server_statistics.hpp"
 
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <random>
+
+#include <gtest/gtest.h>
 
 namespace viscera::runtime {
 namespace {

@@ -3,12 +3,12 @@
 // are checked directly.
 #include "viscera/runtime/session_control.hpp"
 
-#include <gtest/gtest.h>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <thread>
+
+#include <gtest/gtest.h>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/runtime/organ.hpp"
@@ -83,8 +83,9 @@ TEST(SessionControl, OneBuildAtATimeEachWithItsOutcome) {
 }
 
 TEST(SessionControl, AMissingOrBrokenSceneIsRefusedWithWhatThereIs) {
-  SessionControl s(scene_folder(), [](const SceneSpec&) { return std::make_shared<Organ>(); },
-                   [](const std::shared_ptr<const Organ>&, const protocol::MaterialChange&, double) { return std::make_shared<Organ>(); });
+  SessionControl s(
+      scene_folder(), [](const SceneSpec&) { return std::make_shared<Organ>(); },
+      [](const std::shared_ptr<const Organ>&, const protocol::MaterialChange&, double) { return std::make_shared<Organ>(); });
   const auto missing = s.start_scene(request(protocol::Action::load_scene, 1, "kidney"), 0);
   ASSERT_TRUE(missing);
   EXPECT_NE(missing->find("no scene 'kidney' in "), std::string::npos);

@@ -67,7 +67,7 @@ TEST(SimulatedTool, AContactEndsAfter50msWithoutTouchingSoABounceIsOneContact) {
   EXPECT_EQ(tool.update_contact(true, 1.000), ToolEvent::contact_started);
   EXPECT_EQ(tool.update_contact(true, 1.001), ToolEvent::none);
   EXPECT_EQ(tool.update_contact(false, 1.030), ToolEvent::none);  // bounced off for 30 ms
-  EXPECT_EQ(tool.update_contact(true, 1.031), ToolEvent::none);   // back: the same contact
+  EXPECT_EQ(tool.update_contact(true, 1.031), ToolEvent::none);  // back: the same contact
   EXPECT_EQ(tool.update_contact(false, 1.031 + kContactEndAfterS - 1e-4), ToolEvent::none);
   EXPECT_EQ(tool.update_contact(false, 1.031 + kContactEndAfterS + 1e-4), ToolEvent::contact_ended);
   EXPECT_EQ(tool.update_contact(false, 2.0), ToolEvent::none);

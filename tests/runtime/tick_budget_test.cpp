@@ -4,14 +4,14 @@
 // the step, the sub-steps and the limit in the message.
 #include "viscera/runtime/tick_budget.hpp"
 
-#include <gtest/gtest.h>
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
+
+#include <gtest/gtest.h>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/runtime/organ.hpp"
@@ -36,7 +36,7 @@ SceneSpec liver() {
 
 TEST(TickBudget, SubStepsPerTickAreTheCeilingOfTickOverStep) {
   EXPECT_EQ(substeps_per_tick(4e-4, 1000), 3);
-  EXPECT_EQ(substeps_per_tick(5e-4, 1000), 2);   // exactly two: not three from rounding
+  EXPECT_EQ(substeps_per_tick(5e-4, 1000), 2);  // exactly two: not three from rounding
   EXPECT_EQ(substeps_per_tick(1e-3, 1000), 1);
   EXPECT_EQ(substeps_per_tick(2.8e-12, 1000), 357142858);
 }
@@ -59,7 +59,8 @@ TEST(TickBudget, AStepThatCannotRunOrNeedsTooManySubStepsIsRefused) {
 
 TEST(TickBudget, ATickLongerThanItsSlotIsNamedSlowerThanRealTime) {
   EXPECT_EQ(tick_cost(4e-4, 1e-4, 1000), "3 sub-steps of 100 us = 0.3 ms per 1 ms tick");
-  EXPECT_EQ(tick_cost(2.5e-4, 1e-2, 1000), "4 sub-steps of 10000 us = 40 ms per 1 ms tick, slower than real time: about 25 ticks/s (2.5% of real time)");
+  EXPECT_EQ(tick_cost(2.5e-4, 1e-2, 1000),
+            "4 sub-steps of 10000 us = 40 ms per 1 ms tick, slower than real time: about 25 ticks/s (2.5% of real time)");
 }
 
 TEST(TickBudget, TheLiverStepScalesAsOneOverTheRootOfItsModulusAndAStiffLiverIsRefusedAtOnce) {

@@ -3,9 +3,9 @@
 // before its slot (no bursts), and every slot that has ended holds a tick or is counted missed.
 #include "viscera/runtime/tick_grid.hpp"
 
-#include <gtest/gtest.h>
-
 #include <random>
+
+#include <gtest/gtest.h>
 
 namespace viscera::runtime {
 namespace {

@@ -3,15 +3,16 @@
 // zero, and (Saint-Venant) u_x = -kappa (z^2 + nu (x^2 - y^2)) / 2, u_y = -kappa nu x y,
 // u_z = kappa x z, exact on any prismatic section with a traction-free lateral surface. Both end
 // faces get the exact displacement; the bending moment at the base is M = E I kappa.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <functional>
+
+#include <gtest/gtest.h>
 
 #include "viscera/tissue/fem/finite_element_model.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
 #include "viscera/tissue/mesh/box_mesh.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -60,15 +61,16 @@ Result solve(const ForceModel& model, const TetMesh& mesh) {
 void check_convergence(const char* name, const std::function<std::unique_ptr<ForceModel>(std::shared_ptr<TetMesh>)>& make) {
   std::vector<Result> r;
   for (int n : {1, 2, 4}) {
-    auto mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(-kHalfWidth, -kHalfWidth, 0), Vec3(kHalfWidth, kHalfWidth, kLength), 2 * n, 2 * n, 8 * n));
+    auto mesh =
+        std::make_shared<TetMesh>(make_box_mesh(Vec3(-kHalfWidth, -kHalfWidth, 0), Vec3(kHalfWidth, kHalfWidth, kLength), 2 * n, 2 * n, 8 * n));
     r.push_back(solve(*make(mesh), *mesh));
   }
   for (std::size_t k = 0; k < r.size(); ++k) {
-    std::cout << "[ figure ] pure bending, " << name << ", " << r[k].tets << " tets: RMS displacement error "
-              << r[k].displacement_error << ", base moment error " << r[k].moment_error;
+    std::cout << "[ figure ] pure bending, " << name << ", " << r[k].tets << " tets: RMS displacement error " << r[k].displacement_error
+              << ", base moment error " << r[k].moment_error;
     if (k > 0)
-      std::cout << "; convergence rates " << std::log2(r[k - 1].displacement_error / r[k].displacement_error)
-                << " (displacement), " << std::log2(r[k - 1].moment_error / r[k].moment_error) << " (moment)";
+      std::cout << "; convergence rates " << std::log2(r[k - 1].displacement_error / r[k].displacement_error) << " (displacement), "
+                << std::log2(r[k - 1].moment_error / r[k].moment_error) << " (moment)";
     std::cout << "\n";
   }
   EXPECT_GT(std::log2(r[1].displacement_error / r[2].displacement_error), 1.6) << name;  // O(h^2)
@@ -81,9 +83,7 @@ Mat6 material() { return elasticity_matrix(IsotropicElasticity{kE, kNu}); }
 }  // namespace
 
 TEST(BeamConvergence, LinearFeConvergesToPureBending) {
-  check_convergence("linear", [](auto mesh) {
-    return std::make_unique<FiniteElementModel>(mesh, FeKind::linear, std::vector<Mat6>{material()});
-  });
+  check_convergence("linear", [](auto mesh) { return std::make_unique<FiniteElementModel>(mesh, FeKind::linear, std::vector<Mat6>{material()}); });
 }
 
 TEST(BeamConvergence, GpsConvergesToPureBending) {

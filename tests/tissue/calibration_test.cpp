@@ -5,6 +5,7 @@
 #include "viscera/tissue/fem/finite_element_model.hpp"
 #include "viscera/tissue/gps/gps_calibration.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -15,8 +16,7 @@ namespace {
 double relative(const Mat6& a, const Mat6& b) { return (a - b).norm() / b.norm(); }
 
 // max over random u (|u_i| = 1e-8 x element size) of |f_gps - f_fe| / |f_fe|.
-double small_strain_force_error(const ForceModel& gps, const std::array<Vec3, 4>& rest, const Mat6& D,
-                                std::mt19937_64& rng) {
+double small_strain_force_error(const ForceModel& gps, const std::array<Vec3, 4>& rest, const Mat6& D, std::mt19937_64& rng) {
   const Mat12 K = linear_fe_stiffness(rest, D);
   double size = 0.0;
   for (const auto& [a, b] : kTetEdges) size = std::max(size, (rest[b] - rest[a]).norm());
@@ -41,8 +41,7 @@ double small_strain_force_error(const ForceModel& gps, const std::array<Vec3, 4>
 }
 
 std::vector<Mat6> materials(std::mt19937_64& rng) {
-  return {test::soft_tissue(),
-          elasticity_matrix(TransverselyIsotropicElasticity{2e3, 0.45, 20e3, 0.35, 3e3, Vec3(1, 1, 0)}),
+  return {test::soft_tissue(), elasticity_matrix(TransverselyIsotropicElasticity{2e3, 0.45, 20e3, 0.35, 3e3, Vec3(1, 1, 0)}),
           test::random_spd(rng, 1e4)};
 }
 
@@ -96,8 +95,8 @@ TEST(GpsSmallStrain, ForcesEqualLinearFeOnRandomTets) {
           const GpsModel gps(test::single_tet_mesh(x), {D}, {}, {variant, volume_fraction});
           worst = std::max(worst, small_strain_force_error(gps, x, D, rng));
         }
-        std::cout << "[ figure ] GPS vs linear FE at |u| = 1e-8 h, variant " << static_cast<int>(variant)
-                  << ", volume " << volume_fraction << ": max relative force error " << worst << "\n";
+        std::cout << "[ figure ] GPS vs linear FE at |u| = 1e-8 h, variant " << static_cast<int>(variant) << ", volume " << volume_fraction
+                  << ": max relative force error " << worst << "\n";
         EXPECT_LT(worst, 1e-6);
       }
 }

@@ -3,11 +3,11 @@
 #include <gtest/gtest.h>
 
 #include "viscera/common/input_error.hpp"
-#include "viscera/tissue/integrator/simulation_error.hpp"
-
 #include "viscera/tissue/fem/finite_element_model.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -57,11 +57,13 @@ TEST(Conservation, FreeFlightConservesLinearAndAngularMomentum) {
     const Momenta p1 = momenta(s, integrator.masses());
     const double dp = (p1.linear - p0.linear).norm() / p0.linear.norm();
     const double dl = (p1.angular - p0.angular).norm() / p0.angular.norm();
-    std::cout << "[ figure ] " << model->name() << " free flight, 200 steps: relative change of linear momentum "
-              << dp << ", angular momentum " << dl << "\n";
+    std::cout << "[ figure ] " << model->name() << " free flight, 200 steps: relative change of linear momentum " << dp << ", angular momentum " << dl
+              << "\n";
     EXPECT_LT(dp, 1e-12) << model->name();
-    if (model != &linear) EXPECT_LT(dl, 1e-9) << model->name();
-    else EXPECT_GT(dl, 1e-6) << "linear FE is not rotation invariant, so its torques do not cancel";
+    if (model != &linear)
+      EXPECT_LT(dl, 1e-9) << model->name();
+    else
+      EXPECT_GT(dl, 1e-6) << "linear FE is not rotation invariant, so its torques do not cancel";
   }
 }
 
@@ -97,8 +99,8 @@ TEST(Conservation, EnergyConsistentGpsConservesEnergyInFreeVibration) {
       outcome = std::string("went unstable: ") + e.what();
     }
     drift[k++] = worst;
-    std::cout << "[ figure ] " << model->name() << " free vibration to t = " << s.time_s
-              << " s: max |E(t) - E0| / E0 = " << worst << "; " << outcome << "\n";
+    std::cout << "[ figure ] " << model->name() << " free vibration to t = " << s.time_s << " s: max |E(t) - E0| / E0 = " << worst << "; " << outcome
+              << "\n";
   }
   EXPECT_LT(drift[1], 0.02);  // bounded O(dt^2) oscillation of a symplectic integrator
   EXPECT_GT(drift[0], 10 * drift[1]);  // the non-conservative paper form pumps energy
@@ -137,8 +139,7 @@ TEST(Conservation, PaperGpsDoesWorkAroundAClosedLoopEnergyConsistentDoesNot) {
   for (int i = 0; i < 4; ++i) peak[i] += a.segment<3>(3 * i);
   const double scale = energy.energy(peak);
   const double w_paper = loop_work(paper) / scale, w_energy = loop_work(energy) / scale;
-  std::cout << "[ figure ] work around a closed loop / strain energy: paper GPS " << w_paper
-            << ", energy-consistent GPS " << w_energy << "\n";
+  std::cout << "[ figure ] work around a closed loop / strain energy: paper GPS " << w_paper << ", energy-consistent GPS " << w_energy << "\n";
   EXPECT_LT(std::abs(w_energy), 1e-6);
   EXPECT_GT(std::abs(w_paper), 1e-4);
 }

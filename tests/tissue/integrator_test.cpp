@@ -1,21 +1,21 @@
 // Integrators against theory: the computed stable step versus the true global limit 2/omega_max,
 // instability detected at the limit, backward Euler against a dense solve, static equilibrium.
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include <Eigen/Dense>
-
 #include "viscera/common/input_error.hpp"
-#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/fem/finite_element_model.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
 #include "viscera/tissue/integrator/mass_scaling.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/box_mesh.hpp"
 #include "viscera/tissue/mesh/refinement.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
 #include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -87,8 +87,8 @@ TEST(StableStep, IsSafeAndNotFarFromTheTrueGlobalLimit) {
   const ExplicitIntegrator integrator(gps, s.rho(), {});
   const double exact = true_critical_step(*s.mesh, integrator.masses(), test::soft_tissue());
   const double computed = integrator.critical_step().dt_s;
-  std::cout << "[ figure ] liver (596 tets): element-bound critical step " << computed << " s, true global "
-            << exact << " s, ratio " << computed / exact << "\n";
+  std::cout << "[ figure ] liver (596 tets): element-bound critical step " << computed << " s, true global " << exact << " s, ratio "
+            << computed / exact << "\n";
   EXPECT_LE(computed, exact * (1 + 1e-9));
   EXPECT_GT(computed, 0.2 * exact);  // the element bound is conservative (Irons)
 }
@@ -186,9 +186,8 @@ TEST(Implicit, NewtonConvergesOnTheNonlinearGpsAndReportsIterations) {
   const NewtonReport rep = implicit.solve_static(st);  // large sag of a soft organ under gravity
   double sag = 0;
   for (std::size_t i = 0; i < st.x.size(); ++i) sag = std::max(sag, s.mesh->nodes[i].z() - st.x[i].z());
-  std::cout << "[ figure ] static sag of a cantilevered liver under gravity: " << sag << " m in "
-            << rep.iterations << " Newton iterations, residual " << rep.residual_n << " N of " << rep.force_scale_n
-            << " N\n";
+  std::cout << "[ figure ] static sag of a cantilevered liver under gravity: " << sag << " m in " << rep.iterations << " Newton iterations, residual "
+            << rep.residual_n << " N of " << rep.force_scale_n << " N\n";
   EXPECT_TRUE(rep.converged);
   EXPECT_GT(sag, 0.0);
   // Equilibrium check by another path: total reaction at the fixed nodes balances the weight.
@@ -211,10 +210,10 @@ TEST(StableStep, GlobalEstimateIsCloseToTheTrueLimitFromBelowWithItsMargin) {
   const ExplicitIntegrator integrator(gps, s.rho(), {}, o);
   const double exact = true_critical_step(*s.mesh, integrator.masses(), test::soft_tissue());
   const double estimate = integrator.critical_step().dt_s;
-  std::cout << "[ figure ] liver (596 tets): global estimate of the critical step " << estimate << " s, true " << exact
-            << " s, ratio " << estimate / exact << "\n";
-  EXPECT_LE(estimate, exact);         // the margin covers the Rayleigh quotient's underestimate
-  EXPECT_GT(estimate, 0.9 * exact);   // and costs little
+  std::cout << "[ figure ] liver (596 tets): global estimate of the critical step " << estimate << " s, true " << exact << " s, ratio "
+            << estimate / exact << "\n";
+  EXPECT_LE(estimate, exact);  // the margin covers the Rayleigh quotient's underestimate
+  EXPECT_GT(estimate, 0.9 * exact);  // and costs little
   // At the safety factor 0.9 of the estimate the run is stable.
   ExplicitIntegrator run(gps, s.rho(), {}, o);
   State st = State::at_rest(*s.mesh);
@@ -356,8 +355,8 @@ TEST(Explicit, FieldSpringsAtTheEndOfStepExtensionAreBackwardEulerAndNeverGainEn
       if (b.v[0].x() != 0) last_v = b.v[0].x();
       if (std::abs(u) < a && std::abs(u - dt * b.v[0].x()) < a) highest = std::max(highest, run.kinetic_energy(b));
     }
-    std::cout << "[ figure ] dt^2 kappa " << q << ": " << reversals << " velocity reversals, highest kinetic energy between contacts "
-              << highest / e0 << " of the first, last " << run.kinetic_energy(b) / e0 << "\n";
+    std::cout << "[ figure ] dt^2 kappa " << q << ": " << reversals << " velocity reversals, highest kinetic energy between contacts " << highest / e0
+              << " of the first, last " << run.kinetic_energy(b) / e0 << "\n";
     EXPECT_GE(reversals, 3) << q;
     EXPECT_LE(highest, e0 * (1 + 1e-9)) << q;
   }
@@ -453,17 +452,18 @@ TEST(MassScaling, AddsTheStatedMassAndTheTrueStableStepReachesTheElementThreshol
   std::size_t heavier = 0;
   for (std::size_t e = 0; e < after.size(); ++e) {
     EXPECT_GE(2 / after[e], ms.min_element_step_s * (1 - 1e-9)) << "element " << e;
-    if (2 / before[e] >= ms.min_element_step_s) EXPECT_EQ(ms.density_kg_m3[e], 1060.0) << "element " << e;
-    else ++heavier;
+    if (2 / before[e] >= ms.min_element_step_s)
+      EXPECT_EQ(ms.density_kg_m3[e], 1060.0) << "element " << e;
+    else
+      ++heavier;
   }
   EXPECT_EQ(heavier, ms.scaled_elements);
   EXPECT_GT(heavier, 0u);
   EXPECT_LT(heavier, after.size());
   const double exact_plain = true_critical_step(*s.mesh, plain.masses(), test::soft_tissue());
   const double exact_scaled = true_critical_step(*s.mesh, scaled.masses(), test::soft_tissue());
-  std::cout << "[ figure ] liver (596 tets): +2% mass on " << heavier << " of " << after.size() << " elements: true critical step "
-            << exact_plain << " -> " << exact_scaled << " s (x" << exact_scaled / exact_plain << "), element threshold "
-            << ms.min_element_step_s << " s\n";
+  std::cout << "[ figure ] liver (596 tets): +2% mass on " << heavier << " of " << after.size() << " elements: true critical step " << exact_plain
+            << " -> " << exact_scaled << " s (x" << exact_scaled / exact_plain << "), element threshold " << ms.min_element_step_s << " s\n";
   EXPECT_GE(exact_scaled, ms.min_element_step_s);  // omega_max <= max_e omega_e (Irons)
   EXPECT_GT(exact_scaled, exact_plain);
   // The integrator's own step follows the new masses (element bound on the new densities).
@@ -517,9 +517,9 @@ TEST(MassScaling, LowestFrequencyDropsAsTheRayleighQuotientOfTheUnscaledModePred
   const auto [w1, u1] = lowest_mode(*s.mesh, scaled.masses(), test::soft_tissue(), bc.fixed_nodes);
   const double delta = mass_norm2(u0, scaled.masses()) / mass_norm2(u0, plain.masses()) - 1;
   const double bound = w0 / std::sqrt(1 + delta);
-  std::cout << "[ figure ] liver (596 tets), +5% mass on the smallest elements: lowest frequency " << w0 / (2 * M_PI) << " -> "
-            << w1 / (2 * M_PI) << " Hz (" << 100 * (w1 / w0 - 1) << "%; uniform +5% would give " << 100 * (1 / std::sqrt(1.05) - 1)
-            << "%), Rayleigh bound " << bound / (2 * M_PI) << " Hz\n";
+  std::cout << "[ figure ] liver (596 tets), +5% mass on the smallest elements: lowest frequency " << w0 / (2 * M_PI) << " -> " << w1 / (2 * M_PI)
+            << " Hz (" << 100 * (w1 / w0 - 1) << "%; uniform +5% would give " << 100 * (1 / std::sqrt(1.05) - 1) << "%), Rayleigh bound "
+            << bound / (2 * M_PI) << " Hz\n";
   EXPECT_LE(w1, bound * (1 + 1e-10));
   EXPECT_LT(w1, w0);
   EXPECT_NEAR(w0 - w1, w0 - bound, 0.05 * (w0 - bound));  // first order: the drop is the bound's drop
@@ -572,10 +572,10 @@ TEST(MassScaling, OnTheServersTwelveThousandTetLiverTheStepGrowsAndTheLowestFreq
   }
   const double bound = w0 / std::sqrt(mpu / mu);
   const MassScaling& ms = scaled.mass_scaling();
-  std::cout << "[ figure ] 12k liver scene, +" << 100 * ms.added_mass_fraction << "% mass on " << ms.scaled_elements << " of "
-            << mesh->tet_count() << " elements: stable step (global estimate) " << plain.critical_step().dt_s << " -> "
-            << scaled.critical_step().dt_s << " s (x" << scaled.critical_step().dt_s / plain.critical_step().dt_s
-            << "); lowest frequency " << w0 / (2 * M_PI) << " -> " << w1 / (2 * M_PI) << " Hz (" << 100 * (w1 / w0 - 1) << "%)\n";
+  std::cout << "[ figure ] 12k liver scene, +" << 100 * ms.added_mass_fraction << "% mass on " << ms.scaled_elements << " of " << mesh->tet_count()
+            << " elements: stable step (global estimate) " << plain.critical_step().dt_s << " -> " << scaled.critical_step().dt_s << " s (x"
+            << scaled.critical_step().dt_s / plain.critical_step().dt_s << "); lowest frequency " << w0 / (2 * M_PI) << " -> " << w1 / (2 * M_PI)
+            << " Hz (" << 100 * (w1 / w0 - 1) << "%)\n";
   EXPECT_LE(w1, bound * (1 + 1e-8));
   EXPECT_NEAR(w0 - w1, w0 - bound, 0.05 * (w0 - bound) + 1e-9 * w0);
   EXPECT_GT(scaled.critical_step().dt_s, 2 * plain.critical_step().dt_s);

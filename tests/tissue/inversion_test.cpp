@@ -4,6 +4,7 @@
 
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -26,22 +27,20 @@ double final_volume_ratio(const GpsModel& model, const TetMesh& mesh) {
 }  // namespace
 
 TEST(Inversion, PlainGpsStaysInvertedVolumeTermRecovers) {
-  const std::array<Vec3, 4> regular{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0),
-                                    Vec3(0.005, 0.00289, 0.00816)};
+  const std::array<Vec3, 4> regular{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0), Vec3(0.005, 0.00289, 0.00816)};
   const auto mesh = test::single_tet_mesh(regular);
   const GpsModel plain(mesh, {test::soft_tissue()});
   const GpsModel with_volume(mesh, {test::soft_tissue()}, {}, {GpsVariant::paper, 0.5});
   const double plain_ratio = final_volume_ratio(plain, *mesh);
   const double volume_ratio = final_volume_ratio(with_volume, *mesh);
-  std::cout << "[ figure ] after inversion and 2 s of damped motion: V/V0 = " << plain_ratio
-            << " (plain GPS), " << volume_ratio << " (with volume term)\n";
+  std::cout << "[ figure ] after inversion and 2 s of damped motion: V/V0 = " << plain_ratio << " (plain GPS), " << volume_ratio
+            << " (with volume term)\n";
   EXPECT_NEAR(plain_ratio, -1.0, 1e-3);  // settles in the mirrored state
   EXPECT_NEAR(volume_ratio, 1.0, 1e-3);  // recovers its rest shape
 }
 
 TEST(Inversion, MirroredTetHasZeroGpsForce) {
-  const std::array<Vec3, 4> regular{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0),
-                                    Vec3(0.005, 0.00289, 0.00816)};
+  const std::array<Vec3, 4> regular{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0), Vec3(0.005, 0.00289, 0.00816)};
   const auto mesh = test::single_tet_mesh(regular);
   const GpsModel plain(mesh, {test::soft_tissue()});
   std::vector<Vec3> x(regular.begin(), regular.end()), f(4, Vec3::Zero());

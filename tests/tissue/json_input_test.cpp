@@ -1,14 +1,17 @@
 // Hand-edited JSON files: whatever the bytes, one InputError naming the file, the line or the
 // field, never a library exception (a number overflow used to abort the server).
-#include <gtest/gtest.h>
+#include "viscera/common/json_input.hpp"
 
 #include <filesystem>
 #include <functional>
+
 #include <sys/stat.h>
 
+#include <gtest/gtest.h>
+
 #include "viscera/common/input_error.hpp"
-#include "viscera/common/json_input.hpp"
 #include "viscera/tissue/material/material_file.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -42,9 +45,7 @@ TEST(JsonInput, AKeyGivenTwiceIsAnErrorNotTheLastOneSilently) {
   EXPECT_EQ(error_of([] { parse_json(R"([{"a": 1}, {"a": 2}])", "s.json"); }), "no error");
 }
 
-TEST(JsonInput, AByteOrderMarkIsSkipped) {
-  EXPECT_EQ(parse_json("\xEF\xBB\xBF{\"a\": 2}", "bom.json")["a"].get<int>(), 2);
-}
+TEST(JsonInput, AByteOrderMarkIsSkipped) { EXPECT_EQ(parse_json("\xEF\xBB\xBF{\"a\": 2}", "bom.json")["a"].get<int>(), 2); }
 
 TEST(JsonInput, FieldsAreCheckedForTypeRangeAndWholeness) {
   const auto j = parse_json(R"({"x": "3", "y": 1e300, "n": 2.5, "k": [1, "a"], "o": {"z": true}})", "f.json");
@@ -75,11 +76,13 @@ TEST(JsonInput, MaterialFilesSurviveOverflowAndWrongTypes) {
   EXPECT_EQ(error_of([&] { parse_material(head + "1e999, \"poisson_ratio\": 0.3}}", "m.json"); }), "m.json:1: JSON: number overflow parsing '1e999'");
   EXPECT_EQ(error_of([&] { parse_material(head + "1e20, \"poisson_ratio\": 0.3}}", "m.json"); }),
             "m.json: elasticity.youngs_modulus_pa: 1e+20 is outside [0.001, 1e+12]");
-  EXPECT_EQ(error_of([] { parse_material(R"({"density_kg_m3": 1000, "elasticity": {"type": 3}})", "m.json"); }), "m.json: elasticity.type: 3 is not a string");
+  EXPECT_EQ(error_of([] { parse_material(R"({"density_kg_m3": 1000, "elasticity": {"type": 3}})", "m.json"); }),
+            "m.json: elasticity.type: 3 is not a string");
   EXPECT_EQ(error_of([] {
               parse_material(R"({"density_kg_m3": 1000, "elasticity": {"type": "transversely_isotropic", "plane_youngs_modulus_pa": 1000,
                  "plane_poisson_ratio": 0.3, "fibre_youngs_modulus_pa": 2000, "fibre_plane_poisson_ratio": 0.3, "fibre_shear_modulus_pa": 500,
-                 "fibre_direction": [0, "z", 1]}})", "m.json");
+                 "fibre_direction": [0, "z", 1]}})",
+                             "m.json");
             }),
             "m.json: elasticity.fibre_direction[1]: \"z\" is not a number");
 }

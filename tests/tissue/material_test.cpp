@@ -3,6 +3,7 @@
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -71,11 +72,20 @@ TEST(Elasticity, InvalidConstantsNameTheField) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message([] { elasticity_matrix(IsotropicElasticity{5e3, 0.5}, "liver.json"); }).find("liver.json: poisson_ratio: 0.5"), std::string::npos);
+  EXPECT_NE(message([] {
+              elasticity_matrix(IsotropicElasticity{5e3, 0.5}, "liver.json");
+            }).find("liver.json: poisson_ratio: 0.5"),
+            std::string::npos);
   EXPECT_NE(message([] { elasticity_matrix(IsotropicElasticity{-1, 0.3}); }).find("youngs_modulus_pa"), std::string::npos);
   EXPECT_NE(message([] { elasticity_matrix(IsotropicElasticity{std::nan(""), 0.3}); }).find("youngs_modulus_pa"), std::string::npos);
-  EXPECT_NE(message([] { elasticity_matrix(TransverselyIsotropicElasticity{1e3, 0.3, 1e3, 3.0, 1e3, Vec3::UnitZ()}); }).find("fibre_plane_poisson_ratio"), std::string::npos);
-  EXPECT_NE(message([] { elasticity_matrix(TransverselyIsotropicElasticity{1e3, 0.3, 1e3, 0.3, 1e3, Vec3::Zero()}); }).find("fibre_direction"), std::string::npos);
+  EXPECT_NE(message([] {
+              elasticity_matrix(TransverselyIsotropicElasticity{1e3, 0.3, 1e3, 3.0, 1e3, Vec3::UnitZ()});
+            }).find("fibre_plane_poisson_ratio"),
+            std::string::npos);
+  EXPECT_NE(message([] {
+              elasticity_matrix(TransverselyIsotropicElasticity{1e3, 0.3, 1e3, 0.3, 1e3, Vec3::Zero()});
+            }).find("fibre_direction"),
+            std::string::npos);
   Mat6 bad = Mat6::Identity();
   bad(0, 0) = -1;
   EXPECT_NE(message([&] { check_elasticity_matrix(bad, "m.json"); }).find("not positive definite"), std::string::npos);

@@ -1,14 +1,15 @@
 // Mesh readers on the real organ meshes, in every supported format, and on malformed files.
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <sstream>
 
 #include <sys/stat.h>
 
+#include <gtest/gtest.h>
+
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/mesh/vtu_writer.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -20,8 +21,7 @@ namespace {
 // Two tetrahedra sharing the face (1,2,3): nodes and tets in 1-based file ids.
 const char* kNodes[] = {"0 0 0", "1 0 0", "0 1 0", "0 0 1", "1 1 1"};
 
-std::string gmsh_v2(const std::string& node3 = "0 0 1", const std::string& tet2 = "2 3 4 5",
-                    int node_count = 5) {
+std::string gmsh_v2(const std::string& node3 = "0 0 1", const std::string& tet2 = "2 3 4 5", int node_count = 5) {
   std::string s = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"liver\"\n$EndPhysicalNames\n";
   s += "$Nodes\n" + std::to_string(node_count) + "\n";
   for (int i = 0; i < 5; ++i) s += std::to_string(i + 1) + " " + (i == 3 ? node3 : kNodes[i]) + "\n";
@@ -121,14 +121,22 @@ TEST(MeshIo, MalformedFilesGiveOneClearErrorNamingFileAndField) {
       // Bytes from the file are never printed raw: a control character shows as \xNN.
       {"control.msh", gmsh_v2("0 \x01\x1b[2J 1"), "node y: '\\x01\\x1B[2J' is not a number"},
       {"nul.msh", std::string("$MeshFormat\n2.2 0 8\n\0\0\x7f", 23), ":3: holds binary data (a NUL byte at byte 20)"},
-      {"unused.msh", [] { std::string s = gmsh_v2("0 0 1", "1 2 3 4", 5); return s; }(), ""},
+      {"unused.msh",
+       [] {
+         std::string s = gmsh_v2("0 0 1", "1 2 3 4", 5);
+         return s;
+       }(),
+       ""},
       {"tet10.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n$Elements\n1\n1 11 0 1 1 1 1 1 1 1 1 1 1\n$EndElements\n",
        "element 1 type: 11 is a volume element other than the linear tetrahedron"},
       {"binary.msh", "$MeshFormat\n2.2 1 8\n$EndMeshFormat\n", "binary .msh files are not supported"},
       {"bad.vtk", "# vtk DataFile Version 3.0\nx\nBINARY\n", "encoding: 'BINARY' is not supported"},
-      {"hex.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 1 float\n0 0 0\nCELLS 1 9\n8 0 0 0 0 0 0 0 0\nCELL_TYPES 1\n12\n",
+      {"hex.vtk",
+       "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 1 float\n0 0 0\nCELLS 1 9\n8 0 0 0 0 0 0 0 0\nCELL_TYPES 1\n12\n",
        "cell 0 type: 12 is a volume cell"},
-      {"bad.vtu", "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\"><Points><DataArray format=\"binary\">AAAA</DataArray></Points></Piece></UnstructuredGrid></VTKFile>",
+      {"bad.vtu",
+       "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\"><Points><DataArray "
+       "format=\"binary\">AAAA</DataArray></Points></Piece></UnstructuredGrid></VTKFile>",
        "DataArray Points: format 'binary' is not supported"},
       {"broken.vtu", "<VTKFile type=\"UnstructuredGrid\"><Unstruct", "XML:"},
       {"mesh.obj", "v 0 0 0\n", "unknown mesh format"},

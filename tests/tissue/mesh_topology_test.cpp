@@ -1,13 +1,14 @@
 // Boundary extraction and 1:8 refinement, checked against topology and geometry identities.
-#include <gtest/gtest.h>
-
 #include <map>
 #include <set>
+
+#include <gtest/gtest.h>
 
 #include "viscera/tissue/element/tet_geometry.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
 #include "viscera/tissue/mesh/box_mesh.hpp"
 #include "viscera/tissue/mesh/refinement.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -18,8 +19,7 @@ namespace {
 // Volume enclosed by the surface (divergence theorem): sum over triangles of x . n A / 3.
 double enclosed_volume(const TetMesh& m, const BoundarySurface& s) {
   double v = 0.0;
-  for (const auto& t : s.triangles)
-    v += m.nodes[t[0]].dot(m.nodes[t[1]].cross(m.nodes[t[2]])) / 6.0;
+  for (const auto& t : s.triangles) v += m.nodes[t[0]].dot(m.nodes[t[1]].cross(m.nodes[t[2]])) / 6.0;
   return v;
 }
 

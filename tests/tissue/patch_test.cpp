@@ -7,6 +7,7 @@
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
 #include "viscera/tissue/mesh/box_mesh.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -29,8 +30,7 @@ std::shared_ptr<TetMesh> irregular_box() {
 
 // Imposes x = A X on the boundary, solves for equilibrium, returns max over tets of
 // |sigma_tet - sigma_exact| / |sigma_exact| with sigma measured in the frame `R` rotates to.
-double patch_error(const ForceModel& model, const TetMesh& mesh, const Mat3& A, const Mat3& R,
-                   const Vec6& sigma_exact, int* iterations) {
+double patch_error(const ForceModel& model, const TetMesh& mesh, const Mat3& A, const Mat3& R, const Vec6& sigma_exact, int* iterations) {
   BoundaryConditions bc;
   bc.prescribed.push_back({extract_boundary(mesh).nodes, [A](const Vec3& X, double) { return Vec3(A * X); }});
   ImplicitIntegrator solver(model, std::vector<double>(mesh.tet_count(), 1000.0), bc, {1.0, 0.0, 1e-11, 30});
@@ -63,9 +63,9 @@ TEST(PatchTest, UniformStressInsideForEveryModel) {
     const ForceModel* model;
     double strain, degrees, tolerance;
   } cases[] = {
-      {&linear, 1e-3, 0.0, 1e-9},        // linear FE passes the patch test exactly
+      {&linear, 1e-3, 0.0, 1e-9},  // linear FE passes the patch test exactly
       {&corotational, 1e-3, 40.0, 1e-9},  // and corotational FE under a finite rotation too
-      {&gps, 1e-6, 40.0, 1e-5},           // the GPS only at small strain (error O(strain))
+      {&gps, 1e-6, 40.0, 1e-5},  // the GPS only at small strain (error O(strain))
       {&gps_energy, 1e-6, 40.0, 1e-5},
   };
   for (const auto& c : cases) {
@@ -74,9 +74,8 @@ TEST(PatchTest, UniformStressInsideForEveryModel) {
     const Vec6 sigma = D * strain_to_voigt(strain);
     int iterations = 0;
     const double err = patch_error(*c.model, *mesh, R * (Mat3::Identity() + strain), R, sigma, &iterations);
-    std::cout << "[ figure ] patch test " << c.model->name() << " (strain " << c.strain << ", rotation "
-              << c.degrees << " deg): max relative stress deviation " << err << " after " << iterations
-              << " Newton iterations\n";
+    std::cout << "[ figure ] patch test " << c.model->name() << " (strain " << c.strain << ", rotation " << c.degrees
+              << " deg): max relative stress deviation " << err << " after " << iterations << " Newton iterations\n";
     EXPECT_LT(err, c.tolerance) << c.model->name();
   }
 }

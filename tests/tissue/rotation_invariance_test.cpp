@@ -4,6 +4,7 @@
 
 #include "viscera/tissue/fem/finite_element_model.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -44,12 +45,11 @@ TEST(RotationInvariance, RigidMotionGivesNoForceForGpsAndCorotational) {
     const Vec3 shift(0.3, -0.1, 0.2);
     std::vector<Vec3> x = m.mesh->nodes;
     for (auto& p : x) p = R * p + shift;
-    for (const ForceModel* model : {static_cast<const ForceModel*>(&m.gps), static_cast<const ForceModel*>(&m.gps_energy),
-                                    static_cast<const ForceModel*>(&m.corotational)}) {
+    for (const ForceModel* model :
+         {static_cast<const ForceModel*>(&m.gps), static_cast<const ForceModel*>(&m.gps_energy), static_cast<const ForceModel*>(&m.corotational)}) {
       const double scale = norm(forces(*model, stretched));
       const double spurious = norm(forces(*model, x)) / scale;
-      std::cout << "[ figure ] " << model->name() << ": force under rigid rotation / force of 1% stretch = "
-                << spurious << "\n";
+      std::cout << "[ figure ] " << model->name() << ": force under rigid rotation / force of 1% stretch = " << spurious << "\n";
       EXPECT_LT(spurious, 1e-11) << model->name();
     }
   }
@@ -64,8 +64,8 @@ TEST(RotationInvariance, ForcesRotateWithTheBody) {
   const Mat3 R = test::random_rotation(rng);
   std::vector<Vec3> xr = x;
   for (auto& p : xr) p = R * p;
-  for (const ForceModel* model : {static_cast<const ForceModel*>(&m.gps), static_cast<const ForceModel*>(&m.gps_energy),
-                                  static_cast<const ForceModel*>(&m.corotational)}) {
+  for (const ForceModel* model :
+       {static_cast<const ForceModel*>(&m.gps), static_cast<const ForceModel*>(&m.gps_energy), static_cast<const ForceModel*>(&m.corotational)}) {
     const auto f = forces(*model, x), fr = forces(*model, xr);
     double err = 0;
     for (std::size_t i = 0; i < f.size(); ++i) err += (fr[i] - R * f[i]).squaredNorm();
@@ -96,8 +96,8 @@ TEST(RotationInvariance, LinearFeInflatesUnderRotationAsTheoryPredicts) {
     double err = 0;
     for (std::size_t i = 0; i < f.size(); ++i) err += (f[i] - expected[i]).squaredNorm();
     const double spurious = norm(f) / scale;
-    std::cout << "[ figure ] linear FE under a " << degrees << " degree rigid rotation: spurious force = "
-              << spurious << " x the force of a 1% stretch\n";
+    std::cout << "[ figure ] linear FE under a " << degrees << " degree rigid rotation: spurious force = " << spurious
+              << " x the force of a 1% stretch\n";
     EXPECT_LT(std::sqrt(err), 1e-10 * norm(f));
     EXPECT_GT(spurious, degrees >= 30 ? 1.0 : 0.1);  // the paper's "inflation"
   }

@@ -3,6 +3,7 @@
 
 #include "viscera/tissue/fem/finite_element_model.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
+
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
@@ -47,22 +48,20 @@ TEST(Tangent, MatchesFiniteDifferencesAtLargeDeformation) {
     GpsOptions asymmetric = fung_energy;
     asymmetric.viscoelasticity.compression_ratio = 0.4;
     const GpsModel qlv_asymmetric(mesh, {test::soft_tissue()}, {}, asymmetric);
-    for (const ForceModel* m : {static_cast<const ForceModel*>(&paper), static_cast<const ForceModel*>(&energy),
-                                static_cast<const ForceModel*>(&volume), static_cast<const ForceModel*>(&linear),
-                                static_cast<const ForceModel*>(&qlv), static_cast<const ForceModel*>(&qlv_energy),
-                                static_cast<const ForceModel*>(&qlv_asymmetric)}) {
+    for (const ForceModel* m :
+         {static_cast<const ForceModel*>(&paper), static_cast<const ForceModel*>(&energy), static_cast<const ForceModel*>(&volume),
+          static_cast<const ForceModel*>(&linear), static_cast<const ForceModel*>(&qlv), static_cast<const ForceModel*>(&qlv_energy),
+          static_cast<const ForceModel*>(&qlv_asymmetric)}) {
       const Mat12 K = m->element_tangent(x, 0);
       const Mat12 Kfd = finite_difference_tangent(*m, x, 1e-7);
       EXPECT_LT((K - Kfd).norm(), 1e-6 * K.norm()) << m->name();
     }
     // Energy-consistent tangents are symmetric (they are Hessians), with Fung's stiffening in its
     // energy form too; the paper form's is not, nor the edge map's.
-    EXPECT_LT((energy.element_tangent(x, 0) - energy.element_tangent(x, 0).transpose()).norm(),
-              1e-12 * energy.element_tangent(x, 0).norm());
+    EXPECT_LT((energy.element_tangent(x, 0) - energy.element_tangent(x, 0).transpose()).norm(), 1e-12 * energy.element_tangent(x, 0).norm());
     const Mat12 Kq = qlv_energy.element_tangent(x, 0);
     EXPECT_LT((Kq - Kq.transpose()).norm(), 1e-12 * Kq.norm());
-    EXPECT_GT((paper.element_tangent(x, 0) - paper.element_tangent(x, 0).transpose()).norm(),
-              1e-4 * paper.element_tangent(x, 0).norm());
+    EXPECT_GT((paper.element_tangent(x, 0) - paper.element_tangent(x, 0).transpose()).norm(), 1e-4 * paper.element_tangent(x, 0).norm());
   }
 }
 

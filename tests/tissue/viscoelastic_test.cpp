@@ -1,23 +1,24 @@
 // Constant-Q viscoelasticity against theory: the fitted Q(f), closed-form relaxation and creep of a
 // homogeneous GPS element with memory variables, hysteresis loops, Figure 2, explicit stability.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <random>
+
+#include <gtest/gtest.h>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/gps/fung_map.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/box_mesh.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
-#include "viscera/tissue/integrator/explicit_integrator.hpp"
-#include "viscera/tissue/material/material_file.hpp"
-#include "test_support.hpp"
 #include "viscera/tissue/viscoelastic/constant_q.hpp"
 #include "viscera/tissue/viscoelastic/constant_q_fit.hpp"
 #include "viscera/tissue/viscoelastic/figure2.hpp"
 #include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
+
+#include "test_support.hpp"
 
 using namespace viscera::tissue;
 using namespace viscera::common;
@@ -67,8 +68,8 @@ TEST(ConstantQFit, ThreeOptimisedMechanismsStayWithin20PercentFixedPlacementDoes
   ConstantQTarget fixed = paper_target(3);
   fixed.optimise_frequencies = false;
   const ConstantQFit f = fit_constant_q(fixed), o = fit_constant_q(paper_target(3));
-  std::cout << "[ figure ] Q = 4.8, 0.01-10 Hz, 3 mechanisms: log-spaced " << f.q_min << ".." << f.q_max
-            << ", optimised " << o.q_min << ".." << o.q_max << " (max error " << 100 * o.max_relative_error << "%)\n";
+  std::cout << "[ figure ] Q = 4.8, 0.01-10 Hz, 3 mechanisms: log-spaced " << f.q_min << ".." << f.q_max << ", optimised " << o.q_min << ".."
+            << o.q_max << " (max error " << 100 * o.max_relative_error << "%)\n";
   EXPECT_LT(o.max_relative_error, 0.20);
   EXPECT_GT(f.max_relative_error, 0.20);  // why the frequencies must be optimised too
 }
@@ -123,8 +124,8 @@ TEST(GpsMemoryVariables, StepStrainRelaxesAsTheClosedForm) {
   // Shear (relaxes with the shear weights) and dilatation (bulk weights) held after a step.
   const Element el(3);
   Mat3 dilatation = Mat3::Identity();
-  for (const auto& [name, G, solids] : {std::tuple{"shear", pure_shear(), el.ve.shear_fit.solids},
-                                         std::tuple{"bulk", dilatation, el.ve.bulk_fit->solids}}) {
+  for (const auto& [name, G, solids] :
+       {std::tuple{"shear", pure_shear(), el.ve.shear_fit.solids}, std::tuple{"bulk", dilatation, el.ve.bulk_fit->solids}}) {
     const auto x = el.deformed(G, 1e-6);
     std::vector<double> memory(el.model->memory_size(), 0.0);
     std::vector<Vec3> f(4, Vec3::Zero());
@@ -192,8 +193,10 @@ TEST(FirstLoadSoftening, AnElementUnderProportionalLoadingSoftensAsTheLaw) {
   const auto mode_force = [&](const ForceModel& m, double a, std::vector<double>* memory) {
     std::vector<Vec3> x, f(4, Vec3::Zero());
     for (const auto& p : rest) x.push_back(p + a * G * p);
-    if (memory) m.add_forces(x, f, {*memory, *memory, 1e-3});
-    else m.add_forces(x, f);
+    if (memory)
+      m.add_forces(x, f, {*memory, *memory, 1e-3});
+    else
+      m.add_forces(x, f);
     double s = 0;
     for (int i = 0; i < 4; ++i) s += f[i].dot(G * rest[i]);
     return s;
@@ -288,8 +291,8 @@ TEST(GpsMemoryVariables, HysteresisLoopsGiveOneOverQAcrossTheBand) {
     // 1/Q = W_dissipated / (2 pi W_stored), W_stored = amplitude x in-phase force / 2.
     const double inverse_q = loop_area / (2 * M_PI * 0.5 * amp * in_phase);
     const double model_inverse_q = 1.0 / el.ve.shear_fit.solids.q(2 * M_PI * f_hz);
-    std::cout << "[ figure ] hysteresis at " << f_hz << " Hz: 1/Q from the loop area " << inverse_q << " (target "
-              << target << ", fitted model " << model_inverse_q << ", quadrature/in-phase " << quadrature / in_phase << ")\n";
+    std::cout << "[ figure ] hysteresis at " << f_hz << " Hz: 1/Q from the loop area " << inverse_q << " (target " << target << ", fitted model "
+              << model_inverse_q << ", quadrature/in-phase " << quadrature / in_phase << ")\n";
     EXPECT_NEAR(inverse_q / target, 1.0, 0.10) << f_hz;
     EXPECT_NEAR(inverse_q / model_inverse_q, 1.0, 0.01) << f_hz;
   }
@@ -297,8 +300,8 @@ TEST(GpsMemoryVariables, HysteresisLoopsGiveOneOverQAcrossTheBand) {
 
 TEST(Figure2, MemoryVariablesWithin10PercentKelvinVoigtAtLeast3xWorse) {
   const Figure2 r = compute_figure2();
-  std::cout << "[ figure ] Figure 2 RMS / peak over 0-4 s: memory variables (1D) " << 100 * r.rms_memory_variables
-            << "%, 3D GPS block " << 100 * r.rms_gps_block << "%, Kelvin-Voigt " << 100 * r.rms_kelvin_voigt << "%\n";
+  std::cout << "[ figure ] Figure 2 RMS / peak over 0-4 s: memory variables (1D) " << 100 * r.rms_memory_variables << "%, 3D GPS block "
+            << 100 * r.rms_gps_block << "%, Kelvin-Voigt " << 100 * r.rms_kelvin_voigt << "%\n";
   ASSERT_EQ(r.time_s.size(), 1001u);  // 0-4 s at 250 samples per second
   EXPECT_LT(r.rms_memory_variables, 0.10);
   EXPECT_LT(r.rms_gps_block, 0.10);
@@ -360,14 +363,25 @@ TEST(MaterialFile, ViscoelasticFieldsAreCheckedByName) {
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": -1}})").find("tissue.json: viscoelasticity.shear_q"), std::string::npos);
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "band_hz": [10, 0.01]}})").find("viscoelasticity.band_hz"), std::string::npos);
   EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "mechanisms": 9}})").find("viscoelasticity.mechanisms"), std::string::npos);
-  EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": -3000, "poisson_ratio": 0.3}})").find("youngs_modulus_pa"), std::string::npos);
-  EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 3000, "poisson_ratio": 0.5}})").find("poisson_ratio"), std::string::npos);
-  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energetic"}})").find("tissue.json: viscoelasticity.qlv_form"), std::string::npos);
-  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "band": [0.01, 10]}})").find("tissue.json: viscoelasticity.band: unknown field"), std::string::npos);
+  EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": -3000, "poisson_ratio": 0.3}})")
+                .find("youngs_modulus_pa"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 3000, "poisson_ratio": 0.5}})")
+                .find("poisson_ratio"),
+            std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energetic"}})").find("tissue.json: viscoelasticity.qlv_form"),
+            std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "band": [0.01, 10]}})").find("tissue.json: viscoelasticity.band: unknown field"),
+            std::string::npos);
   EXPECT_NE(message(head + R"("viscosity": {"shear_q": 4.8}})").find("tissue.json: viscosity: unknown field"), std::string::npos);
-  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energy", "compression_ratio": 0}})").find("viscoelasticity.compression_ratio"), std::string::npos);
-  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "compression_ratio": 2}})").find("viscoelasticity.compression_ratio: 2 needs \"qlv_form\": \"energy\""), std::string::npos);
-  const Material m = parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "bulk_q": 20, "band_hz": [0.01, 10], "mechanisms": 3, "reference_frequency_hz": 2}})", "ok.json");
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_form": "energy", "compression_ratio": 0}})")
+                .find("viscoelasticity.compression_ratio"),
+            std::string::npos);
+  EXPECT_NE(message(head + R"("viscoelasticity": {"shear_q": 4.8, "compression_ratio": 2}})")
+                .find("viscoelasticity.compression_ratio: 2 needs \"qlv_form\": \"energy\""),
+            std::string::npos);
+  const Material m = parse_material(
+      head + R"("viscoelasticity": {"shear_q": 4.8, "bulk_q": 20, "band_hz": [0.01, 10], "mechanisms": 3, "reference_frequency_hz": 2}})", "ok.json");
   ASSERT_TRUE(m.viscoelasticity.has_value());
   EXPECT_EQ(m.viscoelasticity->mechanisms, 3);
 }
@@ -392,7 +406,8 @@ TEST(MaterialFile, FungStiffeningInItsEnergyFormReachesTheModelAsAConservativeRe
   EXPECT_LT(asymmetry(R"(, "qlv_form": "energy")"), 1e-12);
   EXPECT_GT(asymmetry(""), 1e-4);  // the default: the published edge map
   // The energy form relaxes the whole tension: a bulk that does not relax as the shear is refused.
-  const Material elastic_bulk = parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_stiffening": 8, "qlv_form": "energy"}})", "fung.json");
+  const Material elastic_bulk =
+      parse_material(head + R"("viscoelasticity": {"shear_q": 4.8, "qlv_stiffening": 8, "qlv_form": "energy"}})", "fung.json");
   try {
     make_viscoelastic(elastic_bulk.elasticity, *elastic_bulk.viscoelasticity, "fung.json");
     ADD_FAILURE() << "accepted";

@@ -13,17 +13,18 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "viscera/common/command_line.hpp"
-#include "scripted_device.hpp"
-#include "trajectory_device.hpp"
 #include "viscera/client/client.hpp"
 #include "viscera/client/local_force_model.hpp"
 #include "viscera/client/tick_phase.hpp"
+#include "viscera/common/command_line.hpp"
+
+#include "scripted_device.hpp"
+#include "trajectory_device.hpp"
 
 namespace {
 
@@ -62,7 +63,11 @@ struct MeshWatch {
       }
     }
     if (record)
-      samples.push_back({{"t_s", t}, {"mesh_id", frame->mesh_id}, {"frame", frame->frame}, {"sim_time_s", frame->sim_time_s}, {"max_displacement_m", max_d},
+      samples.push_back({{"t_s", t},
+                         {"mesh_id", frame->mesh_id},
+                         {"frame", frame->frame},
+                         {"sim_time_s", frame->sim_time_s},
+                         {"max_displacement_m", max_d},
                          {"under_tip_dz_m", under_tip_dz}});
   }
   double rate_hz() const { return frames > 1 && last_t > first_t ? static_cast<double>(frames - 1) / (last_t - first_t) : 0.0; }
@@ -82,17 +87,20 @@ struct ForceSample {
 nlohmann::json to_json(const std::vector<ForceSample>& samples) {
   nlohmann::json out = nlohmann::json::array();
   for (const ForceSample& s : samples)
-    out.push_back({{"t_s", s.t_s}, {"tip_z_m", s.tip_z_m}, {"jaw_rad", s.jaw_rad},
+    out.push_back({{"t_s", s.t_s},
+                   {"tip_z_m", s.tip_z_m},
+                   {"jaw_rad", s.jaw_rad},
                    {"force_n", {s.force_n[0], s.force_n[1], s.force_n[2]}},
                    {"torque_n_m", {s.torque_n_m[0], s.torque_n_m[1], s.torque_n_m[2]}},
-                   {"in_contact", s.in_contact}, {"penetration_m", s.penetration_m},
+                   {"in_contact", s.in_contact},
+                   {"penetration_m", s.penetration_m},
                    {"normal_stiffness_n_per_m", s.normal_stiffness_n_per_m},
                    {"rendered_force_n", {s.rendered_force_n[0], s.rendered_force_n[1], s.rendered_force_n[2]}},
-                   {"model_age_commands", s.model_age_commands}, {"model_age_ms", s.model_age_ms},
+                   {"model_age_commands", s.model_age_commands},
+                   {"model_age_ms", s.model_age_ms},
                    {"command_seq", s.command_seq}});
   return out;
 }
-
 
 struct Options {
   std::uint32_t domain = 0, client_id = 1, instrument = 1;
@@ -151,16 +159,16 @@ struct RunResult {
   std::vector<ForceSample> samples;
   MeshWatch mesh;
   double server_lost_t_s = -1;  // when the client noticed the server was gone (-1: never)
-  double faded_t_s = -1;        // when the rendered force had faded to zero after that
-  int server_returns = 0;       // --reconnect: servers claimed again after a loss
-  bool lost = false;            // ended because the server was gone
+  double faded_t_s = -1;  // when the rendered force had faded to zero after that
+  int server_returns = 0;  // --reconnect: servers claimed again after a loss
+  bool lost = false;  // ended because the server was gone
 };
 
 void print_live(const Options& o, viscera::client::Client& client, double t, const Vector3& tip, const viscera::protocol::Force& f,
                 std::size_t frames) {
   const auto rtt = client.round_trip();
-  std::printf("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s\n", t, tip[2], f.force[0],
-              f.force[1], f.force[2], f.in_contact ? "  contact" : "         ", rtt.p50_us, rtt.p99_us,
+  std::printf("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s\n", t, tip[2], f.force[0], f.force[1],
+              f.force[2], f.in_contact ? "  contact" : "         ", rtt.p50_us, rtt.p99_us,
               o.watch_mesh ? ("  mesh frames " + std::to_string(frames)).c_str() : "");
   std::fflush(stdout);
 }
@@ -211,7 +219,8 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
     }
     if (run.faded_t_s >= 0 && server == viscera::client::ServerState::alive) {  // --reconnect: a server is back
       const auto again = client.claim(o.instrument, std::chrono::seconds(5));
-      std::printf("t = %5.2f s  a server is back: instrument %u %s\n", t, o.instrument, again ? "claimed again" : ("not claimed: " + again.why).c_str());
+      std::printf("t = %5.2f s  a server is back: instrument %u %s\n", t, o.instrument,
+                  again ? "claimed again" : ("not claimed: " + again.why).c_str());
       std::fflush(stdout);
       if (const auto now = client.scene()) generation = now->generation;
       run.server_lost_t_s = run.faded_t_s = -1;
@@ -265,8 +274,8 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
     next += period;
     if (phase && in_phase_possible)
       if (const auto tick_end = client.last_tick_end_ns(o.instrument)) {
-        const std::int64_t next_ns = viscera::client::now_ns() +
-                                     std::chrono::duration_cast<std::chrono::nanoseconds>(next - std::chrono::steady_clock::now()).count();
+        const std::int64_t next_ns =
+            viscera::client::now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(next - std::chrono::steady_clock::now()).count();
         ++run.phased;
         run.near_phase += std::abs(phase->error(next_ns, *tick_end).count()) < 50'000;
         next += phase->correction(next_ns, *tick_end);
@@ -278,12 +287,19 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
 
 void write_report(const Options& o, const std::string& scene, const std::string& device, double start_epoch_s,
                   const viscera::client::LatencyStats& rtt, const RunResult& run) {
-  nlohmann::json r{{"scene", scene}, {"instrument", o.instrument}, {"client_id", o.client_id}, {"rate_hz", o.rate_hz},
-                   {"start_epoch_s", start_epoch_s}, {"duration_s", o.duration_s}, {"device", device},
+  nlohmann::json r{{"scene", scene},
+                   {"instrument", o.instrument},
+                   {"client_id", o.client_id},
+                   {"rate_hz", o.rate_hz},
+                   {"start_epoch_s", start_epoch_s},
+                   {"duration_s", o.duration_s},
+                   {"device", device},
                    {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
                    {"tick_phase", {{"offset_us", o.tick_phase_us}, {"periods", run.phased}, {"within_50us", run.near_phase}}},
                    {"fade", {{"stale_after_s", o.fade.stale_after_s}, {"fade_s", o.fade.fade_s}}},
-                   {"server_lost_t_s", run.server_lost_t_s}, {"faded_t_s", run.faded_t_s}, {"server_returns", run.server_returns},
+                   {"server_lost_t_s", run.server_lost_t_s},
+                   {"faded_t_s", run.faded_t_s},
+                   {"server_returns", run.server_returns},
                    {"samples", to_json(run.samples)}};
   if (o.watch_mesh) r["mesh"] = {{"frames", run.mesh.frames}, {"rate_hz", run.mesh.rate_hz()}, {"samples", run.mesh.samples}};
   std::ofstream(o.report) << r.dump(1) << "\n";
@@ -292,7 +308,8 @@ void write_report(const Options& o, const std::string& scene, const std::string&
 }  // namespace
 
 int main(int argc, char** argv) {
-  viscera::common::CommandLine cl("haptic-client",
+  viscera::common::CommandLine cl(
+      "haptic-client",
       "A haptic device client: claims an instrument of a running viscera-server and drives it from a virtual device.\n"
       "Script 'press': the probe starts 1 cm above the organ at the centre of its top and moves down until the\n"
       "server reports contact, presses DEPTH further by mid-run and comes back to the contact height by the end.\n"
@@ -342,9 +359,10 @@ int main(int argc, char** argv) {
     const RunResult run = run_device(o, client, *device, scene->generation);
     if (!run.lost) client.release(o.instrument);
     const auto rtt = client.round_trip();
-    std::printf("haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
-                rtt.samples, rtt.p50_us, rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()),
-                static_cast<unsigned long long>(run.clamps), o.max_force_n);
+    std::printf(
+        "haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
+        rtt.samples, rtt.p50_us, rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()),
+        static_cast<unsigned long long>(run.clamps), o.max_force_n);
     if (o.watch_mesh) std::printf("haptic-client: %zu surface frames at %.1f Hz\n", run.mesh.frames, run.mesh.rate_hz());
     if (run.phased > 0)
       std::printf("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us\n", o.tick_phase_us,

@@ -28,9 +28,12 @@ client::DeviceSample ScriptedDevice::read(double t) {
     z_ = t < mid ? contact_z_ - depth_ * (t - contact_t_) / (mid - contact_t_) : contact_z_ - depth_ * (duration_ - t) / (duration_ - mid);
   } else {  // grasp
     const double bite = contact_z_ - depth_, t1 = contact_t_ + 0.05 * duration_, t2 = std::max(0.75 * duration_, t1 + 1e-3);
-    if (t < t1) z_ = contact_z_ - depth_ * (t - contact_t_) / (t1 - contact_t_);
-    else if (t < t2) z_ = bite + pull_ * (t - t1) / (t2 - t1);
-    else z_ = bite + pull_;
+    if (t < t1)
+      z_ = contact_z_ - depth_ * (t - contact_t_) / (t1 - contact_t_);
+    else if (t < t2)
+      z_ = bite + pull_ * (t - t1) / (t2 - t1);
+    else
+      z_ = bite + pull_;
     jaw = t < t2 ? 0.0 : 0.5;
   }
   return {{cx_, cy_, z_}, jaw, 0, t >= duration_};

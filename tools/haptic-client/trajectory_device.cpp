@@ -52,8 +52,7 @@ std::vector<TrajectoryPoint> read_trajectory(const std::string& path) {
     ++number;
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') continue;
     const auto cells = split(line);
-    if (cells.size() != header.size())
-      fail(number, "", std::to_string(cells.size()) + " values for " + std::to_string(header.size()) + " columns");
+    if (cells.size() != header.size()) fail(number, "", std::to_string(cells.size()) + " values for " + std::to_string(header.size()) + " columns");
     double v[6] = {0, 0, 0, 0, 0.5, 0};
     for (std::size_t k = 0; k < known.size(); ++k) {
       if (column_of[k] < 0) continue;

@@ -68,11 +68,11 @@ void write_svg(const std::string& path, const Figure& input) {
   o << "<text x=\"" << f.width_px / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << escape(f.title) << "</text>\n";
   const double xs = f.log_x ? 1.0 : tick_step(x1 - x0), ys = tick_step(y1 - y0);
   for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs)
-    o << "<line x1=\"" << px(x) << "\" y1=\"" << T << "\" x2=\"" << px(x) << "\" y2=\"" << T + H
-      << "\" stroke=\"#e5e5e5\"/><text x=\"" << px(x) << "\" y=\"" << T + H + 18 << "\" text-anchor=\"middle\">" << fmt(f.log_x ? std::pow(10.0, x) : x) << "</text>\n";
+    o << "<line x1=\"" << px(x) << "\" y1=\"" << T << "\" x2=\"" << px(x) << "\" y2=\"" << T + H << "\" stroke=\"#e5e5e5\"/><text x=\"" << px(x)
+      << "\" y=\"" << T + H + 18 << "\" text-anchor=\"middle\">" << fmt(f.log_x ? std::pow(10.0, x) : x) << "</text>\n";
   for (double y = std::ceil(y0 / ys) * ys; y <= y1 + 1e-9 * ys; y += ys)
-    o << "<line x1=\"" << L << "\" y1=\"" << py(y) << "\" x2=\"" << L + W << "\" y2=\"" << py(y)
-      << "\" stroke=\"#e5e5e5\"/><text x=\"" << L - 6 << "\" y=\"" << py(y) + 4 << "\" text-anchor=\"end\">" << fmt(y) << "</text>\n";
+    o << "<line x1=\"" << L << "\" y1=\"" << py(y) << "\" x2=\"" << L + W << "\" y2=\"" << py(y) << "\" stroke=\"#e5e5e5\"/><text x=\"" << L - 6
+      << "\" y=\"" << py(y) + 4 << "\" text-anchor=\"end\">" << fmt(y) << "</text>\n";
   o << "<rect x=\"" << L << "\" y=\"" << T << "\" width=\"" << W << "\" height=\"" << H << "\" fill=\"none\" stroke=\"black\"/>\n";
   o << "<text x=\"" << L + W / 2 << "\" y=\"" << f.height_px - 15 << "\" text-anchor=\"middle\">" << escape(f.x_label) << "</text>\n";
   o << "<text transform=\"translate(18," << T + H / 2 << ") rotate(-90)\" text-anchor=\"middle\">" << escape(f.y_label) << "</text>\n";
@@ -86,9 +86,9 @@ void write_svg(const std::string& path, const Figure& input) {
   }
   double ly = T + 14;
   for (const auto& s : f.series) {
-    o << "<line x1=\"" << L + W - 250 << "\" y1=\"" << ly - 4 << "\" x2=\"" << L + W - 220 << "\" y2=\"" << ly - 4
-      << "\" stroke=\"" << s.colour << "\" stroke-width=\"2\"" << (s.dash.empty() ? "" : " stroke-dasharray=\"" + s.dash + "\"")
-      << "/><text x=\"" << L + W - 214 << "\" y=\"" << ly << "\">" << escape(s.label) << "</text>\n";
+    o << "<line x1=\"" << L + W - 250 << "\" y1=\"" << ly - 4 << "\" x2=\"" << L + W - 220 << "\" y2=\"" << ly - 4 << "\" stroke=\"" << s.colour
+      << "\" stroke-width=\"2\"" << (s.dash.empty() ? "" : " stroke-dasharray=\"" + s.dash + "\"") << "/><text x=\"" << L + W - 214 << "\" y=\"" << ly
+      << "\">" << escape(s.label) << "</text>\n";
     ly += 18;
   }
   o << "</svg>\n";

@@ -12,8 +12,8 @@
 #include <optional>
 #include <thread>
 
-#include "viscera/common/command_line.hpp"
 #include "viscera/client/client.hpp"
+#include "viscera/common/command_line.hpp"
 
 namespace {
 
@@ -40,13 +40,13 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
     for (const auto& t : client.poll_telemetry()) {
       if (!first) first = t;
       last = t;
-      std::printf("t +%.4f s: %.0f Hz physics, %llu ticks (%llu late, %llu slots missed), step p50 %.0f us p99 %.0f us max %.0f us, "
-                  "tick jitter p99 %.0f us, %llu messages rejected (%llu malformed, %llu not from the owner, %llu for unknown instruments)\n",
-                  1e-9 * static_cast<double>(t.server_stamp_ns - first->server_stamp_ns), t.physics_rate_hz,
-                  static_cast<unsigned long long>(t.steps), static_cast<unsigned long long>(t.late_ticks),
-                  static_cast<unsigned long long>(t.missed_slots), t.step_p50_us, t.step_p99_us, t.step_max_us, t.jitter_p99_us,
-                  static_cast<unsigned long long>(t.rejected_messages), static_cast<unsigned long long>(t.rejected_malformed),
-                  static_cast<unsigned long long>(t.rejected_not_owner), static_cast<unsigned long long>(t.rejected_unknown_instrument));
+      std::printf(
+          "t +%.4f s: %.0f Hz physics, %llu ticks (%llu late, %llu slots missed), step p50 %.0f us p99 %.0f us max %.0f us, "
+          "tick jitter p99 %.0f us, %llu messages rejected (%llu malformed, %llu not from the owner, %llu for unknown instruments)\n",
+          1e-9 * static_cast<double>(t.server_stamp_ns - first->server_stamp_ns), t.physics_rate_hz, static_cast<unsigned long long>(t.steps),
+          static_cast<unsigned long long>(t.late_ticks), static_cast<unsigned long long>(t.missed_slots), t.step_p50_us, t.step_p99_us, t.step_max_us,
+          t.jitter_p99_us, static_cast<unsigned long long>(t.rejected_messages), static_cast<unsigned long long>(t.rejected_malformed),
+          static_cast<unsigned long long>(t.rejected_not_owner), static_cast<unsigned long long>(t.rejected_unknown_instrument));
       std::fflush(stdout);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -70,7 +70,8 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
 }  // namespace
 
 int main(int argc, char** argv) {
-  viscera::common::CommandLine cl("viscera-control",
+  viscera::common::CommandLine cl(
+      "viscera-control",
       "Session control of a running viscera-server. ACTION is one of\n"
       "  pause           the organ stops; forces are still answered from its frozen state\n"
       "  resume, reset   reset: the organ back at rest, graspers let go\n"
@@ -100,13 +101,14 @@ int main(int argc, char** argv) {
     const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, health, events or annotate TEXT";
     if (rest.empty()) throw viscera::common::UsageError("missing ACTION (" + actions + ")");
     const std::string action = rest[0];
-    const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false}, {"load", true}, {"material", false},
+    const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false},  {"load", true},    {"material", false},
                                                {"rate", true},   {"show", false},   {"health", false}, {"events", false}, {"annotate", true}};
     const auto k = known.find(action);
     if (k == known.end()) throw viscera::common::UsageError("ACTION '" + action + "' is not " + actions);
     if (k->second != (rest.size() == 2))
       throw viscera::common::UsageError(k->second ? action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
-    if (action == "annotate" && rest[1].size() > 1024) throw viscera::common::UsageError("TEXT is " + std::to_string(rest[1].size()) + " bytes (at most 1024)");
+    if (action == "annotate" && rest[1].size() > 1024)
+      throw viscera::common::UsageError("TEXT is " + std::to_string(rest[1].size()) + " bytes (at most 1024)");
     viscera::protocol::MaterialChange change;
     const auto material_flag = [&](const char* name, double lo, double hi, std::optional<double>& out) {
       if (cl.has(name)) out = cl.number_in(name, lo, hi);
@@ -117,12 +119,14 @@ int main(int argc, char** argv) {
     material_flag("shear-q", 0.5, 1e4, change.shear_q);
     material_flag("damping-per-s", 0.0, 1e4, change.damping_per_s);
     if ((action == "material") != !change.empty())
-      throw viscera::common::UsageError(action == "material" ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
-                                                          : "material flags are for the material action");
+      throw viscera::common::UsageError(
+          action == "material" ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
+                               : "material flags are for the material action");
     if (action == "load") {
       const std::string& n = rest[1];
-      const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' &&
-                         std::all_of(n.begin(), n.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
+      const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' && std::all_of(n.begin(), n.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+      });
       if (!plain) throw viscera::common::UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
     }
     double rate_hz = 0;
@@ -169,7 +173,8 @@ int main(int argc, char** argv) {
                            : action == "material" ? client.set_material(change, timeout)
                                                   : client.set_physics_rate(rate_hz, timeout);
       if (!outcome) {
-        std::fprintf(stderr, "viscera-control: no outcome of '%s' from the server within %.1f s\n", action.c_str(), 1e-3 * static_cast<double>(timeout.count()));
+        std::fprintf(stderr, "viscera-control: no outcome of '%s' from the server within %.1f s\n", action.c_str(),
+                     1e-3 * static_cast<double>(timeout.count()));
         return 1;
       }
       if (!outcome->accepted) {

@@ -13,10 +13,10 @@ using namespace viscera::common;
 int main(int argc, char** argv) {
   try {
     viscera::common::CommandLine cl("viscera-figure2",
-        "Reproduces Figure 2 of Gross & Buess (2001): a 10 cm block (rho 1e3 kg/m^3, |G| = 1e3 Pa at 2 Hz,\n"
-        "Q = 4.8) sheared by 1 Pa for 1 s, then released. Writes the top displacement [m] of the exact\n"
-        "constant-Q solution, the memory-variable simulations (1D column and 3D GPS block) and a\n"
-        "Kelvin-Voigt solid, as CSV and SVG, and prints the RMS errors relative to the exact peak.");
+                                    "Reproduces Figure 2 of Gross & Buess (2001): a 10 cm block (rho 1e3 kg/m^3, |G| = 1e3 Pa at 2 Hz,\n"
+                                    "Q = 4.8) sheared by 1 Pa for 1 s, then released. Writes the top displacement [m] of the exact\n"
+                                    "constant-Q solution, the memory-variable simulations (1D column and 3D GPS block) and a\n"
+                                    "Kelvin-Voigt solid, as CSV and SVG, and prints the RMS errors relative to the exact peak.");
     cl.flag("csv", "PATH", "CSV output", "docs/figure2.csv");
     cl.flag("svg", "PATH", "SVG plot output", "docs/figure2.svg");
     cl.flag("mechanisms", "L", "number of memory variables (standard linear solids), 1-8", "3");
@@ -35,8 +35,7 @@ int main(int argc, char** argv) {
     out << "time_s,exact_cq_m,memory_variables_m,kelvin_voigt_m,gps_block_m\n";
     out.precision(9);
     for (std::size_t k = 0; k < r.time_s.size(); ++k)
-      out << r.time_s[k] << ',' << r.exact_cq_m[k] << ',' << r.memory_variables_m[k] << ',' << r.kelvin_voigt_m[k] << ','
-          << r.gps_block_m[k] << '\n';
+      out << r.time_s[k] << ',' << r.exact_cq_m[k] << ',' << r.memory_variables_m[k] << ',' << r.kelvin_voigt_m[k] << ',' << r.gps_block_m[k] << '\n';
     if (!out) throw std::runtime_error(csv + ": cannot write");
     const auto mm = [](const std::vector<double>& v) {
       std::vector<double> o2;
@@ -46,12 +45,14 @@ int main(int argc, char** argv) {
     char title[200];
     std::snprintf(title, sizeof title, "Figure 2: 1 Pa shear for 1 s (RMS/peak: memory variables %.1f%%, GPS 3D %.1f%%, Kelvin-Voigt %.1f%%)",
                   100 * r.rms_memory_variables, 100 * r.rms_gps_block, 100 * r.rms_kelvin_voigt);
-    viscera::plot::write_svg(cl.text("svg"),
-                             {title, "time [s]", "top displacement [mm]",
-                              {{"exact constant Q", r.time_s, mm(r.exact_cq_m), "#000000", "", 2.2},
-                               {std::to_string(o.mechanisms) + " memory variables (1D column)", r.time_s, mm(r.memory_variables_m), "#d62728", "6 4", 1.6},
-                               {std::to_string(o.mechanisms) + " memory variables (3D GPS block)", r.time_s, mm(r.gps_block_m), "#2ca02c", "2 3", 1.6},
-                               {"Kelvin-Voigt (one relaxation time)", r.time_s, mm(r.kelvin_voigt_m), "#1f77b4", "10 5", 1.6}}});
+    viscera::plot::write_svg(
+        cl.text("svg"), {title,
+                         "time [s]",
+                         "top displacement [mm]",
+                         {{"exact constant Q", r.time_s, mm(r.exact_cq_m), "#000000", "", 2.2},
+                          {std::to_string(o.mechanisms) + " memory variables (1D column)", r.time_s, mm(r.memory_variables_m), "#d62728", "6 4", 1.6},
+                          {std::to_string(o.mechanisms) + " memory variables (3D GPS block)", r.time_s, mm(r.gps_block_m), "#2ca02c", "2 3", 1.6},
+                          {"Kelvin-Voigt (one relaxation time)", r.time_s, mm(r.kelvin_voigt_m), "#1f77b4", "10 5", 1.6}}});
     std::printf("wrote %s and %s\n", csv.c_str(), cl.text("svg").c_str());
     return 0;
   } catch (const viscera::common::UsageError& e) {

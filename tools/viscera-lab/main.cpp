@@ -7,16 +7,18 @@
 #include <string>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/decimation.hpp"
-#include "viscera/common/input_error.hpp"
+
 #include "model_file.hpp"
 #include "report.hpp"
 
 using namespace viscera::lab;
 
 int main(int argc, char** argv) {
-  viscera::common::CommandLine cl("viscera-lab",
+  viscera::common::CommandLine cl(
+      "viscera-lab",
       "analyze: fits the baseline (linear elasticity + Kelvin-Voigt damping) to the data set, shows where it is wrong\n"
       "  (per test, and on tests left out of the fit), names the cause among broadband_relaxation, strain_stiffening,\n"
       "  tension_compression_asymmetry and first_load_softening (accepted only if the held-out gain is clearly above the\n"
@@ -43,7 +45,8 @@ int main(int argc, char** argv) {
   if (!cl.has("out")) return usage_error("--out OUT_DIR is required");
   const std::string out = cl.text("out");
   const bool quiet = cl.has("quiet");
-  try {    const auto t0 = std::chrono::steady_clock::now();
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
     if (positional[0] == "analyze") {
       if (positional.size() != 2) return usage_error("analyze takes one DATASET_DIR");
       const Dataset d = read_dataset(positional[1]);

@@ -5,8 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "viscera/plot/svg_plot.hpp"
 #include "viscera/lab/fit.hpp"
+#include "viscera/plot/svg_plot.hpp"
+
 #include "model_file.hpp"
 
 namespace viscera::lab {
@@ -45,8 +46,12 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   j["gain"] = a.gain;
   j["candidates"] = json::array();
   for (const auto& c : a.candidates)
-    j["candidates"].push_back({{"mechanism", name(c.mechanism)}, {"round", c.round}, {"heldout_rms_before_pa", c.heldout_before_pa},
-                               {"heldout_rms_after_pa", c.heldout_after_pa}, {"accepted", c.accepted}, {"evidence", c.evidence}});
+    j["candidates"].push_back({{"mechanism", name(c.mechanism)},
+                               {"round", c.round},
+                               {"heldout_rms_before_pa", c.heldout_before_pa},
+                               {"heldout_rms_after_pa", c.heldout_after_pa},
+                               {"accepted", c.accepted},
+                               {"evidence", c.evidence}});
   j["verdict"] = a.verdict;
   j["specimen"] = json::array();
   for (const auto& c : a.specimen) {
@@ -66,14 +71,16 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences): " << a.noise_pa << " Pa. "
      << "Analysis time: " << seconds << " s.\n\n";
   for (const auto& line : a.decimated) md << "Decimated for the fit and the plots: " << line << ".\n\n";
-  md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out |\n|---|---|---|---|---|---|\n";
+  md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out "
+        "|\n|---|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < a.baseline.tests.size(); ++k)
     md << "| " << a.baseline.tests[k].file << " | " << a.baseline.tests[k].noise_pa << " | " << a.baseline.tests[k].fit_rms_pa << " | "
        << a.baseline.tests[k].heldout_rms_pa << " | " << a.final.tests[k].fit_rms_pa << " | " << a.final.tests[k].heldout_rms_pa << " |\n";
   md << "| **all (RMS over tests)** | " << a.noise_pa << " | " << a.baseline.fit_rms_pa << " | " << a.baseline.heldout_rms_pa << " | "
      << a.final.fit_rms_pa << " | " << a.final.heldout_rms_pa << " |\n\n";
   md << "Held-out: the model is fitted to the other tests only and predicts this one.\n\n";
-  md << "## Candidate mechanisms\n\n| round | mechanism | held-out RMS before | after | accepted | evidence in the residuals |\n|---|---|---|---|---|---|\n";
+  md << "## Candidate mechanisms\n\n| round | mechanism | held-out RMS before | after | accepted | evidence in the residuals "
+        "|\n|---|---|---|---|---|---|\n";
   for (const auto& c : a.candidates)
     md << "| " << c.round << " | " << name(c.mechanism) << " | " << c.heldout_before_pa << " | " << c.heldout_after_pa << " | "
        << (c.accepted ? "yes" : "no") << " | " << c.evidence << " |\n";
@@ -94,8 +101,8 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
       md << "  | " << c.files[k] << " | " << c.specimen_rms_pa[k] << " | " << c.law_rms_pa[k] << " |\n";
     md << "\n";
   }
-  md << "\n## Models\n\n- baseline: `" << a.baseline.model.describe() << "`, E = " << a.baseline.model.modulus_pa << " Pa, eta = "
-     << a.baseline.model.viscosity_pa_s << " Pa s\n- final: `" << a.final.model.describe() << "` (parameters in `model.json`)\n\n";
+  md << "\n## Models\n\n- baseline: `" << a.baseline.model.describe() << "`, E = " << a.baseline.model.modulus_pa
+     << " Pa, eta = " << a.baseline.model.viscosity_pa_s << " Pa s\n- final: `" << a.final.model.describe() << "` (parameters in `model.json`)\n\n";
   md << "## Data, baseline and final model\n\n";
   for (std::size_t k = 0; k < d.tests.size(); ++k) {
     const TestData& t = d.tests[k];
@@ -111,17 +118,22 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
     std::vector<double> since;
     const double offset = t.time_s[1] - t.time_s[0];
     for (double x : t.time_s) since.push_back(x - t.time_s[0] + offset);
-    plot::Figure fit{t.file + ": stress, data and models (fitted to all tests)", "time since the first sample [s] (log)", "stress [Pa]",
+    plot::Figure fit{t.file + ": stress, data and models (fitted to all tests)",
+                     "time since the first sample [s] (log)",
+                     "stress [Pa]",
                      {{"data", since, t.stress_pa, "#000000", "", 2.0},
                       {"baseline (" + std::to_string(a.baseline.model.parameter_count()) + " parameters)", since, yb, "#1f77b4", "8 4", 1.6},
                       {"final (" + std::to_string(a.final.model.parameter_count()) + " parameters)", since, yf, "#d62728", "", 1.6}}};
     fit.log_x = true;
     plot::write_svg((fs::path(out_dir) / name_fit).string(), fit);
-    plot::Figure res{t.file + ": residual (data - model)", "time since the first sample [s] (log)", "residual [Pa]",
+    plot::Figure res{t.file + ": residual (data - model)",
+                     "time since the first sample [s] (log)",
+                     "residual [Pa]",
                      {{"baseline", since, rb, "#1f77b4", "8 4", 1.6}, {"final", since, rf, "#d62728", "", 1.6}}};
     res.log_x = true;
     plot::write_svg((fs::path(out_dir) / name_res).string(), res);
-    md << "### " << t.file << " (" << to_string(t.control) << " control)\n\n![" << t.file << "](" << name_fit << ")\n\n![residual](" << name_res << ")\n\n";
+    md << "### " << t.file << " (" << to_string(t.control) << " control)\n\n![" << t.file << "](" << name_fit << ")\n\n![residual](" << name_res
+       << ")\n\n";
   }
 }
 

@@ -1,17 +1,17 @@
 // viscera-sim: loads an organ mesh and a material, fixes a region, runs it under gravity and
 // writes VTU frames (ParaView), printing progress and the step rate.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <algorithm>
 #include <iostream>
 #include <sstream>
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
-#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
@@ -32,8 +32,10 @@ std::vector<std::int32_t> fixed_nodes(const viscera::common::CommandLine& cl, co
     const auto v = cl.numbers(flag, 6);
     return Box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
   };
-  if (cl.has("fix-box")) for (auto i : nodes_in_box(mesh, box_of("fix-box"))) fixed.push_back(i);
-  if (cl.has("fix-surface-box")) for (auto i : surface_nodes_in_box(mesh, box_of("fix-surface-box"))) fixed.push_back(i);
+  if (cl.has("fix-box"))
+    for (auto i : nodes_in_box(mesh, box_of("fix-box"))) fixed.push_back(i);
+  if (cl.has("fix-surface-box"))
+    for (auto i : surface_nodes_in_box(mesh, box_of("fix-surface-box"))) fixed.push_back(i);
   if (cl.has("fix-slab")) {
     // AXIS,SIDE,FRACTION: surface nodes within FRACTION of the extent from the min or max side.
     const std::string spec = cl.text("fix-slab");
@@ -53,8 +55,10 @@ std::vector<std::int32_t> fixed_nodes(const viscera::common::CommandLine& cl, co
     if (!(fraction > 0 && fraction <= 1)) throw viscera::common::UsageError("--fix-slab: fraction must lie in (0, 1]");
     Box b = bounding_box(mesh);
     const double extent = b.hi[a] - b.lo[a];
-    if (side == "min") b.hi[a] = b.lo[a] + fraction * extent;
-    else b.lo[a] = b.hi[a] - fraction * extent;
+    if (side == "min")
+      b.hi[a] = b.lo[a] + fraction * extent;
+    else
+      b.lo[a] = b.hi[a] - fraction * extent;
     for (auto i : surface_nodes_in_box(mesh, b)) fixed.push_back(i);
   }
   if (cl.has("fix-nodes")) {
@@ -84,8 +88,8 @@ double max_displacement(const State& s, const TetMesh& mesh) {
 
 int run(int argc, char** argv) {
   viscera::common::CommandLine cl("viscera-sim",
-      "Runs an organ mesh under gravity with a fixed region and writes VTU frames for ParaView.\n"
-      "Units are SI: metres, seconds, pascals, kilograms.");
+                                  "Runs an organ mesh under gravity with a fixed region and writes VTU frames for ParaView.\n"
+                                  "Units are SI: metres, seconds, pascals, kilograms.");
   cl.flag("mesh", "PATH", "tetrahedral mesh (.msh Gmsh v1/v2/v4.1, .vtk legacy, .vtu)");
   cl.flag("scale", "M_PER_UNIT", "metres per mesh unit (organ meshes carry no units)", "1");
   cl.flag("material", "FILE.json", "material file (docs/MATERIAL.md)");
@@ -147,13 +151,13 @@ int run(int argc, char** argv) {
 
   const Box box = bounding_box(*mesh);
   const Vec3 size = box.hi - box.lo;
-  std::printf("mesh      %s: %zu nodes, %zu tetrahedra, %zu surface triangles\n", mesh_path.c_str(),
-              mesh->node_count(), mesh->tet_count(), extract_boundary(*mesh).triangles.size());
-  std::printf("          scaled by %g m/unit to %.3f x %.3f x %.3f m, volume %.3g m^3, mass %.3g kg\n", scale,
-              size.x(), size.y(), size.z(), mesh_volume(*mesh), mesh_volume(*mesh) * material.density_kg_m3);
+  std::printf("mesh      %s: %zu nodes, %zu tetrahedra, %zu surface triangles\n", mesh_path.c_str(), mesh->node_count(), mesh->tet_count(),
+              extract_boundary(*mesh).triangles.size());
+  std::printf("          scaled by %g m/unit to %.3f x %.3f x %.3f m, volume %.3g m^3, mass %.3g kg\n", scale, size.x(), size.y(), size.z(),
+              mesh_volume(*mesh), mesh_volume(*mesh) * material.density_kg_m3);
   std::printf("material  %s, density %g kg/m^3\n", material.name.c_str(), material.density_kg_m3);
-  std::printf("model     %s; %zu fixed nodes; gravity (%g, %g, %g) m/s^2; damping %g 1/s\n",
-              std::string(model->name()).c_str(), bc.fixed_nodes.size(), g[0], g[1], g[2], damping);
+  std::printf("model     %s; %zu fixed nodes; gravity (%g, %g, %g) m/s^2; damping %g 1/s\n", std::string(model->name()).c_str(),
+              bc.fixed_nodes.size(), g[0], g[1], g[2], damping);
   if (bc.fixed_nodes.empty()) std::printf("warning   no node is fixed: the organ will fall freely\n");
 
   const std::vector<double> rho(mesh->tet_count(), material.density_kg_m3);
@@ -162,8 +166,7 @@ int run(int argc, char** argv) {
   if (integrator_name == "explicit") {
     explicit_integrator = std::make_unique<ExplicitIntegrator>(*model, rho, bc, ExplicitOptions{0.9, 0.0, damping, 2.0});
     const auto& c = explicit_integrator->critical_step();
-    std::printf("explicit  critical step %.3g s (element %zu), using %.3g s (safety 0.9)\n", c.dt_s, c.element,
-                explicit_integrator->dt_s());
+    std::printf("explicit  critical step %.3g s (element %zu), using %.3g s (safety 0.9)\n", c.dt_s, c.element, explicit_integrator->dt_s());
   } else {
     implicit_integrator = std::make_unique<ImplicitIntegrator>(*model, rho, bc, ImplicitOptions{cl.number_in("dt", 1e-7, 10), damping, 1e-8, 50});
     std::printf("implicit  backward Euler, dt %.3g s, Newton to 1e-8 relative residual, CHOLMOD\n", cl.number("dt"));
@@ -203,10 +206,11 @@ int run(int argc, char** argv) {
     write_frame();
     if (state.time_s >= next_report - 1e-12 || state.time_s >= duration - 1e-12) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-      std::printf("t = %6.3f s  %8ld steps  %9.0f steps/s  %6.2fx real time  max displacement %.2f mm%s\n",
-                  state.time_s, steps, static_cast<double>(steps) / std::max(wall, 1e-9), state.time_s / std::max(wall, 1e-9),
-                  1e3 * max_displacement(state, *mesh),
-                  implicit_integrator ? (" Newton iterations/step " + std::to_string(static_cast<double>(newton_total) / static_cast<double>(steps))).c_str() : "");
+      std::printf("t = %6.3f s  %8ld steps  %9.0f steps/s  %6.2fx real time  max displacement %.2f mm%s\n", state.time_s, steps,
+                  static_cast<double>(steps) / std::max(wall, 1e-9), state.time_s / std::max(wall, 1e-9), 1e3 * max_displacement(state, *mesh),
+                  implicit_integrator
+                      ? (" Newton iterations/step " + std::to_string(static_cast<double>(newton_total) / static_cast<double>(steps))).c_str()
+                      : "");
       std::fflush(stdout);
       next_report += 0.1 * duration;
     }

@@ -7,13 +7,9 @@
 
 namespace viscera::tissue {
 
-FiniteElementModel::FiniteElementModel(std::shared_ptr<const TetMesh> mesh, FeKind kind,
-                                       std::vector<Mat6> materials,
+FiniteElementModel::FiniteElementModel(std::shared_ptr<const TetMesh> mesh, FeKind kind, std::vector<Mat6> materials,
                                        std::vector<std::uint16_t> material_of_tet)
-    : ForceModel(std::move(mesh)),
-      kind_(kind),
-      materials_(std::move(materials)),
-      material_of_tet_(std::move(material_of_tet)) {
+    : ForceModel(std::move(mesh)), kind_(kind), materials_(std::move(materials)), material_of_tet_(std::move(material_of_tet)) {
   if (materials_.empty()) throw std::invalid_argument("FiniteElementModel: no material");
   if (!material_of_tet_.empty() && material_of_tet_.size() != element_count())
     throw std::invalid_argument("FiniteElementModel: material_of_tet size differs from tet count");
@@ -24,9 +20,7 @@ FiniteElementModel::FiniteElementModel(std::shared_ptr<const TetMesh> mesh, FeKi
   }
 }
 
-std::string_view FiniteElementModel::name() const {
-  return kind_ == FeKind::linear ? "linear" : "corotational";
-}
+std::string_view FiniteElementModel::name() const { return kind_ == FeKind::linear ? "linear" : "corotational"; }
 
 Mat3 FiniteElementModel::deformation_gradient(std::span<const Vec3> x, std::size_t e) const {
   return edge_matrix(gather(x, e)) * elements_[e].dm_inv;

@@ -6,9 +6,7 @@
 namespace viscera::tissue {
 
 namespace {
-Eigen::Matrix<double, 12, 6> pseudo_inverse(const Mat6x12& J) {
-  return J.completeOrthogonalDecomposition().pseudoInverse();
-}
+Eigen::Matrix<double, 12, 6> pseudo_inverse(const Mat6x12& J) { return J.completeOrthogonalDecomposition().pseudoInverse(); }
 }  // namespace
 
 Mat6 gps_edge_hessian(const std::array<Eigen::Vector3d, 4>& rest, const Mat6& D) {
@@ -21,8 +19,7 @@ Mat6 gps_edge_hessian(const std::array<Eigen::Vector3d, 4>& rest, const Mat6& D)
 Mat6 calibrate_gps_pseudoinverse(const std::array<Eigen::Vector3d, 4>& rest, const Mat6& D) {
   const Mat6 H = gps_edge_hessian(rest, D);
   Vec6 inv_length;
-  for (int e = 0; e < 6; ++e)
-    inv_length(e) = 1.0 / (rest[kTetEdges[e][1]] - rest[kTetEdges[e][0]]).norm();
+  for (int e = 0; e < 6; ++e) inv_length(e) = 1.0 / (rest[kTetEdges[e][1]] - rest[kTetEdges[e][0]]).norm();
   return inv_length.asDiagonal() * H;
 }
 

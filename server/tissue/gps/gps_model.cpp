@@ -19,8 +19,7 @@ constexpr std::size_t kPrefetchAhead = 2;  // blocks (1, 2 and 4 measured at 96k
 constexpr std::size_t kPrefetchAboveBytes = std::size_t{16} << 20;
 }  // namespace
 
-GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
-                   std::vector<std::uint16_t> material_of_tet, GpsOptions options)
+GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials, std::vector<std::uint16_t> material_of_tet, GpsOptions options)
     : ForceModel(std::move(mesh)), options_(options) {
   if (materials.empty()) throw std::invalid_argument("GpsModel: no material");
   if (!material_of_tet.empty() && material_of_tet.size() != element_count())
@@ -43,8 +42,7 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   if (bulk_differs && ve.energy_map())
     throw std::invalid_argument("GpsModel: Fung stiffening in energy form relaxes the whole tension: bulk and shear weights must agree");
   std::vector<double> kappa(materials.size());
-  for (std::size_t m = 0; m < materials.size(); ++m)
-    kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
+  for (std::size_t m = 0; m < materials.size(); ++m) kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
 
   const std::size_t n = element_count();
   blocks_.resize((n + L - 1) / L);
@@ -115,8 +113,8 @@ Mat6 GpsModel::paper_constants(std::size_t e) const {
 }
 
 template <bool kEnergyConsistent, bool kVolume, bool kMemory>
-ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory,
-                                     std::size_t first_block, std::size_t end_block) const {
+ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory, std::size_t first_block,
+                                     std::size_t end_block) const {
   const Vec3* X = mesh_->nodes.data();
   double max_strain[L] = {}, nan_probe[L] = {};
   // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l; with
@@ -147,8 +145,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
   // them ahead: at 96k tets asking for them two blocks early makes a step 25% faster (AMD EPYC).
   // While they fit in the caches it costs: 9% on a 12k step (Intel Xeon). Into all cache levels
   // (locality 3): the non-temporal hint made the Xeon's 12k and 96k steps 2.6-2.9x slower.
-  const bool prefetch =
-      blocks_.size() * (sizeof(Block) + (kMemory ? stride * sizeof(double) : 0)) > kPrefetchAboveBytes;
+  const bool prefetch = blocks_.size() * (sizeof(Block) + (kMemory ? stride * sizeof(double) : 0)) > kPrefetchAboveBytes;
   for (std::size_t bi = first_block; bi < end_block; ++bi) {
     const Block& b = blocks_[bi];
     if (prefetch && bi + kPrefetchAhead < end_block) {
@@ -210,8 +207,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
           }
       } else {
         for (int k = 0; k < 6; ++k)
-          for (int j = 0; j < L; ++j)
-            dL[k][j] = b.rest_length[k][j] * std::expm1(qlv * dL[k][j] * b.inv_rest_length[k][j]) / qlv;
+          for (int j = 0; j < L; ++j) dL[k][j] = b.rest_length[k][j] * std::expm1(qlv * dL[k][j] * b.inv_rest_length[k][j]) / qlv;
       }
     }
     double bulk_part[6][L];  // a_b - a_s, for bulk relaxation that differs from shear
@@ -219,7 +215,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     // elastic tensions h' (H h) themselves (3D QLV: the hereditary integral over the elastic
     // response, exact in 1D); otherwise the memory filters the elongations and H acts after it.
     double t[6][L];
-    const auto apply_h = [&](double (&v)[6][L]) {
+    const auto apply_h = [&](double(&v)[6][L]) {
       for (int k = 0; k < 6; ++k)
 #pragma omp simd
         for (int j = 0; j < L; ++j) t[k][j] = 0.0;
@@ -242,7 +238,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
 #pragma omp simd
         for (int j = 0; j < L; ++j) t[k][j] *= dh[k][j];
     }
-    double (&filtered)[6][L] = qlv_energy ? t : dL;
+    double(&filtered)[6][L] = qlv_energy ? t : dL;
     double block_probe = 0.0;  // NaN if any elongation of the block is not finite
     if constexpr (kMemory) {
       // Per lane first: one long scalar chain of 48 dependent adds cost a quarter of the loop.
@@ -369,13 +365,9 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
   return {std::isnan(probe) ? std::numeric_limits<double>::quiet_NaN() : worst};
 }
 
-ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) const {
-  return add_forces(x, f, MemoryUpdate{}, ElementPart{});
-}
+ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) const { return add_forces(x, f, MemoryUpdate{}, ElementPart{}); }
 
-std::size_t GpsModel::memory_size() const {
-  return options_.viscoelasticity.has_memory() ? blocks_.size() * memory_stride() : 0;
-}
+std::size_t GpsModel::memory_size() const { return options_.viscoelasticity.has_memory() ? blocks_.size() * memory_stride() : 0; }
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
   return add_forces(x, f, memory, ElementPart{});
@@ -388,10 +380,12 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, cons
   const bool ec = options_.variant == GpsVariant::energy_consistent;
   // Without memory attached (or none to keep): the unrelaxed (instantaneous) response.
   if (memory_size() == 0 || memory.before.size() != memory_size() || memory.after.size() != memory_size()) {
-    if (!with_volume_) return ec ? add_forces_impl<true, false, false>(x, f, nullptr, b0, b1) : add_forces_impl<false, false, false>(x, f, nullptr, b0, b1);
+    if (!with_volume_)
+      return ec ? add_forces_impl<true, false, false>(x, f, nullptr, b0, b1) : add_forces_impl<false, false, false>(x, f, nullptr, b0, b1);
     return ec ? add_forces_impl<true, true, false>(x, f, nullptr, b0, b1) : add_forces_impl<false, true, false>(x, f, nullptr, b0, b1);
   }
-  if (!with_volume_) return ec ? add_forces_impl<true, false, true>(x, f, &memory, b0, b1) : add_forces_impl<false, false, true>(x, f, &memory, b0, b1);
+  if (!with_volume_)
+    return ec ? add_forces_impl<true, false, true>(x, f, &memory, b0, b1) : add_forces_impl<false, false, true>(x, f, &memory, b0, b1);
   return ec ? add_forces_impl<true, true, true>(x, f, &memory, b0, b1) : add_forces_impl<false, true, true>(x, f, &memory, b0, b1);
 }
 
@@ -502,7 +496,7 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
   const bool softened = phi != nullptr && !qlv_energy;
   if (softened)
     for (int k = 0; k < 6; ++k) {
-      Gm.row(k) = (*phi)(k) * Gm.row(k) + dL(k) * (*dphi_de)(k) / edge_length(e, k) * G.row(k);
+      Gm.row(k) = (*phi)(k)*Gm.row(k) + dL(k) * (*dphi_de)(k) / edge_length(e, k) * G.row(k);
       dL(k) *= (*phi)(k);
     }
   const Vec6 Hh = H * dL;

@@ -8,13 +8,11 @@
 namespace viscera::tissue {
 
 std::vector<double> lumped_masses(const TetMesh& mesh, std::span<const double> density_kg_m3) {
-  if (density_kg_m3.size() != mesh.tets.size())
-    throw std::invalid_argument("lumped_masses: one density per tetrahedron expected");
+  if (density_kg_m3.size() != mesh.tets.size()) throw std::invalid_argument("lumped_masses: one density per tetrahedron expected");
   std::vector<double> m(mesh.nodes.size(), 0.0);
   for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
     const Tet& t = mesh.tets[e];
-    const double quarter =
-        0.25 * density_kg_m3[e] * signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+    const double quarter = 0.25 * density_kg_m3[e] * signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
     for (int k = 0; k < 4; ++k) m[t[k]] += quarter;
   }
   return m;

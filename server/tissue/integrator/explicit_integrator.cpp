@@ -12,13 +12,10 @@ namespace viscera::tissue {
 
 using common::short_number;
 
-ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
-                                       BoundaryConditions bc, ExplicitOptions options)
+ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc, ExplicitOptions options)
     : model_(model), bc_(std::move(bc)), options_(options) {
-  if (!(options_.safety_factor > 0 && options_.safety_factor <= 1))
-    throw std::invalid_argument("ExplicitOptions.safety_factor must lie in (0, 1]");
-  if (!(options_.mass_damping_per_s >= 0))
-    throw std::invalid_argument("ExplicitOptions.mass_damping_per_s must be >= 0");
+  if (!(options_.safety_factor > 0 && options_.safety_factor <= 1)) throw std::invalid_argument("ExplicitOptions.safety_factor must lie in (0, 1]");
+  if (!(options_.mass_damping_per_s >= 0)) throw std::invalid_argument("ExplicitOptions.mass_damping_per_s must be >= 0");
   const std::vector<double> weight = lumped_masses(model.rest_mesh(), density_kg_m3);
   if (options_.added_mass_fraction > 0) {
     scaling_ = scale_small_element_masses(model, density_kg_m3, options_.added_mass_fraction);
@@ -67,9 +64,8 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
     std::ostringstream msg;
-    msg << "explicit integration went unstable at t = " << state.time_s << " s: element " << e
-        << " has edge strain " << model_.element_max_edge_strain(state.x, e) << " (limit "
-        << options_.max_edge_strain << "); dt = " << dt << " s, critical step "
+    msg << "explicit integration went unstable at t = " << state.time_s << " s: element " << e << " has edge strain "
+        << model_.element_max_edge_strain(state.x, e) << " (limit " << options_.max_edge_strain << "); dt = " << dt << " s, critical step "
         << critical_.dt_s << " s";
     if (!x_prev_.empty()) {  // back to the last state that passed this check
       state.x = x_prev_;

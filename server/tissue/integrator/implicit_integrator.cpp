@@ -18,8 +18,7 @@ double norm(const std::vector<double>& r) {
 }
 }  // namespace
 
-ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
-                                       BoundaryConditions bc, ImplicitOptions options)
+ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc, ImplicitOptions options)
     : model_(model), bc_(std::move(bc)), options_(options) {
   if (!(options_.dt_s > 0)) throw std::invalid_argument("ImplicitOptions.dt_s must be > 0");
   mass_ = lumped_masses(model.rest_mesh(), density_kg_m3);
@@ -81,8 +80,8 @@ void ImplicitIntegrator::apply_constraints(State& state, double t) {
     for (auto i : p.nodes) state.x[i][p.axis] = p.coordinate(rest[i], t);
 }
 
-double ImplicitIntegrator::residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n,
-                                    const std::vector<Vec3>& v_n, std::vector<double>& r) {
+double ImplicitIntegrator::residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n, const std::vector<Vec3>& v_n,
+                                    std::vector<double>& r) {
   std::fill(force_.begin(), force_.end(), Vec3::Zero());
   if (dynamic && memory_before_) {
     memory_trial_.resize(memory_before_->size());
@@ -110,7 +109,7 @@ void ImplicitIntegrator::assemble(const std::vector<Vec3>& x, double mass_scale,
   std::span<double> values = solver_->values();
   std::fill(values.begin(), values.end(), 0.0);
   for (std::size_t e = 0; e < model_.element_count(); ++e) {
-    const Mat12 K = mass_scale <= 0   ? model_.element_tangent(x, e)
+    const Mat12 K = mass_scale <= 0  ? model_.element_tangent(x, e)
                     : memory_before_ ? model_.element_tangent(x, e, options_.dt_s, *memory_before_)
                                      : model_.element_tangent(x, e, options_.dt_s);
     const long* slots = &element_slots_[144 * e];
@@ -120,8 +119,7 @@ void ImplicitIntegrator::assemble(const std::vector<Vec3>& x, double mass_scale,
   }
   double mean_diagonal = 0.0;
   for (std::size_t c = 0; c < dof_.size(); ++c)
-    if (dof_[c] >= 0)
-      values[static_cast<std::size_t>(diagonal_slots_[static_cast<std::size_t>(dof_[c])])] += mass_scale * mass_[c / 3];
+    if (dof_[c] >= 0) values[static_cast<std::size_t>(diagonal_slots_[static_cast<std::size_t>(dof_[c])])] += mass_scale * mass_[c / 3];
   if (regularisation > 0) {
     for (long s : diagonal_slots_) mean_diagonal += values[static_cast<std::size_t>(s)];
     mean_diagonal /= static_cast<double>(diagonal_slots_.size());
@@ -147,8 +145,7 @@ void ImplicitIntegrator::update_external(double t) {
   for (std::size_t i = 0; i < mass_.size(); ++i) external_[i] = mass_[i] * bc_.gravity_m_s2 + bc_.nodal_force(i, t);
 }
 
-NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::vector<Vec3>& x_n,
-                                        const std::vector<Vec3>& v_n) {
+NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::vector<Vec3>& x_n, const std::vector<Vec3>& v_n) {
   NewtonReport rep;
   std::vector<double> r, dx(static_cast<std::size_t>(free_dofs_));
   double rn = residual(state.x, dynamic, x_n, v_n, r);
@@ -230,9 +227,8 @@ NewtonReport ImplicitIntegrator::step(State& state) {
   NewtonReport rep = free_dofs_ > 0 ? newton(state, true, x_n, v_n) : NewtonReport{0, 0, 0, 0, 0, true, false};
   if (!rep.converged) {
     std::ostringstream msg;
-    msg << "implicit step at t = " << state.time_s << " s did not converge in " << rep.iterations
-        << " Newton iterations: residual " << rep.residual_n << " N (tolerance "
-        << options_.relative_tolerance * rep.force_scale_n << " N)";
+    msg << "implicit step at t = " << state.time_s << " s did not converge in " << rep.iterations << " Newton iterations: residual " << rep.residual_n
+        << " N (tolerance " << options_.relative_tolerance * rep.force_scale_n << " N)";
     state.x = x_n;
     state.v = v_n;
     memory_before_ = nullptr;
@@ -260,8 +256,7 @@ NewtonReport ImplicitIntegrator::solve_static(State& state) {
   std::fill(state.v.begin(), state.v.end(), Vec3::Zero());
   if (!rep.converged) {
     std::ostringstream msg;
-    msg << "static solve did not converge in " << rep.iterations << " Newton iterations: residual "
-        << rep.residual_n << " N";
+    msg << "static solve did not converge in " << rep.iterations << " Newton iterations: residual " << rep.residual_n << " N";
     throw SimulationError(msg.str());
   }
   return rep;

@@ -9,11 +9,9 @@
 
 namespace viscera::tissue {
 
-MassScaling scale_small_element_masses(const ForceModel& model, std::span<const double> density_kg_m3,
-                                       double added_mass_fraction) {
+MassScaling scale_small_element_masses(const ForceModel& model, std::span<const double> density_kg_m3, double added_mass_fraction) {
   if (!(added_mass_fraction >= 0 && added_mass_fraction <= 10))
-    throw std::invalid_argument("scale_small_element_masses: added mass fraction " + std::to_string(added_mass_fraction) +
-                                " is outside [0, 10]");
+    throw std::invalid_argument("scale_small_element_masses: added mass fraction " + std::to_string(added_mass_fraction) + " is outside [0, 10]");
   const std::vector<double> omega = element_frequencies(model, density_kg_m3);
   const std::size_t n = omega.size();
   std::vector<double> mass(n);

@@ -17,14 +17,12 @@ struct SparseCholesky::Impl {
 
 SparseCholesky::SparseCholesky(int n, std::vector<int> column_pointers, std::vector<int> row_indices)
     : impl_(new Impl), n_(n), column_pointers_(std::move(column_pointers)), row_indices_(std::move(row_indices)) {
-  if (static_cast<int>(column_pointers_.size()) != n + 1)
-    throw std::invalid_argument("SparseCholesky: column pointer count");
+  if (static_cast<int>(column_pointers_.size()) != n + 1) throw std::invalid_argument("SparseCholesky: column pointer count");
   cholmod_start(&impl_->common);
   impl_->common.print = 0;
   impl_->common.error_handler = nullptr;
   const auto nnz = static_cast<size_t>(column_pointers_.back());
-  impl_->A = cholmod_allocate_sparse(static_cast<size_t>(n), static_cast<size_t>(n), nnz, 1, 1, 1,
-                                     CHOLMOD_REAL, &impl_->common);
+  impl_->A = cholmod_allocate_sparse(static_cast<size_t>(n), static_cast<size_t>(n), nnz, 1, 1, 1, CHOLMOD_REAL, &impl_->common);
   if (!impl_->A) throw std::runtime_error("CHOLMOD: cannot allocate the matrix");
   std::memcpy(impl_->A->p, column_pointers_.data(), sizeof(int) * column_pointers_.size());
   std::memcpy(impl_->A->i, row_indices_.data(), sizeof(int) * nnz);
@@ -40,9 +38,7 @@ SparseCholesky::~SparseCholesky() {
   delete impl_;
 }
 
-std::span<double> SparseCholesky::values() {
-  return {static_cast<double*>(impl_->A->x), static_cast<size_t>(column_pointers_.back())};
-}
+std::span<double> SparseCholesky::values() { return {static_cast<double*>(impl_->A->x), static_cast<size_t>(column_pointers_.back())}; }
 
 long SparseCholesky::slot(int row, int col) const {
   const auto begin = row_indices_.begin() + column_pointers_[col];

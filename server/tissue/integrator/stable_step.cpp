@@ -2,16 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 #include <stdexcept>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 
 namespace viscera::tissue {
 
 std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3) {
-  if (density_kg_m3.size() != model.element_count())
-    throw std::invalid_argument("element_frequencies: one density per element expected");
+  if (density_kg_m3.size() != model.element_count()) throw std::invalid_argument("element_frequencies: one density per element expected");
   const auto& rest = model.rest_mesh().nodes;
   std::vector<double> omega(model.element_count());
   for (std::size_t e = 0; e < model.element_count(); ++e) {
@@ -19,8 +18,7 @@ std::vector<double> element_frequencies(const ForceModel& model, std::span<const
     const double volume = signed_volume(x[0], x[1], x[2], x[3]);
     const Mat12 K = model.element_tangent(rest, e);
     const Mat12 Ks = 0.5 * (K + K.transpose());
-    const double lambda =
-        Eigen::SelfAdjointEigenSolver<Mat12>(Ks, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+    const double lambda = Eigen::SelfAdjointEigenSolver<Mat12>(Ks, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
     omega[e] = std::sqrt(lambda / (0.25 * density_kg_m3[e] * volume));
   }
   return omega;
@@ -37,8 +35,8 @@ StableStep critical_time_step(const ForceModel& model, std::span<const double> d
   return {2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi), omega, static_cast<std::size_t>(worst - omegas.begin())};
 }
 
-StableStep global_time_step(const ForceModel& model, std::span<const double> masses, std::span<const char> constrained,
-                            int iterations, double margin) {
+StableStep global_time_step(const ForceModel& model, std::span<const double> masses, std::span<const char> constrained, int iterations,
+                            double margin) {
   const auto& X = model.rest_mesh().nodes;
   const std::size_t n = X.size();
   std::vector<double> inv_sqrt_m(n);

@@ -25,10 +25,10 @@ void require(bool ok, const std::string& source, const char* field, double value
 }  // namespace
 
 Mat6 elasticity_matrix(const IsotropicElasticity& m, const std::string& source) {
-  require(std::isfinite(m.youngs_modulus_pa) && m.youngs_modulus_pa > 0, source, "youngs_modulus_pa",
-          m.youngs_modulus_pa, "must be a positive number of pascals");
-  require(std::isfinite(m.poisson_ratio) && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5, source,
-          "poisson_ratio", m.poisson_ratio, "must lie in (-1, 0.5)");
+  require(std::isfinite(m.youngs_modulus_pa) && m.youngs_modulus_pa > 0, source, "youngs_modulus_pa", m.youngs_modulus_pa,
+          "must be a positive number of pascals");
+  require(std::isfinite(m.poisson_ratio) && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5, source, "poisson_ratio", m.poisson_ratio,
+          "must lie in (-1, 0.5)");
   const double E = m.youngs_modulus_pa, nu = m.poisson_ratio;
   const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   const double mu = E / (2 * (1 + nu));
@@ -40,16 +40,15 @@ Mat6 elasticity_matrix(const IsotropicElasticity& m, const std::string& source) 
 }
 
 Mat6 elasticity_matrix(const TransverselyIsotropicElasticity& m, const std::string& source) {
-  require(std::isfinite(m.plane_youngs_modulus_pa) && m.plane_youngs_modulus_pa > 0, source,
-          "plane_youngs_modulus_pa", m.plane_youngs_modulus_pa, "must be a positive number of pascals");
-  require(std::isfinite(m.fibre_youngs_modulus_pa) && m.fibre_youngs_modulus_pa > 0, source,
-          "fibre_youngs_modulus_pa", m.fibre_youngs_modulus_pa, "must be a positive number of pascals");
-  require(std::isfinite(m.fibre_shear_modulus_pa) && m.fibre_shear_modulus_pa > 0, source,
-          "fibre_shear_modulus_pa", m.fibre_shear_modulus_pa, "must be a positive number of pascals");
-  require(std::isfinite(m.plane_poisson_ratio) && std::abs(m.plane_poisson_ratio) < 1.0, source,
-          "plane_poisson_ratio", m.plane_poisson_ratio, "must lie in (-1, 1)");
-  require(std::isfinite(m.fibre_plane_poisson_ratio), source, "fibre_plane_poisson_ratio",
-          m.fibre_plane_poisson_ratio, "must be finite");
+  require(std::isfinite(m.plane_youngs_modulus_pa) && m.plane_youngs_modulus_pa > 0, source, "plane_youngs_modulus_pa", m.plane_youngs_modulus_pa,
+          "must be a positive number of pascals");
+  require(std::isfinite(m.fibre_youngs_modulus_pa) && m.fibre_youngs_modulus_pa > 0, source, "fibre_youngs_modulus_pa", m.fibre_youngs_modulus_pa,
+          "must be a positive number of pascals");
+  require(std::isfinite(m.fibre_shear_modulus_pa) && m.fibre_shear_modulus_pa > 0, source, "fibre_shear_modulus_pa", m.fibre_shear_modulus_pa,
+          "must be a positive number of pascals");
+  require(std::isfinite(m.plane_poisson_ratio) && std::abs(m.plane_poisson_ratio) < 1.0, source, "plane_poisson_ratio", m.plane_poisson_ratio,
+          "must lie in (-1, 1)");
+  require(std::isfinite(m.fibre_plane_poisson_ratio), source, "fibre_plane_poisson_ratio", m.fibre_plane_poisson_ratio, "must be finite");
   const double n = m.fibre_direction.norm();
   require(std::isfinite(n) && n > 0, source, "fibre_direction", n, "(its length) must be non-zero");
 
@@ -63,12 +62,13 @@ Mat6 elasticity_matrix(const TransverselyIsotropicElasticity& m, const std::stri
   S(0, 1) = S(1, 0) = -nup / Ep;
   S(0, 2) = S(2, 0) = S(1, 2) = S(2, 1) = -nufp / Ef;
   S(3, 3) = S(4, 4) = 1 / Gf;  // yz, xz: planes containing the fibre (z)
-  S(5, 5) = 1 / Gp;            // xy: the isotropic plane
+  S(5, 5) = 1 / Gp;  // xy: the isotropic plane
   Eigen::LLT<Mat6> llt(S);
   if (llt.info() != Eigen::Success)
     throw InputError(source, 0, "fibre_plane_poisson_ratio",
-                     num(nufp) + " with the other constants gives a compliance that is not positive "
-                                 "definite (unphysical material)");
+                     num(nufp) +
+                         " with the other constants gives a compliance that is not positive "
+                         "definite (unphysical material)");
   const Mat6 D_local = S.inverse();
 
   // Rotation taking local z onto the fibre direction.
@@ -88,8 +88,7 @@ Mat6 elasticity_matrix(const TransverselyIsotropicElasticity& m, const std::stri
 
 void check_elasticity_matrix(const Mat6& D, const std::string& source) {
   if (!D.allFinite()) throw InputError(source, 0, "D", "has non-finite entries");
-  if ((D - D.transpose()).norm() > 1e-12 * D.norm())
-    throw InputError(source, 0, "D", "is not symmetric");
+  if ((D - D.transpose()).norm() > 1e-12 * D.norm()) throw InputError(source, 0, "D", "is not symmetric");
   Eigen::LLT<Mat6> llt(D);
   if (llt.info() != Eigen::Success) throw InputError(source, 0, "D", "is not positive definite");
 }

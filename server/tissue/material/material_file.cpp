@@ -6,10 +6,10 @@
 
 namespace viscera::tissue {
 
-using common::short_number;
-using common::read_text_file;
-using common::parse_json;
 using common::JsonObject;
+using common::parse_json;
+using common::read_text_file;
+using common::short_number;
 
 namespace {
 // Ranges wide enough for any tissue and any material a study may want (bone is about 2e10 Pa),
@@ -45,8 +45,8 @@ Material parse_material(const std::string& text, const std::string& source) {
   }
   if (top.has("viscoelasticity")) {
     const JsonObject v = top.object("viscoelasticity");
-    v.require_known({"model", "shear_q", "bulk_q", "band_hz", "mechanisms", "reference_frequency_hz", "qlv_stiffening", "qlv_form",
-                     "compression_ratio"});
+    v.require_known(
+        {"model", "shear_q", "bulk_q", "band_hz", "mechanisms", "reference_frequency_hz", "qlv_stiffening", "qlv_form", "compression_ratio"});
     ViscoelasticSpec spec;
     if (v.choice("model", {"constant_q", "kelvin_voigt"}, "constant_q") == "kelvin_voigt") spec.model = ViscoelasticSpec::Model::kelvin_voigt;
     spec.shear_q = v.number("shear_q", 0.5, 1e4);

@@ -18,18 +18,18 @@ constexpr long long kTet4 = 4;
 // Number of nodes of a Gmsh element type; -1 if unknown.
 int gmsh_node_count(long long type) {
   switch (type) {
-    case 1: return 2;    // line
-    case 2: return 3;    // triangle
-    case 3: return 4;    // quadrangle
-    case 4: return 4;    // tetrahedron
-    case 5: return 8;    // hexahedron
-    case 6: return 6;    // prism
-    case 7: return 5;    // pyramid
-    case 8: return 3;    // second-order line
-    case 9: return 6;    // second-order triangle
-    case 10: return 9;   // second-order quadrangle
+    case 1: return 2;  // line
+    case 2: return 3;  // triangle
+    case 3: return 4;  // quadrangle
+    case 4: return 4;  // tetrahedron
+    case 5: return 8;  // hexahedron
+    case 6: return 6;  // prism
+    case 7: return 5;  // pyramid
+    case 8: return 3;  // second-order line
+    case 9: return 6;  // second-order triangle
+    case 10: return 9;  // second-order quadrangle
     case 11: return 10;  // second-order tetrahedron
-    case 15: return 1;   // point
+    case 15: return 1;  // point
     default: return -1;
   }
 }
@@ -77,8 +77,7 @@ void read_elements_v1v2(TextCursor& in, MeshBuilder& b, bool v1, std::string_vie
       in.integer("element elementary region");
       const long long count = in.integer("element node count");
       if (count != nodes)
-        in.fail("element " + std::to_string(id) + " node count",
-                std::to_string(count) + " does not match type " + std::to_string(type));
+        in.fail("element " + std::to_string(id) + " node count", std::to_string(count) + " does not match type " + std::to_string(type));
     } else {
       const long long tags = in.integer_in("element tag count", 0, 64);
       for (long long k = 0; k < tags; ++k) in.integer("element tag");
@@ -176,14 +175,19 @@ TetMesh read_gmsh(const std::string& path) {
       }
       expect(in, "$EndMeshFormat");
     } else if (section == "$Nodes") {
-      if (version == 2) read_nodes_v1v2(in, b, "$EndNodes");
-      else if (version == 4) read_nodes_v4(in, b);
-      else in.fail("$Nodes", "no $MeshFormat before it");
+      if (version == 2)
+        read_nodes_v1v2(in, b, "$EndNodes");
+      else if (version == 4)
+        read_nodes_v4(in, b);
+      else
+        in.fail("$Nodes", "no $MeshFormat before it");
       nodes = true;
     } else if (section == "$Elements") {
       if (!nodes) in.fail("$Elements", "elements before nodes");
-      if (version == 2) read_elements_v1v2(in, b, false, "$EndElements");
-      else read_elements_v4(in, b);
+      if (version == 2)
+        read_elements_v1v2(in, b, false, "$EndElements");
+      else
+        read_elements_v4(in, b);
       elements = true;
     } else if (section.starts_with("$")) {
       // Any other section ($PhysicalNames, $Entities, $NodeData...): skip to its end marker.

@@ -8,8 +8,7 @@ namespace viscera::tissue {
 using common::InputError;
 
 void MeshBuilder::add_node(long long id, const Vec3& p, long line) {
-  if (!p.allFinite())
-    throw InputError(source_, line, "node " + std::to_string(id), "coordinates are not finite");
+  if (!p.allFinite()) throw InputError(source_, line, "node " + std::to_string(id), "coordinates are not finite");
   const auto [it, inserted] = index_of_.emplace(id, static_cast<std::int32_t>(nodes_.size()));
   if (!inserted) throw InputError(source_, line, "node " + std::to_string(id), "duplicate node id");
   nodes_.push_back(p);
@@ -17,9 +16,7 @@ void MeshBuilder::add_node(long long id, const Vec3& p, long line) {
   node_lines_.push_back(line);
 }
 
-void MeshBuilder::add_tet(const std::array<long long, 4>& ids, long long element, long line) {
-  tets_.push_back({ids, element, line});
-}
+void MeshBuilder::add_tet(const std::array<long long, 4>& ids, long long element, long line) { tets_.push_back({ids, element, line}); }
 
 TetMesh MeshBuilder::build() {
   TetMesh mesh;

@@ -42,13 +42,10 @@ void validate_mesh(const TetMesh& mesh, const MeshOrigin* origin) {
     const std::string name = element(e);
     const long line = element_line(e);
     for (int k = 0; k < 4; ++k)
-      if (t[k] < 0 || t[k] >= n)
-        fail(name, "vertex index " + std::to_string(t[k]) + " is out of range [0, " +
-                       std::to_string(n - 1) + "]", line);
+      if (t[k] < 0 || t[k] >= n) fail(name, "vertex index " + std::to_string(t[k]) + " is out of range [0, " + std::to_string(n - 1) + "]", line);
     std::array<std::int32_t, 4> sorted = t;
     std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
-      fail(name, "repeats a vertex", line);
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) fail(name, "repeats a vertex", line);
     const auto [it, inserted] = seen.emplace(sorted, e);
     if (!inserted) fail(name, "duplicates " + element(it->second), line);
     const double q = tet_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);

@@ -12,15 +12,13 @@ TetMesh refine_uniform(const TetMesh& mesh) {
   out.nodes = mesh.nodes;
   std::unordered_map<std::uint64_t, std::int32_t> midpoint;
   const auto mid = [&](std::int32_t a, std::int32_t b) {
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) |
-                              static_cast<std::uint32_t>(std::max(a, b));
+    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
     const auto [it, inserted] = midpoint.try_emplace(key, static_cast<std::int32_t>(out.nodes.size()));
     if (inserted) out.nodes.push_back(0.5 * (mesh.nodes[a] + mesh.nodes[b]));
     return it->second;
   };
   const auto add = [&](Tet t) {
-    if (signed_volume(out.nodes[t[0]], out.nodes[t[1]], out.nodes[t[2]], out.nodes[t[3]]) < 0)
-      std::swap(t[2], t[3]);
+    if (signed_volume(out.nodes[t[0]], out.nodes[t[1]], out.nodes[t[2]], out.nodes[t[3]]) < 0) std::swap(t[2], t[3]);
     out.tets.push_back(t);
   };
   out.tets.reserve(8 * mesh.tets.size());
@@ -43,8 +41,7 @@ TetMesh refine_uniform(const TetMesh& mesh) {
         best = d;
       }
     }
-    for (int k = 0; k < 4; ++k)
-      add({diag[best][0], diag[best][1], ring[best][k], ring[best][(k + 1) % 4]});
+    for (int k = 0; k < 4; ++k) add({diag[best][0], diag[best][1], ring[best][k], ring[best][(k + 1) % 4]});
   }
   return out;
 }

@@ -9,8 +9,7 @@ void scale_mesh(TetMesh& mesh, double factor) {
 }
 
 Box bounding_box(const TetMesh& mesh) {
-  Box b{Vec3::Constant(std::numeric_limits<double>::infinity()),
-        Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  Box b{Vec3::Constant(std::numeric_limits<double>::infinity()), Vec3::Constant(-std::numeric_limits<double>::infinity())};
   for (const auto& p : mesh.nodes) {
     b.lo = b.lo.cwiseMin(p);
     b.hi = b.hi.cwiseMax(p);
@@ -20,8 +19,7 @@ Box bounding_box(const TetMesh& mesh) {
 
 double mesh_volume(const TetMesh& mesh) {
   double v = 0.0;
-  for (const auto& t : mesh.tets)
-    v += signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+  for (const auto& t : mesh.tets) v += signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
   return v;
 }
 

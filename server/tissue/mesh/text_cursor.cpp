@@ -19,8 +19,7 @@ namespace {
 bool is_space(char c) { return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
 }  // namespace
 
-TextCursor::TextCursor(std::string source, std::string text)
-    : source_(std::move(source)), text_(std::move(text)) {}
+TextCursor::TextCursor(std::string source, std::string text) : source_(std::move(source)), text_(std::move(text)) {}
 
 TextCursor TextCursor::from_file(const std::string& path) {
   std::string text = read_text_file(path, std::size_t{4} << 30);
@@ -39,8 +38,10 @@ long TextCursor::next_line() {
 void TextCursor::skip_space() {
   while (pos_ < text_.size()) {
     const char c = text_[pos_];
-    if (c == '\n') ++line_;
-    else if (!is_space(c)) break;
+    if (c == '\n')
+      ++line_;
+    else if (!is_space(c))
+      break;
     ++pos_;
   }
 }
@@ -50,9 +51,7 @@ bool TextCursor::at_end() {
   return pos_ >= text_.size();
 }
 
-void TextCursor::fail(std::string_view field, const std::string& message) const {
-  throw InputError(source_, line_, std::string(field), message);
-}
+void TextCursor::fail(std::string_view field, const std::string& message) const { throw InputError(source_, line_, std::string(field), message); }
 
 std::string_view TextCursor::token(std::string_view field) {
   skip_space();
@@ -66,8 +65,7 @@ double TextCursor::real(std::string_view field) {
   const std::string_view t = token(field);
   double v = 0.0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size())
-    fail(field, "'" + printable(t) + "' is not a number");
+  if (ec != std::errc() || end != t.data() + t.size()) fail(field, "'" + printable(t) + "' is not a number");
   if (!std::isfinite(v)) fail(field, "'" + printable(t) + "' is not a finite number");
   return v;
 }
@@ -76,16 +74,13 @@ long long TextCursor::integer(std::string_view field) {
   const std::string_view t = token(field);
   long long v = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size())
-    fail(field, "'" + printable(t) + "' is not an integer");
+  if (ec != std::errc() || end != t.data() + t.size()) fail(field, "'" + printable(t) + "' is not an integer");
   return v;
 }
 
 long long TextCursor::integer_in(std::string_view field, long long lo, long long hi) {
   const long long v = integer(field);
-  if (v < lo || v > hi)
-    fail(field, std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
-                    std::to_string(hi) + "]");
+  if (v < lo || v > hi) fail(field, std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   return v;
 }
 

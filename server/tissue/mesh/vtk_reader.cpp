@@ -24,28 +24,22 @@ namespace {
 constexpr long long kVtkTetra = 10;
 
 // VTK volume cell types other than the linear tetrahedron.
-bool is_other_volume_cell(long long type) {
-  return type == 11 || type == 12 || type == 13 || type == 14 || type == 24 || type == 25 ||
-         type == 42;
-}
+bool is_other_volume_cell(long long type) { return type == 11 || type == 12 || type == 13 || type == 14 || type == 24 || type == 25 || type == 42; }
 
 long long to_integer(TextCursor& in, std::string_view t, std::string_view field) {
   long long v = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size())
-    in.fail(field, "'" + printable(t) + "' is not an integer");
+  if (ec != std::errc() || end != t.data() + t.size()) in.fail(field, "'" + printable(t) + "' is not an integer");
   return v;
 }
 
 /// `lines`: each cell's line in the file (empty: `line` for all).
-void add_cells(const std::string& path, MeshBuilder& b, const std::vector<long long>& offsets,
-               const std::vector<long long>& connectivity, const std::vector<long long>& types,
-               const std::vector<long>& lines, long cells_line) {
+void add_cells(const std::string& path, MeshBuilder& b, const std::vector<long long>& offsets, const std::vector<long long>& connectivity,
+               const std::vector<long long>& types, const std::vector<long>& lines, long cells_line) {
   const std::size_t n = types.size();
   const long line = cells_line;
   if (offsets.size() != n + 1)
-    throw InputError(path, line, "offsets", "has " + std::to_string(offsets.size()) +
-                                                " entries for " + std::to_string(n) + " cells");
+    throw InputError(path, line, "offsets", "has " + std::to_string(offsets.size()) + " entries for " + std::to_string(n) + " cells");
   for (std::size_t c = 0; c < n; ++c) {
     const long long begin = offsets[c], end = offsets[c + 1];
     const long cell_line = c < lines.size() ? lines[c] : line;
@@ -53,15 +47,14 @@ void add_cells(const std::string& path, MeshBuilder& b, const std::vector<long l
       throw InputError(path, cell_line, "cell " + std::to_string(c), "offsets out of range");
     if (types[c] == kVtkTetra) {
       if (end - begin != 4)
-        throw InputError(path, cell_line, "cell " + std::to_string(c),
-                         "tetrahedron with " + std::to_string(end - begin) + " points");
-      b.add_tet({connectivity[begin], connectivity[begin + 1], connectivity[begin + 2],
-                 connectivity[begin + 3]},
-                static_cast<long long>(c), cell_line);
+        throw InputError(path, cell_line, "cell " + std::to_string(c), "tetrahedron with " + std::to_string(end - begin) + " points");
+      b.add_tet({connectivity[begin], connectivity[begin + 1], connectivity[begin + 2], connectivity[begin + 3]}, static_cast<long long>(c),
+                cell_line);
     } else if (is_other_volume_cell(types[c])) {
       throw InputError(path, cell_line, "cell " + std::to_string(c) + " type",
-                       std::to_string(types[c]) + " is a volume cell other than the linear "
-                                                  "tetrahedron (10), which is all viscera simulates");
+                       std::to_string(types[c]) +
+                           " is a volume cell other than the linear "
+                           "tetrahedron (10), which is all viscera simulates");
     }
   }
 }
@@ -71,16 +64,14 @@ void add_cells(const std::string& path, MeshBuilder& b, const std::vector<long l
 TetMesh read_legacy_vtk(const std::string& path) {
   TextCursor in = TextCursor::from_file(path);
   const std::string header = in.rest_of_line();
-  if (!header.starts_with("# vtk DataFile Version"))
-    in.fail("header", "not a legacy VTK file (first line '" + printable(header) + "')");
+  if (!header.starts_with("# vtk DataFile Version")) in.fail("header", "not a legacy VTK file (first line '" + printable(header) + "')");
   const bool v5 = header.find("5.") != std::string::npos;
   in.rest_of_line();  // title
   const std::string_view encoding = in.token("encoding");
   if (encoding != "ASCII") in.fail("encoding", "'" + printable(encoding) + "' is not supported (ASCII)");
   if (in.token("DATASET") != "DATASET") in.fail("DATASET", "missing");
   const std::string_view kind = in.token("DATASET");
-  if (kind != "UNSTRUCTURED_GRID")
-    in.fail("DATASET", "'" + printable(kind) + "' is not an UNSTRUCTURED_GRID");
+  if (kind != "UNSTRUCTURED_GRID") in.fail("DATASET", "'" + printable(kind) + "' is not an UNSTRUCTURED_GRID");
 
   MeshBuilder b(path);
   std::vector<long long> offsets, connectivity, types;
@@ -157,23 +148,19 @@ TetMesh read_legacy_vtk(const std::string& path) {
 namespace {
 
 template <typename T>
-std::vector<T> parse_ascii_array(const std::string& path, const pugi::xml_node& array,
-                                 const char* name) {
+std::vector<T> parse_ascii_array(const std::string& path, const pugi::xml_node& array, const char* name) {
   const std::string format = array.attribute("format").as_string("ascii");
   if (format != "ascii")
-    throw InputError(path, 0, std::string("DataArray ") + name,
-                     "format '" + format + "' is not supported (save the VTU as ASCII)");
+    throw InputError(path, 0, std::string("DataArray ") + name, "format '" + format + "' is not supported (save the VTU as ASCII)");
   std::istringstream ss(array.child_value());
   std::vector<T> out;
   std::string tok;
   while (ss >> tok) {
     std::istringstream one(tok);
     T v{};
-    if (!(one >> v) || !one.eof())
-      throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not a number");
+    if (!(one >> v) || !one.eof()) throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not a number");
     if constexpr (std::is_floating_point_v<T>)
-      if (!std::isfinite(v))
-        throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not finite");
+      if (!std::isfinite(v)) throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not finite");
     out.push_back(v);
   }
   return out;
@@ -195,8 +182,7 @@ TetMesh read_vtu(const std::string& path) {
   };
   pugi::xml_document doc;
   const pugi::xml_parse_result ok = doc.load_buffer(text.data(), text.size());
-  if (!ok) throw InputError(path, line_at(ok.offset), "XML", std::string(ok.description()) + " at byte " +
-                                                  std::to_string(ok.offset));
+  if (!ok) throw InputError(path, line_at(ok.offset), "XML", std::string(ok.description()) + " at byte " + std::to_string(ok.offset));
   const pugi::xml_node file = doc.child("VTKFile");
   if (!file || std::string(file.attribute("type").as_string()) != "UnstructuredGrid")
     throw InputError(path, 0, "VTKFile", "not a VTK UnstructuredGrid file");
@@ -209,15 +195,13 @@ TetMesh read_vtu(const std::string& path) {
 
   const auto points = parse_ascii_array<double>(path, piece.child("Points").child("DataArray"), "Points");
   if (static_cast<long long>(points.size()) != 3 * np)
-    throw InputError(path, 0, "Points", std::to_string(points.size()) + " values for " +
-                                             std::to_string(np) + " points (expected 3 per point)");
+    throw InputError(path, 0, "Points", std::to_string(points.size()) + " values for " + std::to_string(np) + " points (expected 3 per point)");
   const pugi::xml_node cells = piece.child("Cells");
   const auto connectivity = parse_ascii_array<long long>(path, find_array(cells, "connectivity"), "connectivity");
   auto offsets = parse_ascii_array<long long>(path, find_array(cells, "offsets"), "offsets");
   const auto types = parse_ascii_array<long long>(path, find_array(cells, "types"), "types");
   if (static_cast<long long>(types.size()) != nc)
-    throw InputError(path, 0, "types", std::to_string(types.size()) + " entries for NumberOfCells " +
-                                            std::to_string(nc));
+    throw InputError(path, 0, "types", std::to_string(types.size()) + " entries for NumberOfCells " + std::to_string(nc));
   offsets.insert(offsets.begin(), 0);  // VTU offsets are cell ends
 
   MeshBuilder b(path);

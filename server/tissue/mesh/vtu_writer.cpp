@@ -21,8 +21,7 @@ std::ofstream open_for_writing(const std::string& path) {
 }
 }  // namespace
 
-void write_vtu(const std::string& path, const TetMesh& mesh, std::span<const Vec3> x,
-               std::span<const Vec3> v) {
+void write_vtu(const std::string& path, const TetMesh& mesh, std::span<const Vec3> x, std::span<const Vec3> v) {
   const std::span<const Vec3> pos = x.empty() ? std::span<const Vec3>(mesh.nodes) : x;
   std::ofstream out = open_for_writing(path);
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
@@ -48,8 +47,7 @@ void write_vtu(const std::string& path, const TetMesh& mesh, std::span<const Vec
     const Mat3 ds = edge_matrix({pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]});
     const Mat3 F = ds * dm.inverse();
     const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-    out << E(0, 0) << ' ' << E(1, 1) << ' ' << E(2, 2) << ' ' << E(0, 1) << ' ' << E(1, 2) << ' '
-        << E(0, 2) << '\n';
+    out << E(0, 0) << ' ' << E(1, 1) << ' ' << E(2, 2) << ' ' << E(0, 1) << ' ' << E(1, 2) << ' ' << E(0, 2) << '\n';
     const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Mat3>(E, Eigen::EigenvaluesOnly).eigenvalues();
     principal[e] = ev.cwiseAbs().maxCoeff();
   }
@@ -71,8 +69,7 @@ void write_vtu(const std::string& path, const TetMesh& mesh, std::span<const Vec
 void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& frames) {
   std::ofstream out = open_for_writing(path);
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (const auto& [t, file] : frames)
-    out << "<DataSet timestep=\"" << t << "\" part=\"0\" file=\"" << file << "\"/>\n";
+  for (const auto& [t, file] : frames) out << "<DataSet timestep=\"" << t << "\" part=\"0\" file=\"" << file << "\"/>\n";
   out << "</Collection>\n</VTKFile>\n";
   if (!out) throw InputError(path, 0, "", "write failed (disk full?)");
 }

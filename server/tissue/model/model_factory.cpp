@@ -13,9 +13,8 @@ const std::vector<std::string>& force_model_names() {
   return names;
 }
 
-std::unique_ptr<ForceModel> make_force_model(const std::string& name, std::shared_ptr<const TetMesh> mesh,
-                                             std::vector<Mat6> materials, double volume_fraction,
-                                             const GpsViscoelasticity& viscoelasticity) {
+std::unique_ptr<ForceModel> make_force_model(const std::string& name, std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
+                                             double volume_fraction, const GpsViscoelasticity& viscoelasticity) {
   if (name == "gps" || name == "gps_energy") {
     const GpsVariant v = name == "gps" ? GpsVariant::paper : GpsVariant::energy_consistent;
     return std::make_unique<GpsModel>(std::move(mesh), std::move(materials), std::vector<std::uint16_t>{},
@@ -23,10 +22,8 @@ std::unique_ptr<ForceModel> make_force_model(const std::string& name, std::share
   }
   if (viscoelasticity.has_memory() || viscoelasticity.qlv_stiffening > 0)
     throw InputError("model", 0, "name", "'" + name + "': viscoelasticity needs a GPS model (gps or gps_energy)");
-  if (name == "corotational")
-    return std::make_unique<FiniteElementModel>(std::move(mesh), FeKind::corotational, std::move(materials));
-  if (name == "linear")
-    return std::make_unique<FiniteElementModel>(std::move(mesh), FeKind::linear, std::move(materials));
+  if (name == "corotational") return std::make_unique<FiniteElementModel>(std::move(mesh), FeKind::corotational, std::move(materials));
+  if (name == "linear") return std::make_unique<FiniteElementModel>(std::move(mesh), FeKind::linear, std::move(materials));
   throw InputError("model", 0, "name", "'" + name + "' is not one of gps, gps_energy, corotational, linear");
 }
 

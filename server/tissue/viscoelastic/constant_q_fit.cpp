@@ -43,8 +43,8 @@ Eigen::VectorXd residuals(const Eigen::VectorXd& p, int L, const std::vector<dou
 
 // Weighted Levenberg-Marquardt on the chosen parameters (free = first `n_free` of p are fixed
 // when optimise is false: only the weights move).
-Eigen::VectorXd levenberg_marquardt(Eigen::VectorXd p, int L, const std::vector<double>& w, double q,
-                                    const Eigen::VectorXd& weights, bool move_frequencies, int iterations) {
+Eigen::VectorXd levenberg_marquardt(Eigen::VectorXd p, int L, const std::vector<double>& w, double q, const Eigen::VectorXd& weights,
+                                    bool move_frequencies, int iterations) {
   const Eigen::Index n = p.size();
   double lambda = 1e-3;
   auto cost = [&](const Eigen::VectorXd& x) { return (weights.array() * residuals(x, L, w, q).array()).matrix().squaredNorm(); };
@@ -95,8 +95,7 @@ ConstantQFit fit_constant_q(const ConstantQTarget& t, const std::string& source)
   };
   if (!(t.q > 0) || !std::isfinite(t.q)) bad("q", t.q, "must be a positive number");
   if (!(t.band_low_hz > 0)) bad("band_low_hz", t.band_low_hz, "must be positive");
-  if (!(t.band_high_hz > t.band_low_hz) || !std::isfinite(t.band_high_hz))
-    bad("band_high_hz", t.band_high_hz, "must be above band_low_hz");
+  if (!(t.band_high_hz > t.band_low_hz) || !std::isfinite(t.band_high_hz)) bad("band_high_hz", t.band_high_hz, "must be above band_low_hz");
   if (t.mechanisms < 1 || t.mechanisms > 8) bad("mechanisms", t.mechanisms, "must be 1 to 8");
   if (!(t.modulus_pa > 0) || !std::isfinite(t.modulus_pa)) bad("modulus_pa", t.modulus_pa, "must be positive");
   if (!(t.reference_frequency_hz > 0)) bad("reference_frequency_hz", t.reference_frequency_hz, "must be positive");
@@ -166,8 +165,8 @@ ConstantQFit fit_constant_q(const ConstantQTarget& t, const std::string& source)
 std::string describe(const ConstantQFit& fit, const ConstantQTarget& t) {
   std::ostringstream s;
   char line[200];
-  std::snprintf(line, sizeof line, "constant Q = %g over %g-%g Hz with %d standard linear solids; |M(%g Hz)| = %g Pa\n",
-                t.q, t.band_low_hz, t.band_high_hz, t.mechanisms, t.reference_frequency_hz, t.modulus_pa);
+  std::snprintf(line, sizeof line, "constant Q = %g over %g-%g Hz with %d standard linear solids; |M(%g Hz)| = %g Pa\n", t.q, t.band_low_hz,
+                t.band_high_hz, t.mechanisms, t.reference_frequency_hz, t.modulus_pa);
   s << line;
   s << "  mechanism  relaxation frequency [Hz]  relaxation time [s]  weight Y\n";
   for (std::size_t l = 0; l < fit.solids.size(); ++l) {
@@ -175,10 +174,9 @@ std::string describe(const ConstantQFit& fit, const ConstantQTarget& t) {
                   1.0 / fit.solids.omega_rad_s[l], fit.solids.weight[l]);
     s << line;
   }
-  std::snprintf(line, sizeof line,
-                "  unrelaxed modulus %.5g Pa, relaxed modulus %.5g Pa; achieved Q over the band %.3f..%.3f (%+.1f%% / %+.1f%%)\n",
-                fit.solids.unrelaxed_modulus_pa, fit.solids.relaxed_modulus(), fit.q_min, fit.q_max,
-                100 * (fit.q_min / t.q - 1), 100 * (fit.q_max / t.q - 1));
+  std::snprintf(line, sizeof line, "  unrelaxed modulus %.5g Pa, relaxed modulus %.5g Pa; achieved Q over the band %.3f..%.3f (%+.1f%% / %+.1f%%)\n",
+                fit.solids.unrelaxed_modulus_pa, fit.solids.relaxed_modulus(), fit.q_min, fit.q_max, 100 * (fit.q_min / t.q - 1),
+                100 * (fit.q_max / t.q - 1));
   s << line;
   return s.str();
 }

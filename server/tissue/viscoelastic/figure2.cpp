@@ -15,8 +15,7 @@ namespace viscera::tissue {
 
 namespace {
 
-std::vector<double> simulate_gps_block(const Figure2Options& o, const std::function<double(double)>& traction,
-                                       std::size_t samples, double* dt_out) {
+std::vector<double> simulate_gps_block(const Figure2Options& o, const std::function<double(double)>& traction, std::size_t samples, double* dt_out) {
   ShearBlock block = make_shear_block(o, traction);
   ExplicitIntegrator integrator(*block.model, block.density, block.bc);
   *dt_out = integrator.dt_s();
@@ -88,12 +87,12 @@ Figure2 compute_figure2(const Figure2Options& o) {
   const ShearLayer layer{o.thickness_m, o.density_kg_m3};
   const ConstantQ cq{o.q, o.modulus_pa, o.reference_frequency_hz};
   const double w0 = 2 * M_PI * o.reference_frequency_hz, g = cq.gamma();
-  r.exact_cq_m = exact_top_displacement(layer, [&](std::complex<double> s) { return o.modulus_pa * std::pow(s / w0, 2 * g); },
-                                        traction, dt, samples);
+  r.exact_cq_m = exact_top_displacement(
+      layer, [&](std::complex<double> s) { return o.modulus_pa * std::pow(s / w0, 2 * g); }, traction, dt, samples);
   // Kelvin-Voigt matched at the reference frequency: Q(w0) = 1 / (w0 tau), |M(w0)| = |G|.
   const double tau = 1.0 / (o.q * w0), G_kv = o.modulus_pa / std::sqrt(1.0 + 1.0 / (o.q * o.q));
-  r.kelvin_voigt_m = exact_top_displacement(layer, [&](std::complex<double> s) { return G_kv * (1.0 + tau * s); },
-                                            traction, dt, samples);
+  r.kelvin_voigt_m = exact_top_displacement(
+      layer, [&](std::complex<double> s) { return G_kv * (1.0 + tau * s); }, traction, dt, samples);
   r.fit = fit_constant_q({o.q, o.band_low_hz, o.band_high_hz, o.mechanisms, o.modulus_pa, o.reference_frequency_hz});
   const ColumnResult column = simulate_memory_column(layer, r.fit.solids, traction, dt, samples, o.column_elements);
   r.memory_variables_m = column.top_displacement_m;

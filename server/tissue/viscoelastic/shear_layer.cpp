@@ -6,8 +6,7 @@
 
 namespace viscera::tissue {
 
-std::vector<double> exact_top_displacement(const ShearLayer& layer,
-                                           const std::function<std::complex<double>(std::complex<double>)>& modulus,
+std::vector<double> exact_top_displacement(const ShearLayer& layer, const std::function<std::complex<double>(std::complex<double>)>& modulus,
                                            const std::function<double(double)>& traction, double dt, std::size_t samples) {
   // Period long against the output window, fine sampling; exponential window exp(-alpha t).
   std::size_t n = 1;
@@ -39,9 +38,8 @@ std::vector<double> exact_top_displacement(const ShearLayer& layer,
   return out;
 }
 
-ColumnResult simulate_memory_column(const ShearLayer& layer, const StandardLinearSolids& solids,
-                                    const std::function<double(double)>& traction, double output_dt,
-                                    std::size_t samples, int elements) {
+ColumnResult simulate_memory_column(const ShearLayer& layer, const StandardLinearSolids& solids, const std::function<double(double)>& traction,
+                                    double output_dt, std::size_t samples, int elements) {
   const std::size_t ne = static_cast<std::size_t>(elements), L = solids.size();
   const double h = layer.thickness_m / elements, rho = layer.density_kg_m3, MU = solids.unrelaxed_modulus_pa;
   // Stable step of a 2-node element with lumped mass: dt <= h / c_U (c_U from the unrelaxed

@@ -8,8 +8,7 @@ namespace viscera::tissue {
 
 std::complex<double> StandardLinearSolids::complex_modulus(double w) const {
   std::complex<double> m = 1.0;
-  for (std::size_t l = 0; l < size(); ++l)
-    m -= weight[l] * omega_rad_s[l] / std::complex<double>(omega_rad_s[l], w);
+  for (std::size_t l = 0; l < size(); ++l) m -= weight[l] * omega_rad_s[l] / std::complex<double>(omega_rad_s[l], w);
   return unrelaxed_modulus_pa * m;
 }
 

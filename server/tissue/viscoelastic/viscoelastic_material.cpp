@@ -47,8 +47,8 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
     out.gps.kelvin_voigt_time_s = 1.0 / (spec.shear_q * w_ref);
     out.unrelaxed_elasticity = D / std::sqrt(1.0 + 1.0 / (spec.shear_q * spec.shear_q));
     std::ostringstream s;
-    s << "Kelvin-Voigt: relaxation time " << out.gps.kelvin_voigt_time_s << " s (Q = " << spec.shear_q
-      << " at " << spec.reference_frequency_hz << " Hz only; Q(f) = Q f_ref / f)\n";
+    s << "Kelvin-Voigt: relaxation time " << out.gps.kelvin_voigt_time_s << " s (Q = " << spec.shear_q << " at " << spec.reference_frequency_hz
+      << " Hz only; Q(f) = Q f_ref / f)\n";
     out.table = s.str();
     return out;
   }

@@ -121,4 +121,4 @@ class Client {
   std::map<std::uint32_t, std::int64_t> tick_end_ns_;  // per instrument: the newest tick force's stamp
 };
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

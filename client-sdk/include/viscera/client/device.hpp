@@ -13,10 +13,10 @@ namespace viscera::client {
 
 /// One reading of a device, in the scene frame.
 struct DeviceSample {
-  protocol::Vector3 tip_m{};   ///< tool tip position [m]
-  double jaw_rad = 0.5;        ///< jaw opening [rad] (graspers; 0 = closed)
+  protocol::Vector3 tip_m{};  ///< tool tip position [m]
+  double jaw_rad = 0.5;  ///< jaw opening [rad] (graspers; 0 = closed)
   std::uint32_t buttons = 0;
-  bool finished = false;       ///< a virtual device that ran out of trajectory
+  bool finished = false;  ///< a virtual device that ran out of trajectory
 };
 
 class Device {
@@ -30,4 +30,4 @@ class Device {
   virtual void render(const protocol::Vector3& force_n, bool in_contact) = 0;
 };
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

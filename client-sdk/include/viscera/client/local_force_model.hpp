@@ -15,8 +15,7 @@ struct RenderedForce {
 };
 
 /// x0: the tip position of the command the force answers; x: the tip position now.
-RenderedForce render_local_model(const protocol::Force& f, const protocol::Vector3& x0, const protocol::Vector3& x,
-                                 double max_force_n);
+RenderedForce render_local_model(const protocol::Force& f, const protocol::Vector3& x0, const protocol::Vector3& x, double max_force_n);
 
 /// How the rendered force goes when the server stops answering: it fades linearly to zero over
 /// `fade_s`, starting when the newest model is `stale_after_s` old or when the application says
@@ -25,7 +24,7 @@ RenderedForce render_local_model(const protocol::Force& f, const protocol::Vecto
 /// A model that arrives later fades the force back in at the same rate.
 struct FadePolicy {
   double stale_after_s = 0.25;  ///< the newest model this old means the server is not answering
-  double fade_s = 0.25;         ///< from full force to none [s]
+  double fade_s = 0.25;  ///< from full force to none [s]
 };
 
 /// Renders at the device rate from the newest local model. When a new model arrives the force
@@ -62,4 +61,4 @@ class LocalForceRenderer {
   double resume_s_ = 0, resume_gain_ = 1;  // a model after a fade: when it came, and the gain then
 };
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

@@ -24,8 +24,7 @@ class TickPhase {
   /// `period`: the loop's period, equal to the server's tick; `offset`: where in the period to run,
   /// after the end of a tick; `max_step`: the largest correction per period (keeps the device rate
   /// within a few percent while the phase moves).
-  TickPhase(std::chrono::nanoseconds period, std::chrono::nanoseconds offset,
-            std::chrono::nanoseconds max_step = std::chrono::microseconds(20));
+  TickPhase(std::chrono::nanoseconds period, std::chrono::nanoseconds offset, std::chrono::nanoseconds max_step = std::chrono::microseconds(20));
 
   /// The signed distance of `next_ns` from the nearest target time (a tick's end plus the offset,
   /// plus whole periods), in [-period/2, period/2). Both on the same clock [ns].
@@ -37,4 +36,4 @@ class TickPhase {
   std::int64_t period_ns_, offset_ns_, max_step_ns_;
 };
 
-}  // namespace viscera::commonent
+}  // namespace viscera::client

@@ -20,13 +20,13 @@ class DdsError : public std::runtime_error {
 /// The streams of the protocol; each is one topic of Envelope with its own QoS.
 enum class Stream {
   instrument_command,  ///< best effort, keep last 1 per key, volatile
-  force_feedback,      ///< best effort, keep last 1 per key, volatile
-  session_request,     ///< reliable, keep last 16, volatile
-  scene_state,         ///< reliable, keep last 1, transient local (late joiners get it)
-  telemetry,           ///< best effort, keep last 1, volatile
-  surface_topology,    ///< reliable, keep last 1 per key, transient local (late joiners get it)
-  mesh_frame,          ///< reliable, keep last 1 per key, volatile (slow readers skip frames)
-  event,               ///< reliable, keep last 64, volatile (server events and client annotations)
+  force_feedback,  ///< best effort, keep last 1 per key, volatile
+  session_request,  ///< reliable, keep last 16, volatile
+  scene_state,  ///< reliable, keep last 1, transient local (late joiners get it)
+  telemetry,  ///< best effort, keep last 1, volatile
+  surface_topology,  ///< reliable, keep last 1 per key, transient local (late joiners get it)
+  mesh_frame,  ///< reliable, keep last 1 per key, volatile (slow readers skip frames)
+  event,  ///< reliable, keep last 64, volatile (server events and client annotations)
 };
 constexpr int kStreamCount = 8;
 

@@ -31,12 +31,18 @@ struct Force {
   bool in_contact = false;
   Vector3 contact_point{}, contact_normal{};
   std::array<double, 9> stiffness{};  ///< row-major [N/m]
-  double penetration_m = 0;           ///< [m] tip depth in the tissue (added in schema 2)
+  double penetration_m = 0;  ///< [m] tip depth in the tissue (added in schema 2)
 };
 
 enum class Action : std::int8_t {
-  claim_instrument = 0, release_instrument = 1, pause = 2, resume = 3, reset = 4,
-  load_scene = 5, set_material = 6, set_physics_rate = 7  // schema 3
+  claim_instrument = 0,
+  release_instrument = 1,
+  pause = 2,
+  resume = 3,
+  reset = 4,
+  load_scene = 5,
+  set_material = 6,
+  set_physics_rate = 7  // schema 3
 };
 const char* action_name(Action a);
 
@@ -52,9 +58,9 @@ struct SessionRequest {
   std::uint32_t instrument_id = 0;
   // schema 3:
   std::uint64_t request_seq = 0;
-  std::string scene_name;     ///< load_scene: [A-Za-z0-9._-], at most 64, not starting with '.'
-  MaterialChange material;    ///< set_material: at least one parameter
-  double physics_rate_hz = 0; ///< set_physics_rate: [10, 10000]
+  std::string scene_name;  ///< load_scene: [A-Za-z0-9._-], at most 64, not starting with '.'
+  MaterialChange material;  ///< set_material: at least one parameter
+  double physics_rate_hz = 0;  ///< set_physics_rate: [10, 10000]
 };
 
 struct InstrumentInfo {
@@ -69,7 +75,7 @@ struct MaterialInfo {
   double youngs_modulus_pa = 0;  ///< 0: not isotropic
   double poisson_ratio = 0;
   double density_kg_m3 = 0;
-  double shear_q = 0;            ///< 0: elastic
+  double shear_q = 0;  ///< 0: elastic
   double damping_per_s = 0;
   double added_mass_fraction = 0;  ///< mass scaling of the smallest elements / organ mass (schema 4)
 };
@@ -95,7 +101,7 @@ struct Scene {
   std::vector<std::string> available_scenes;
   std::string preparing;  ///< scene or material being built in the background
   std::vector<RequestOutcome> recent_requests;  ///< the last few, oldest first
-  std::vector<std::string> unreadable_scenes;   ///< schema 6: "name: error" for scene files that do not read
+  std::vector<std::string> unreadable_scenes;  ///< schema 6: "name: error" for scene files that do not read
 };
 
 struct TelemetryReport {
@@ -115,7 +121,7 @@ struct SurfaceTopology {
   std::string organ_name;
   std::uint32_t vertex_count = 0;
   std::vector<std::uint32_t> triangles;  ///< 3 vertex indices per triangle
-  std::vector<float> rest_positions;     ///< [m] 3 per vertex
+  std::vector<float> rest_positions;  ///< [m] 3 per vertex
 };
 
 /// The deformed surface at one instant.
@@ -128,9 +134,21 @@ struct MeshFrame {
 };
 
 enum class EventKind : std::int8_t {
-  annotation = 0, instrument_claimed, instrument_released, paused, resumed, organ_reset, physics_reset,
-  contact_started, contact_ended, grasped, let_go,
-  scene_loaded, material_changed, physics_rate_changed, request_refused  // schema 3
+  annotation = 0,
+  instrument_claimed,
+  instrument_released,
+  paused,
+  resumed,
+  organ_reset,
+  physics_reset,
+  contact_started,
+  contact_ended,
+  grasped,
+  let_go,
+  scene_loaded,
+  material_changed,
+  physics_rate_changed,
+  request_refused  // schema 3
 };
 /// The kind's name; "unknown" for kinds added by a newer server (decoders pass them through).
 const char* event_name(EventKind k);

@@ -19,8 +19,7 @@ class CommandLine {
   CommandLine(std::string program, std::string summary);
 
   /// Declares --name VALUE (default shown in help) or, with is_switch, a boolean --name.
-  void flag(const std::string& name, const std::string& value_name, const std::string& help,
-            std::optional<std::string> default_value = std::nullopt);
+  void flag(const std::string& name, const std::string& value_name, const std::string& help, std::optional<std::string> default_value = std::nullopt);
   void option_switch(const std::string& name, const std::string& help);
 
   /// The usage line of --help (default "PROGRAM [options]"), e.g. "viscera-lab analyze DIR --out DIR".

@@ -13,7 +13,7 @@ namespace viscera::lab {
 
 struct TestFigures {
   std::string file;
-  double fit_rms_pa = 0.0;      ///< model fitted to all tests
+  double fit_rms_pa = 0.0;  ///< model fitted to all tests
   double heldout_rms_pa = 0.0;  ///< model fitted to the other tests (leave one test out)
   double noise_pa = 0.0;
 };
@@ -26,10 +26,10 @@ struct ModelEvaluation {
 
 struct Candidate {
   Mechanism mechanism;
-  int round = 0;                 ///< 1: tried on the baseline; 2..: on the extended model
+  int round = 0;  ///< 1: tried on the baseline; 2..: on the extended model
   double heldout_before_pa = 0.0, heldout_after_pa = 0.0;
   bool accepted = false;
-  std::string evidence;          ///< the residual signature that points at it
+  std::string evidence;  ///< the residual signature that points at it
 };
 
 /// A model run on the tetrahedral specimen (viscera's GPS, implicit, inertia) next to its
@@ -55,8 +55,8 @@ struct Analysis {
   ModelEvaluation baseline, final;
   std::vector<Candidate> candidates;
   std::vector<Mechanism> causes;  ///< accepted, strongest first
-  double gain = 1.0;              ///< baseline held-out RMS / final held-out RMS
-  std::string verdict;            ///< one paragraph: what is wrong, why, what still does not fit
+  double gain = 1.0;  ///< baseline held-out RMS / final held-out RMS
+  std::string verdict;  ///< one paragraph: what is wrong, why, what still does not fit
   std::vector<std::string> decimated;  ///< "file: N rows, fitted on M" for the tests decimated for the fit
   std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen
 };
@@ -69,7 +69,6 @@ ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d);
 
 /// The whole analysis; `progress` receives one line per stage, with an estimate of the time the
 /// rest will take once the baseline's fits have been timed.
-Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {},
-                 const AnalyzeOptions& options = {});
+Analysis analyze(const Dataset& d, const std::function<void(const std::string&)>& progress = {}, const AnalyzeOptions& options = {});
 
 }  // namespace viscera::lab

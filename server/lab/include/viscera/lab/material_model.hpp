@@ -35,7 +35,7 @@ struct MaterialModel {
   double softening_d = 0.0;
   double modulus_pa = 0.0;
   double viscosity_pa_s = 0.0;
-  std::vector<double> relaxation_time_s;      ///< broadband only
+  std::vector<double> relaxation_time_s;  ///< broadband only
   std::vector<double> relaxation_modulus_pa;  ///< broadband only
 
   bool has(Mechanism m) const { return mechanisms & (1u << static_cast<unsigned>(m)); }

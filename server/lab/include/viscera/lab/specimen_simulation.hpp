@@ -26,16 +26,16 @@ struct ShapeCalibration {
   double law_r = 1, gps_r = 1;  ///< compression ratio (1: symmetric)
   double strain_lo = 0, strain_hi = 0;
   double uncalibrated_mismatch = 0;  ///< relative RMS of the specimen's curve against the law's with the law's constants
-  double mismatch = 0;               ///< the same with the calibrated constants
+  double mismatch = 0;  ///< the same with the calibrated constants
 };
 ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& d);
 
 struct SpecimenResult {
   bool supported = false;
-  std::string note;                 ///< why not, or what is approximated
-  std::vector<double> stress_pa;    ///< at the data times (strain control: predicted; stress control: imposed)
-  std::vector<double> strain;       ///< at the data times (stress control: predicted)
-  double rms_pa = 0.0;              ///< strain control: RMS stress error; stress control: RMS strain error x modulus
+  std::string note;  ///< why not, or what is approximated
+  std::vector<double> stress_pa;  ///< at the data times (strain control: predicted; stress control: imposed)
+  std::vector<double> strain;  ///< at the data times (stress control: predicted)
+  double rms_pa = 0.0;  ///< strain control: RMS stress error; stress control: RMS strain error x modulus
   long steps = 0, newton_iterations = 0, step_cuts = 0;
   ShapeCalibration shape;  ///< when the model stiffens or is asymmetric
 };
@@ -47,7 +47,6 @@ struct SpecimenResult {
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why);
 
 /// `calibration`: calibrate_elastic_shape(m, d), if already known (it is computed otherwise).
-SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t,
-                                 const ShapeCalibration* calibration = nullptr);
+SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration = nullptr);
 
 }  // namespace viscera::lab

@@ -41,8 +41,8 @@ class CommandResponder {
  public:
   /// The instruments of a new organ: one contact query each (it keeps scratch space), on the
   /// organ's surface and rest positions.
-  void set_instruments(const std::vector<InstrumentSpec>& instruments, const std::vector<tissue::Triangle>& surface,
-                       std::span<const Vec3> rest, double contact_stiffness_n_per_m);
+  void set_instruments(const std::vector<InstrumentSpec>& instruments, const std::vector<tissue::Triangle>& surface, std::span<const Vec3> rest,
+                       double contact_stiffness_n_per_m);
   /// Physics thread, after each tick.
   void publish(std::shared_ptr<const Snapshot> snapshot);
   std::shared_ptr<const Snapshot> latest() const;

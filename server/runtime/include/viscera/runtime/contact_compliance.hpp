@@ -47,7 +47,7 @@ class ContactCompliance {
 
   std::vector<Eigen::Matrix3d> blocks_;
   std::unique_ptr<std::atomic<std::uint8_t>[]> state_;  // per node: 0 unknown, 1 requested, 2 known
-  std::atomic<int> factorised_{0};                       // 0 pending, 1 done, -1 failed
+  std::atomic<int> factorised_{0};  // 0 pending, 1 done, -1 failed
   std::mutex mutex_;
   std::condition_variable cv_, done_cv_;
   std::deque<std::int32_t> requests_;

@@ -22,14 +22,14 @@ class GraspHold {
   GraspHold() = default;
   /// Grasps the nodes among `candidates` whose positions x lie within `radius_m` of the tip, for a
   /// tool at `tip` with orientation `tool` (tool frame to world).
-  GraspHold(const Vec3& tip, const Eigen::Quaterniond& tool, std::span<const std::int32_t> candidates, std::span<const Vec3> x,
-            double radius_m, double stiffness_n_per_m);
+  GraspHold(const Vec3& tip, const Eigen::Quaterniond& tool, std::span<const std::int32_t> candidates, std::span<const Vec3> x, double radius_m,
+            double stiffness_n_per_m);
 
   bool empty() const { return held_.empty(); }
   std::size_t size() const { return held_.size(); }
 
   struct Reaction {
-    Vec3 force_on_tool = Vec3::Zero();   ///< [N]
+    Vec3 force_on_tool = Vec3::Zero();  ///< [N]
     Vec3 torque_on_tool = Vec3::Zero();  ///< about the tip [N m]
   };
   /// The springs' forces on the organ during one explicit step (the integrator's force field,

@@ -13,17 +13,16 @@
 #include <thread>
 #include <vector>
 
-#include "viscera/tissue/mesh/tet_mesh.hpp"
 #include "viscera/protocol/messages.hpp"
 #include "viscera/runtime/server_endpoints.hpp"
+#include "viscera/tissue/mesh/tet_mesh.hpp"
 
 namespace viscera::runtime {
 
 class MeshPublisher {
  public:
   /// `surface_nodes[k]` is the mesh node of surface vertex k; `triangles` index surface vertices.
-  MeshPublisher(std::unique_ptr<MeshStream> stream, protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
-                double rate_hz);
+  MeshPublisher(std::unique_ptr<MeshStream> stream, protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes, double rate_hz);
   ~MeshPublisher();
   MeshPublisher(const MeshPublisher&) = delete;
   MeshPublisher& operator=(const MeshPublisher&) = delete;

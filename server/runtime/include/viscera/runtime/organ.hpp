@@ -5,14 +5,14 @@
 // off the physics thread and swaps the result in between ticks.
 #include <memory>
 
+#include "viscera/protocol/messages.hpp"
 #include "viscera/runtime/contact_compliance.hpp"
 #include "viscera/runtime/parallel_forces.hpp"
+#include "viscera/runtime/scene_file.hpp"
+#include "viscera/runtime/tick_budget.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
-#include "viscera/runtime/scene_file.hpp"
-#include "viscera/runtime/tick_budget.hpp"
-#include "viscera/protocol/messages.hpp"
 
 namespace viscera::runtime {
 

@@ -42,8 +42,8 @@ class ParallelForces {
   // next_: generation in the high 32 bits, next chunk in the low 32; taken by compare-exchange so
   // a helper still in an old evaluation never takes a chunk of a new one.
   std::atomic<std::uint64_t> next_{0};
-  std::atomic<std::uint64_t> go_{0};        // generation to work on; helpers wait on it
-  std::atomic<std::size_t> finished_{0};    // chunks 1.. finished in this generation
+  std::atomic<std::uint64_t> go_{0};  // generation to work on; helpers wait on it
+  std::atomic<std::size_t> finished_{0};  // chunks 1.. finished in this generation
   std::atomic<bool> stop_{false};
   std::uint64_t generation_ = 0;
   std::vector<std::thread> helpers_;

@@ -38,7 +38,7 @@ struct ContactResult {
   int triangles_in_contact = 0;
   double depth_m = 0;  ///< deepest penetration of the tip sphere [m]
   std::array<std::int32_t, 3> deepest_triangle{-1, -1, -1};  ///< nodes of the deepest contact
-  Vec3 deepest_weights = Vec3::Zero();                        ///< its barycentric weights
+  Vec3 deepest_weights = Vec3::Zero();  ///< its barycentric weights
 };
 
 class ProbeContact {

@@ -15,7 +15,7 @@ struct ServerStats {
   /// rejected, by reason: failed verification; from a client that does not own the instrument;
   /// naming an instrument the scene does not have
   std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0;
-  std::uint64_t late_ticks = 0;    ///< ticks that ended after their 1/rate slot (the next one starts at once)
+  std::uint64_t late_ticks = 0;  ///< ticks that ended after their 1/rate slot (the next one starts at once)
   std::uint64_t missed_slots = 0;  ///< slots of the fixed-rate grid that passed with no tick
   std::uint64_t physics_resets = 0;  ///< organ reset to rest after an integration failure
   std::uint64_t mesh_frames = 0, mesh_frames_skipped = 0;  ///< surface frames published; due but replaced

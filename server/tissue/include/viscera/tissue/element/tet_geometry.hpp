@@ -22,11 +22,9 @@ using Vec12 = Eigen::Matrix<double, 12, 1>;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
 using Mat6x12 = Eigen::Matrix<double, 6, 12>;
 
-inline constexpr std::array<std::array<int, 2>, 6> kTetEdges{
-    {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+inline constexpr std::array<std::array<int, 2>, 6> kTetEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
 
-inline double signed_volume(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
-                            const Eigen::Vector3d& x2, const Eigen::Vector3d& x3) {
+inline double signed_volume(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Eigen::Vector3d& x2, const Eigen::Vector3d& x3) {
   return (x1 - x0).cross(x2 - x0).dot(x3 - x0) / 6.0;
 }
 

@@ -16,8 +16,7 @@ enum class FeKind { linear, corotational };
 class FiniteElementModel final : public ForceModel {
  public:
   /// One elasticity matrix per material; material_of_tet (empty = all material 0).
-  FiniteElementModel(std::shared_ptr<const TetMesh> mesh, FeKind kind, std::vector<Mat6> materials,
-                     std::vector<std::uint16_t> material_of_tet = {});
+  FiniteElementModel(std::shared_ptr<const TetMesh> mesh, FeKind kind, std::vector<Mat6> materials, std::vector<std::uint16_t> material_of_tet = {});
 
   std::string_view name() const override;
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const override;
@@ -34,9 +33,7 @@ class FiniteElementModel final : public ForceModel {
     double volume;
   };
   Mat3 deformation_gradient(std::span<const Vec3> x, std::size_t e) const;
-  const Mat6& material(std::size_t e) const {
-    return materials_[material_of_tet_.empty() ? 0 : material_of_tet_[e]];
-  }
+  const Mat6& material(std::size_t e) const { return materials_[material_of_tet_.empty() ? 0 : material_of_tet_[e]]; }
 
   FeKind kind_;
   std::vector<Mat6> materials_;

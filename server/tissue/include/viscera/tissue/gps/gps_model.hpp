@@ -25,9 +25,9 @@ enum class GpsVariant { paper, energy_consistent };
 /// the tension becomes t = S [H_dev (dL - sum Y^s_l zeta_l) + H_vol (dL - sum Y^b_l zeta_l)].
 /// Shear and bulk share the relaxation frequencies and have their own weights (their own Q).
 struct GpsViscoelasticity {
-  std::vector<double> omega_rad_s;   ///< relaxation frequencies w_l
+  std::vector<double> omega_rad_s;  ///< relaxation frequencies w_l
   std::vector<double> shear_weight;  ///< Y^s_l
-  std::vector<double> bulk_weight;   ///< Y^b_l (same size; zeros: no bulk relaxation)
+  std::vector<double> bulk_weight;  ///< Y^b_l (same size; zeros: no bulk relaxation)
   /// Kelvin-Voigt baseline: t += S H tau d(dL)/dt (one relaxation time; 0 = off).
   double kelvin_voigt_time_s = 0.0;
   /// Fung's quasi-linear viscoelasticity: each edge strain e = dL/L0 is replaced by
@@ -63,8 +63,8 @@ struct GpsOptions {
 
 class GpsModel final : public ForceModel {
  public:
-  GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
-           std::vector<std::uint16_t> material_of_tet = {}, GpsOptions options = {});
+  GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials, std::vector<std::uint16_t> material_of_tet = {},
+           GpsOptions options = {});
 
   std::string_view name() const override;
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f) const override;

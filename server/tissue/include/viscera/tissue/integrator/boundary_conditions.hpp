@@ -35,9 +35,9 @@ struct PrescribedAxisMotion {
 
 struct BoundaryConditions {
   Vec3 gravity_m_s2 = Vec3::Zero();
-  std::vector<std::int32_t> fixed_nodes;        ///< held at their rest positions
-  std::vector<AxisConstraint> fixed_axes;       ///< single coordinates held at rest
-  std::vector<PrescribedMotion> prescribed;     ///< moved as prescribed
+  std::vector<std::int32_t> fixed_nodes;  ///< held at their rest positions
+  std::vector<AxisConstraint> fixed_axes;  ///< single coordinates held at rest
+  std::vector<PrescribedMotion> prescribed;  ///< moved as prescribed
   std::vector<PrescribedAxisMotion> prescribed_axes;  ///< one coordinate moved as prescribed
   /// External forces [N] per node (empty = none), scaled by force_amplitude(t) if given.
   std::vector<Vec3> nodal_forces;
@@ -58,11 +58,11 @@ struct BoundaryConditions {
   /// stable while it stays, but when contact switches on and off at the step's time scale the
   /// changing mass pumps energy into the surface (seen on the 12k liver with mass scaling).
   struct FieldEvaluation {
-    std::span<const Vec3> x, v;   ///< positions [m], velocities [m/s]
-    std::span<Vec3> f;            ///< forces to add to [N]
+    std::span<const Vec3> x, v;  ///< positions [m], velocities [m/s]
+    std::span<Vec3> f;  ///< forces to add to [N]
     std::span<double> stiffness;  ///< per node [N/m]
-    std::span<double> damping;    ///< per node [N s/m]
-    double dt_s = 0.0;            ///< the step these forces will be integrated over [s]
+    std::span<double> damping;  ///< per node [N s/m]
+    double dt_s = 0.0;  ///< the step these forces will be integrated over [s]
   };
   std::function<void(const FieldEvaluation&)> force_field;
 

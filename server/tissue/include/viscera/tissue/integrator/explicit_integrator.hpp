@@ -17,9 +17,9 @@ struct ExplicitOptions {
   /// dt = safety x critical step (0 < s <= 1); with a stiff force field, s <= sqrt(3)/2 keeps the
   /// bound (BoundaryConditions::force_field)
   double safety_factor = 0.9;
-  double dt_s = 0.0;                  ///< if > 0, used instead (for studies; may be unstable)
-  double mass_damping_per_s = 0.0;    ///< alpha >= 0 [1/s]
-  double max_edge_strain = 2.0;       ///< |dL|/L0 above this means the run went unstable
+  double dt_s = 0.0;  ///< if > 0, used instead (for studies; may be unstable)
+  double mass_damping_per_s = 0.0;  ///< alpha >= 0 [1/s]
+  double max_edge_strain = 2.0;  ///< |dL|/L0 above this means the run went unstable
   /// Critical step from the global estimate (global_time_step) instead of the element bound.
   bool global_stable_step = false;
   /// Selective mass scaling (mass_scaling.hpp): this fraction of the organ's mass is added to the
@@ -29,8 +29,7 @@ struct ExplicitOptions {
 
 class ExplicitIntegrator {
  public:
-  ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
-                     BoundaryConditions bc, ExplicitOptions options = {});
+  ExplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc, ExplicitOptions options = {});
 
   double dt_s() const { return dt_; }
   const StableStep& critical_step() const { return critical_; }
@@ -67,8 +66,8 @@ class ExplicitIntegrator {
   BoundaryConditions bc_;
   ExplicitOptions options_;
   std::vector<double> mass_;
-  std::vector<Vec3> inv_mass_;     // per coordinate; 0 where constrained
-  std::vector<Vec3> gravity_;      // m g per node
+  std::vector<Vec3> inv_mass_;  // per coordinate; 0 where constrained
+  std::vector<Vec3> gravity_;  // m g per node
   ForceEvaluation evaluate_;
   std::function<bool()> interrupted_;
   MassScaling scaling_;

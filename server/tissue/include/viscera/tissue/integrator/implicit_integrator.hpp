@@ -19,15 +19,15 @@ namespace viscera::tissue {
 struct ImplicitOptions {
   double dt_s = 1e-2;
   double mass_damping_per_s = 0.0;
-  double relative_tolerance = 1e-8;   ///< |r| <= tol x force scale (see NewtonReport)
+  double relative_tolerance = 1e-8;  ///< |r| <= tol x force scale (see NewtonReport)
   int max_iterations = 50;
 };
 
 struct NewtonReport {
   int iterations = 0;
-  double initial_residual_n = 0.0;   ///< |r| before the first iteration [N]
-  double residual_n = 0.0;           ///< |r| at the end [N]
-  double force_scale_n = 0.0;        ///< max(|r0|, |f_ext|, |f_int|, k_max |u|_max) [N]: the tolerance is relative to it
+  double initial_residual_n = 0.0;  ///< |r| before the first iteration [N]
+  double residual_n = 0.0;  ///< |r| at the end [N]
+  double force_scale_n = 0.0;  ///< max(|r0|, |f_ext|, |f_int|, k_max |u|_max) [N]: the tolerance is relative to it
   int regularised_factorisations = 0;  ///< tangents that were not positive definite
   bool converged = false;
   bool roundoff_limited = false;  ///< stopped at the floating-point floor above the tolerance
@@ -35,8 +35,7 @@ struct NewtonReport {
 
 class ImplicitIntegrator {
  public:
-  ImplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3,
-                     BoundaryConditions bc, ImplicitOptions options = {});
+  ImplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc, ImplicitOptions options = {});
   ~ImplicitIntegrator();
 
   /// One backward Euler step of options.dt_s. Throws SimulationError if Newton fails to converge.
@@ -61,8 +60,7 @@ class ImplicitIntegrator {
 
  private:
   NewtonReport newton(State& state, bool dynamic, const std::vector<Vec3>& x_n, const std::vector<Vec3>& v_n);
-  double residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n,
-                  const std::vector<Vec3>& v_n, std::vector<double>& r);
+  double residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n, const std::vector<Vec3>& v_n, std::vector<double>& r);
   void assemble(const std::vector<Vec3>& x, double mass_scale, double regularisation);
   void apply_constraints(State& state, double t);
   void update_external(double t);
@@ -72,7 +70,7 @@ class ImplicitIntegrator {
   ImplicitOptions options_;
   std::vector<double> mass_;
   std::vector<Vec3> external_;
-  std::vector<int> dof_;          // dof of each coordinate (3 per node), -1 if constrained
+  std::vector<int> dof_;  // dof of each coordinate (3 per node), -1 if constrained
   int free_dofs_ = 0;
   std::unique_ptr<SparseCholesky> solver_;
   std::vector<long> element_slots_;  // 144 per element: slot of (i, j) or -1
@@ -81,7 +79,8 @@ class ImplicitIntegrator {
   const std::vector<double>* memory_before_ = nullptr;  // during a dynamic step
   std::vector<double> memory_trial_, memory_accepted_;
   double internal_norm_ = 0.0;
-  double stiffness_scale_ = 0.0;  // largest diagonal entry of the element tangents at rest [N/m]  // |f_int| over free dofs at the last residual evaluation
+  double stiffness_scale_ =
+      0.0;  // largest diagonal entry of the element tangents at rest [N/m]  // |f_int| over free dofs at the last residual evaluation
 };
 
 }  // namespace viscera::tissue

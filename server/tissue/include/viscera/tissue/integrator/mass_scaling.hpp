@@ -14,8 +14,8 @@ namespace viscera::tissue {
 
 struct MassScaling {
   std::vector<double> density_kg_m3;  ///< per element, >= the given density
-  double added_mass_fraction = 0;     ///< added mass / the organ's mass
-  std::size_t scaled_elements = 0;    ///< elements that got heavier
+  double added_mass_fraction = 0;  ///< added mass / the organ's mass
+  std::size_t scaled_elements = 0;  ///< elements that got heavier
   /// Every element's own critical step (2 / element_frequencies) is now at least this [s].
   double min_element_step_s = 0;
 };
@@ -26,7 +26,6 @@ struct MassScaling {
 /// fraction. Element steps are the eigenvalue bounds of critical_time_step; the global step they
 /// allow is found as usual (critical_time_step or global_time_step on the new densities).
 /// Deterministic. Throws std::invalid_argument for a fraction outside [0, 10].
-MassScaling scale_small_element_masses(const ForceModel& model, std::span<const double> density_kg_m3,
-                                       double added_mass_fraction);
+MassScaling scale_small_element_masses(const ForceModel& model, std::span<const double> density_kg_m3, double added_mass_fraction);
 
 }  // namespace viscera::tissue

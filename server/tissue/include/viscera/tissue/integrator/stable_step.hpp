@@ -7,9 +7,9 @@
 namespace viscera::tissue {
 
 struct StableStep {
-  double dt_s;              ///< critical step 2 / omega_max of symplectic Euler [s]
-  double omega_max_rad_s;   ///< bound on the highest natural frequency
-  std::size_t element;      ///< the element that sets it
+  double dt_s;  ///< critical step 2 / omega_max of symplectic Euler [s]
+  double omega_max_rad_s;  ///< bound on the highest natural frequency
+  std::size_t element;  ///< the element that sets it
 };
 
 /// Critical explicit time step from the mesh and the material, by the element eigenvalue bound
@@ -28,7 +28,7 @@ std::vector<double> element_frequencies(const ForceModel& model, std::span<const
 /// below, so the estimate is inflated by `margin` (omega^2 x margin). Deterministic (fixed start
 /// vector). Typically 2-3.5x longer than the element bound; its safety rests on the margin and on
 /// the integrator's instability check, so it is an option, not the default.
-StableStep global_time_step(const ForceModel& model, std::span<const double> masses, std::span<const char> constrained,
-                            int iterations = 300, double margin = 1.05);
+StableStep global_time_step(const ForceModel& model, std::span<const double> masses, std::span<const char> constrained, int iterations = 300,
+                            double margin = 1.05);
 
 }  // namespace viscera::tissue

@@ -33,8 +33,7 @@ Mat6 elasticity_matrix(const IsotropicElasticity& m, const std::string& source =
 
 /// D of a transversely isotropic material, rotated so its axis is the fibre direction.
 /// Throws InputError when a constant is out of range or D is not positive definite.
-Mat6 elasticity_matrix(const TransverselyIsotropicElasticity& m,
-                       const std::string& source = "material");
+Mat6 elasticity_matrix(const TransverselyIsotropicElasticity& m, const std::string& source = "material");
 
 /// Checks that D is symmetric positive definite; throws InputError naming `source` if not.
 void check_elasticity_matrix(const Mat6& D, const std::string& source);

@@ -12,8 +12,8 @@ using Triangle = std::array<std::int32_t, 3>;
 
 struct BoundarySurface {
   std::vector<Triangle> triangles;
-  std::vector<std::int32_t> owner_tet;   ///< tetrahedron of each triangle
-  std::vector<std::int32_t> nodes;       ///< sorted node indices on the boundary
+  std::vector<std::int32_t> owner_tet;  ///< tetrahedron of each triangle
+  std::vector<std::int32_t> nodes;  ///< sorted node indices on the boundary
 };
 
 BoundarySurface extract_boundary(const TetMesh& mesh);

@@ -15,9 +15,9 @@ using Vec3 = Eigen::Vector3d;
 using Tet = std::array<std::int32_t, 4>;
 
 struct TetMesh {
-  std::vector<Vec3> nodes;   ///< rest positions [m]
-  std::vector<Tet> tets;     ///< vertex indices into nodes
-  std::string source;        ///< file (or generator) it came from, for messages
+  std::vector<Vec3> nodes;  ///< rest positions [m]
+  std::vector<Tet> tets;  ///< vertex indices into nodes
+  std::string source;  ///< file (or generator) it came from, for messages
 
   std::size_t node_count() const { return nodes.size(); }
   std::size_t tet_count() const { return tets.size(); }
@@ -29,9 +29,7 @@ void scale_mesh(TetMesh& mesh, double factor);
 /// Axis-aligned bounding box of the nodes.
 struct Box {
   Vec3 lo, hi;
-  bool contains(const Vec3& p) const {
-    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
-  }
+  bool contains(const Vec3& p) const { return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all(); }
 };
 Box bounding_box(const TetMesh& mesh);
 

@@ -7,8 +7,8 @@
 namespace viscera::tissue {
 
 struct ConstantQ {
-  double q = 0.0;                       ///< quality factor (> 0)
-  double modulus_pa = 0.0;              ///< |M| at the reference frequency [Pa]
+  double q = 0.0;  ///< quality factor (> 0)
+  double modulus_pa = 0.0;  ///< |M| at the reference frequency [Pa]
   double reference_frequency_hz = 1.0;  ///< [Hz]
 
   double gamma() const;

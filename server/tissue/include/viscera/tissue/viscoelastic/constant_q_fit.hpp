@@ -20,10 +20,10 @@ struct ConstantQFit {
 struct ConstantQTarget {
   double q = 4.8;
   double band_low_hz = 0.01, band_high_hz = 10.0;
-  int mechanisms = 3;                   ///< 1..8
-  double modulus_pa = 1e3;              ///< |M| at the reference frequency
+  int mechanisms = 3;  ///< 1..8
+  double modulus_pa = 1e3;  ///< |M| at the reference frequency
   double reference_frequency_hz = 2.0;
-  bool optimise_frequencies = true;     ///< false: log-spaced relaxation frequencies, weights only
+  bool optimise_frequencies = true;  ///< false: log-spaced relaxation frequencies, weights only
   /// If not empty: use these relaxation frequencies [rad/s] as they are and fit only the weights
   /// (to give bulk and shear the same frequencies).
   std::vector<double> fixed_frequencies_rad_s;

@@ -22,7 +22,7 @@ struct Figure2Options {
   int mechanisms = 3;
   double load_duration_s = 1.0, end_time_s = 4.0, sample_rate_hz = 250.0;
   int column_elements = 100;  ///< 1D column
-  int block_layers = 20;      ///< 3D block: cells through the thickness (6 tets each)
+  int block_layers = 20;  ///< 3D block: cells through the thickness (6 tets each)
 };
 
 struct Figure2 {

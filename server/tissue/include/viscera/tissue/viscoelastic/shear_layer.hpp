@@ -20,20 +20,17 @@ struct ShearLayer {
 };
 
 /// Top displacement [m] at t = k dt, k = 0..samples-1, exact for the modulus M(s) [Pa].
-std::vector<double> exact_top_displacement(const ShearLayer& layer,
-                                           const std::function<std::complex<double>(std::complex<double>)>& modulus,
-                                           const std::function<double(double)>& traction_pa, double dt_s,
-                                           std::size_t samples);
+std::vector<double> exact_top_displacement(const ShearLayer& layer, const std::function<std::complex<double>(std::complex<double>)>& modulus,
+                                           const std::function<double(double)>& traction_pa, double dt_s, std::size_t samples);
 
 struct ColumnResult {
   std::vector<double> top_displacement_m;  ///< at the output times
-  double dt_s = 0.0;                       ///< integration step used
+  double dt_s = 0.0;  ///< integration step used
   long steps = 0;
 };
 
 /// Memory-variable simulation of the same layer with `elements` linear elements.
-ColumnResult simulate_memory_column(const ShearLayer& layer, const StandardLinearSolids& solids,
-                                    const std::function<double(double)>& traction_pa, double output_dt_s,
-                                    std::size_t samples, int elements);
+ColumnResult simulate_memory_column(const ShearLayer& layer, const StandardLinearSolids& solids, const std::function<double(double)>& traction_pa,
+                                    double output_dt_s, std::size_t samples, int elements);
 
 }  // namespace viscera::tissue

@@ -13,7 +13,7 @@ namespace viscera::tissue {
 struct StandardLinearSolids {
   double unrelaxed_modulus_pa = 0.0;
   std::vector<double> omega_rad_s;  ///< relaxation frequencies w_l
-  std::vector<double> weight;       ///< Y_l (dimensionless, sum < 1)
+  std::vector<double> weight;  ///< Y_l (dimensionless, sum < 1)
 
   std::size_t size() const { return omega_rad_s.size(); }
   std::complex<double> complex_modulus(double omega_rad_s) const;

@@ -35,7 +35,6 @@ struct ViscoelasticSetup {
 
 /// D_reference: elasticity at the reference frequency (|M| of the deviatoric and volumetric parts).
 /// Throws InputError naming `source` and the field for invalid values.
-ViscoelasticSetup make_viscoelastic(const Mat6& D_reference, const ViscoelasticSpec& spec,
-                                    const std::string& source = "viscoelasticity");
+ViscoelasticSetup make_viscoelastic(const Mat6& D_reference, const ViscoelasticSpec& spec, const std::string& source = "viscoelasticity");
 
 }  // namespace viscera::tissue
