@@ -69,7 +69,7 @@ void count_tets(benchmark::State& st, const Level* level) {
       benchmark::Counter(tets * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void force(benchmark::State& st, std::string model_name, const Level* level) {
+void force(benchmark::State& st, const std::string& model_name, const Level* level) {
   const auto model = make_model(model_name, level);
   const auto x = deformed(*level->mesh);
   std::vector<Vec3> f(x.size());
@@ -81,7 +81,7 @@ void force(benchmark::State& st, std::string model_name, const Level* level) {
   count_tets(st, level);
 }
 
-void step(benchmark::State& st, std::string model_name, const Level* level) {
+void step(benchmark::State& st, const std::string& model_name, const Level* level) {
   const auto model = make_model(model_name, level);
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -9.81);

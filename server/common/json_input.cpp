@@ -188,7 +188,7 @@ std::string JsonObject::text(const char* key) const {
 std::string JsonObject::text(const char* key, const std::string& fallback) const { return has(key) ? text(key) : fallback; }
 
 std::string JsonObject::choice(const char* key, std::initializer_list<const char*> choices, const std::string& fallback) const {
-  const std::string v = text(key, fallback);
+  std::string v = text(key, fallback);
   if (std::any_of(choices.begin(), choices.end(), [&](const char* c) { return v == c; })) return v;
   std::string list;
   for (const char* c : choices) list += std::string(list.empty() ? "" : " | ") + c;

@@ -21,7 +21,7 @@ std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance&
     C += r.deepest_weights[k] * *block;
   }
   const double k = 1.0 / (1.0 / k_penalty + r.normal.dot(C * r.normal));
-  std::array<double, 9> out;
+  std::array<double, 9> out{};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) out[3 * i + j] = k * r.normal[i] * r.normal[j];
   return out;

@@ -6,7 +6,7 @@ namespace viscera::runtime {
 
 namespace proto = viscera::protocol;
 
-MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, proto::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes,
+MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, const proto::SurfaceTopology& topology, std::vector<std::int32_t> surface_nodes,
                              double rate_hz)
     : stream_(std::move(stream)), nodes_(std::move(surface_nodes)), mesh_id_(topology.mesh_id), period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
   stream_->write_topology(mesh_id_, proto::encode(topology));

@@ -9,3 +9,5 @@ sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/mesh
   "$src/data/scenes/liver.json" > "$scene"
 failures=0; passed=0
 check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
+# A check written in Python, read from standard input (a here-document): counts one pass or one failure.
+pycheck() { if python3 - "$@"; then passed=$((passed+1)); else echo "FAIL the Python check above"; failures=$((failures+1)); fi; }

@@ -36,7 +36,7 @@ check "trajectory client exit code 0 (got $trajectory_rc)" "[ $trajectory_rc -eq
 check "server exit code 0 after SIGINT (got $server_rc)" "[ $server_rc -eq 0 ]"
 check "server reports a clean stop" "grep -q 'stopped after' '$tmp/server.log'"
 check "the console received health reports (rc $health_rc)" "[ $health_rc -eq 0 ]"
-python3 - "$tmp/health.log" "$scene" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/health.log" "$scene" <<'PY'
 import json, re, sys
 rate = json.load(open(sys.argv[2]))["physics_rate_hz"]
 r = [(float(m[1]), int(m[2]), int(m[3]), int(m[4])) for m in
@@ -49,7 +49,7 @@ slots = (t1 - t0) * rate
 assert abs((n1 + m1) - (n0 + m0) - slots) <= 5, f"{n1 - n0} ticks + {m1 - m0} missed slots in {t1 - t0:.4f} s at {rate:.0f} Hz ({slots:.0f} slots)"
 print(f"[ figure ] health reports: {len(r)}; over {t1 - t0:.3f} s, {n1 - n0} ticks and {m1 - m0} missed slots for {slots:.1f} slots of the grid")
 PY
-python3 - "$tmp/grasp.json" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/grasp.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 d = r["duration_s"]
@@ -67,7 +67,7 @@ after = max(abs(x["force_n"][2]) for x in released)
 assert after < 0.05, f"opened jaws still hold the tissue: {after:.3f} N"
 print(f"[ figure ] grasp and pull 2 cm: restoring force {early:.2f} N early, {late:.2f} N late in the pull; {after:.3f} N after opening")
 PY
-python3 - "$tmp/trajectory.json" "$src/data/trajectories/press-and-slide.csv" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/trajectory.json" "$src/data/trajectories/press-and-slide.csv" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 end = max(float(l.split(",")[0]) for l in open(sys.argv[2]) if l[0].isdigit())
@@ -80,7 +80,7 @@ lifted = [x for x in s if x["t_s"] > 4.4]
 assert lifted and not any(x["in_contact"] for x in lifted), "still in contact after lifting off 2 cm above the top"
 print(f"[ figure ] trajectory press-and-slide: {len(s)} samples over {end} s, pushed back in {100*up:.0f}% of the pressed phase, free after lift-off")
 PY
-python3 - "$tmp/report.json" 0.03 <<'PY' || failures=$((failures+1))
+pycheck "$tmp/report.json" 0.03 <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 depth = float(sys.argv[2])
@@ -95,7 +95,7 @@ assert tail and min(tail) > 0.5 * deepest, f"the surface did not come back: {100
 print(f"[ figure ] mesh stream: {m['frames']} frames at {m['rate_hz']:.1f} Hz; surface under the probe down {1000*-deepest:.1f} mm at the deepest "
       f"({1000*depth:.0f} mm press), {1000*-min(tail):.1f} mm at the end")
 PY
-python3 - "$tmp/report.json" "$scene" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/report.json" "$scene" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 k = json.load(open(sys.argv[2]))["organ"]["contact_stiffness_n_per_m"]
@@ -132,6 +132,5 @@ print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% oppos
       f"({100 * deep / (k * travel):.0f}% of the penalty on a rigid surface over {1000 * travel:.0f} mm); "
       f"round trip p50 {rt['p50']:.0f} us, p99 {rt['p99']:.0f} us, max {rt['max']:.0f} us over {rt['samples']} commands")
 PY
-[ $? -eq 0 ] && passed=$((passed+1))
 echo "probe_press_test: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -66,7 +66,7 @@ check "the scene state shows the new scene, generation 2" "grep -q 'scene liver-
 check "the holding client claimed its probe again in the new scene" "grep -q 'loaded scene liver-12k: instrument 1 claimed again' '$tmp/hold.log'"
 check "a client of the new scene ran (rc $rc_after $rc_presser)" "[ $rc_after -eq 0 ] && [ $rc_presser -eq 0 ]"
 check "server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
-python3 - "$tmp/events.log" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/events.log" <<'PY'
 import sys
 lines = [l.split() for l in open(sys.argv[1]) if l.startswith("event ")]
 kinds = [l[1] for l in lines]
@@ -80,8 +80,7 @@ for k in order:
 assert "the scene was replaced by liver-12k" in text, "the released owner was not told why"
 print(f"[ figure ] control events seen by a console, in order: {', '.join(order)}")
 PY
-[ $? -eq 0 ] && passed=$((passed+1))
-python3 - "$tmp/hold.json" "$t_material" "$t_material_done" "$tmp/after.json" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/hold.json" "$t_material" "$t_material_done" "$tmp/after.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 t0 = float(sys.argv[2]) - r["start_epoch_s"]   # client time of the request
@@ -111,6 +110,5 @@ assert len(a["samples"]) / a["duration_s"] > 800, "forces in the new scene below
 print(f"[ figure ] after loading liver-12k: a new client received {len(frames)} frames of the new surface and "
       f"{len(a['samples']) / a['duration_s']:.0f} forces/s")
 PY
-[ $? -eq 0 ] && passed=$((passed+1))
 echo "scene_control_test: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -49,7 +49,7 @@ sleep 0.5; kill "$watcher"; wait "$watcher" 2>/dev/null
 kill -INT "$server"; wait "$server"; rc_server=$?
 cat "$tmp/control.log" "$tmp/ctl.log" "$tmp/events.log"
 check "annotation sent (rc $rc_note)" "[ $rc_note -eq 0 ]"
-python3 - "$tmp/events.log" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/events.log" <<'PY'
 import sys
 lines = [l.split() for l in open(sys.argv[1]) if l.startswith("event ")]
 kinds = [l[1] for l in lines]
@@ -66,12 +66,11 @@ assert claimed < touched < paused < reset < note < resumed < released, f"events 
 assert "resected segment IV" in open(sys.argv[1]).read()
 print(f"[ figure ] events seen by a console: {len(lines)}, in order: claimed, contact_started, paused, organ_reset, annotation, resumed, released")
 PY
-[ $? -eq 0 ] && passed=$((passed+1))
 check "pause, reset, resume accepted (rc $rc_pause $rc_reset $rc_resume)" "[ $rc_pause -eq 0 ] && [ $rc_reset -eq 0 ] && [ $rc_resume -eq 0 ]"
 check "pausing client ran (rc $rc_presser)" "[ $rc_presser -eq 0 ]"
 check "control reports the paused scene" "grep -q 'scene liver: paused' '$tmp/control.log'"
 check "server logged the reset" "grep -q 'reset the organ to rest' '$tmp/server.log'"
-python3 - "$tmp/ctl.json" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/ctl.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 frames = sorted(r["mesh"]["samples"], key=lambda f: f["t_s"])
@@ -97,7 +96,6 @@ print(f"[ figure ] session control: paused for {t1 - t0:.2f} s (simulated time h
       f"surface displaced {1000 * min(f['max_displacement_m'] for f in before):.1f} mm before the reset, "
       f"{1000 * max(f['max_displacement_m'] for f in after):.2f} mm after; forces still answered at {rate:.0f}/s")
 PY
-[ $? -eq 0 ] && passed=$((passed+1))
 cat "$tmp/a.log" "$tmp/b.log" "$tmp/hostile.log" "$tmp/victim.log" "$tmp/heir.log" "$tmp/server.log"
 check "client A ran (rc $rc_a)" "[ $rc_a -eq 0 ]"
 check "client B ran (rc $rc_b)" "[ $rc_b -eq 0 ]"
@@ -111,7 +109,7 @@ check "server rejected and counted hostile payloads ($rejected)" "[ -n '$rejecte
 reasons=$(grep 'stopped after' "$tmp/server.log" | grep -o 'malformed [0-9]*, not owner [0-9]*, unknown instrument [0-9]*')
 echo "[ figure ] rejected by reason: $reasons"
 check "rejections counted by reason ($reasons)" "python3 -c \"import re,sys; m,o,u=map(int,re.findall(r'\\d+','$reasons')); sys.exit(not (m > 3*o > 0 and u > 0 and m + o + u == $rejected))\""
-python3 - "$tmp/a.json" "$tmp/b.json" "$(python3 -c "print($claimed_at - $killed_at)")" <<'PY' || failures=$((failures+1))
+pycheck "$tmp/a.json" "$tmp/b.json" "$(python3 -c "print($claimed_at - $killed_at)")" <<'PY'
 import json, sys
 for path in sys.argv[1:3]:
     r = json.load(open(path))
@@ -121,6 +119,5 @@ for path in sys.argv[1:3]:
           f"round trip p50 {r['round_trip_us']['p50']:.0f} us p99 {r['round_trip_us']['p99']:.0f} us")
 print(f"[ figure ] SIGKILLed client's instrument claimed by another {float(sys.argv[3]):.2f} s after the kill")
 PY
-[ $? -eq 0 ] && passed=$((passed+1))
 echo "sessions_test: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

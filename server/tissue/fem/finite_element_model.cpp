@@ -32,7 +32,7 @@ ForceStats FiniteElementModel::add_forces(std::span<const Vec3> x, std::span<Vec
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     const Element& el = elements_[e];
     const Tet& t = tets[e];
-    const Vec3 x0 = x[t[0]];
+    const Vec3& x0 = x[t[0]];
     Mat3 ds;
     ds.col(0) = x[t[1]] - x0;
     ds.col(1) = x[t[2]] - x0;

@@ -11,7 +11,7 @@ namespace {
 Eigen::Matrix3d rotation_from_svd(const Eigen::Matrix3d& F) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d U = svd.matrixU();
-  const Eigen::Matrix3d V = svd.matrixV();
+  const Eigen::Matrix3d& V = svd.matrixV();
   if ((U * V.transpose()).determinant() < 0) U.col(2) = -U.col(2);  // smallest singular value
   return U * V.transpose();
 }

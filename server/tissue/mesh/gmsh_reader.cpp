@@ -17,7 +17,7 @@ constexpr long long kTet4 = 4;
 
 // Number of nodes of a Gmsh element type; -1 if unknown.
 int gmsh_node_count(long long type) {
-  switch (type) {
+  switch (type) {  // NOLINT(bugprone-branch-clone): a table of node counts, equal for some types
     case 1: return 2;  // line
     case 2: return 3;  // triangle
     case 3: return 4;  // quadrangle

@@ -22,7 +22,8 @@ namespace viscera::runtime {
 class MeshPublisher {
  public:
   /// `surface_nodes[k]` is the mesh node of surface vertex k; `triangles` index surface vertices.
-  MeshPublisher(std::unique_ptr<MeshStream> stream, protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes, double rate_hz);
+  MeshPublisher(std::unique_ptr<MeshStream> stream, const protocol::SurfaceTopology& topology, std::vector<std::int32_t> surface_nodes,
+                double rate_hz);
   ~MeshPublisher();
   MeshPublisher(const MeshPublisher&) = delete;
   MeshPublisher& operator=(const MeshPublisher&) = delete;

@@ -30,7 +30,7 @@ class FiniteElementModel final : public ForceModel {
  private:
   struct Element {
     Mat3 dm_inv;
-    double volume;
+    double volume = 0;
   };
   Mat3 deformation_gradient(std::span<const Vec3> x, std::size_t e) const;
   const Mat6& material(std::size_t e) const { return materials_[material_of_tet_.empty() ? 0 : material_of_tet_[e]]; }

@@ -71,7 +71,7 @@ class ExplicitIntegrator {
   ForceEvaluation evaluate_;
   std::function<bool()> interrupted_;
   MassScaling scaling_;
-  StableStep critical_;
+  StableStep critical_{};
   double dt_;
   std::vector<Vec3> force_, x_prev_, v_prev_;
   std::vector<double> field_stiffness_, field_damping_;
