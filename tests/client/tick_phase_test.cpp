@@ -73,7 +73,8 @@ TEST(TickPhase, LocksALoopStartedAtAnyPhaseAndKeepsItsRate) {
       }
       EXPECT_LT(largest_late_error, 150'000) << "start " << start << ", server period " << server_period;
       // Locked, the loop's mean period is the server's (500 ppm apart from its own: 500 ns).
-      const double mean_period = static_cast<double>(next - half) / (periods - 1 - periods / 2);
+      const auto counted = periods - 1 - periods / 2;  // the periods from the half-way index to the last
+      const double mean_period = static_cast<double>(next - half) / static_cast<double>(counted);
       EXPECT_NEAR(mean_period, static_cast<double>(server_period), 50.0) << "start " << start;
     }
   }

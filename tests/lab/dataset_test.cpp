@@ -14,7 +14,7 @@ using namespace viscera::lab;
 
 namespace {
 std::string make(const std::string& name, const std::string& json, const std::string& csv) {
-  const std::string dir = std::string(VISCERA_TEST_TMP) + "/bad/" + name;
+  std::string dir = std::string(VISCERA_TEST_TMP) + "/bad/" + name;
   std::filesystem::create_directories(dir);
   std::ofstream(dir + "/dataset.json") << json;
   std::ofstream(dir + "/a.csv") << csv;

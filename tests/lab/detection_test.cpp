@@ -28,6 +28,7 @@ TEST(HiddenEffect, NamedCorrectlyIn95PercentOf40SeedsWithGainAboveNoise) {
     if (ok)
       ++correct;
     else
+      // NOLINTNEXTLINE(performance-inefficient-string-concatenation): a test's message, once per seed
       wrong[expected + " -> " + found + (a.causes.size() > 1 ? " (+more)" : "")]++;
     if (!a.causes.empty()) {
       // A named cause must come with a held-out gain above noise.

@@ -18,7 +18,7 @@ namespace {
 
 /// A scene folder of the test's own (ctest runs the tests of this file in parallel processes).
 std::string scene_folder() {
-  const std::string dir = std::string(VISCERA_TEST_TMP) + "/scenes-" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::string dir = std::string(VISCERA_TEST_TMP) + "/scenes-" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   std::filesystem::copy_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json", dir + "/liver.json");

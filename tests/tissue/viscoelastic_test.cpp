@@ -501,6 +501,7 @@ TEST(Qlv, UniformDilatationStiffensExactlyAsFungsExponential) {
     const GpsModel qlv(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, q);
     for (double e : {-0.1, -0.0004, 0.0007, 0.05, 0.2}) {  // both sides of the series/closed-form switch at |B e| = 0.01
       std::vector<Vec3> x;
+      x.reserve(rest.size());
       for (const auto& p : rest) x.push_back((1 + e) * p);
       std::vector<Vec3> fl(4, Vec3::Zero()), fq(4, Vec3::Zero());
       linear.add_forces(x, fl);

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
     if (!out) throw std::runtime_error(csv + ": cannot write");
     const auto mm = [](const std::vector<double>& v) {
       std::vector<double> o2;
+      o2.reserve(v.size());
       for (double x : v) o2.push_back(1e3 * x);
       return o2;
     };

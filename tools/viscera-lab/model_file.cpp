@@ -43,7 +43,7 @@ MaterialModel read_model(const std::string& path) {
   const double big = 1e300;
   const auto numbers = [&](const char* key, bool positive) {
     const json& a = top.array(key);
-    const std::vector<double> v = top.numbers(key, a.size(), 0.0, big);
+    std::vector<double> v = top.numbers(key, a.size(), 0.0, big);
     for (std::size_t k = 0; k < v.size(); ++k)
       if (positive && !(v[k] > 0)) top.fail(std::string(key) + "[" + std::to_string(k) + "]", "0 is outside (0, inf)");
     return v;

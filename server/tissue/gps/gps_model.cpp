@@ -20,7 +20,7 @@ constexpr std::size_t kPrefetchAboveBytes = std::size_t{16} << 20;
 }  // namespace
 
 GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials, std::vector<std::uint16_t> material_of_tet, GpsOptions options)
-    : ForceModel(std::move(mesh)), options_(options) {
+    : ForceModel(std::move(mesh)), options_(std::move(options)) {
   if (materials.empty()) throw std::invalid_argument("GpsModel: no material");
   if (!material_of_tet.empty() && material_of_tet.size() != element_count())
     throw std::invalid_argument("GpsModel: material_of_tet size differs from tet count");

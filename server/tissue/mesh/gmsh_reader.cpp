@@ -16,8 +16,9 @@ namespace {
 constexpr long long kTet4 = 4;
 
 // Number of nodes of a Gmsh element type; -1 if unknown.
+// NOLINTBEGIN(bugprone-branch-clone): a table of node counts, equal for some types
 int gmsh_node_count(long long type) {
-  switch (type) {  // NOLINT(bugprone-branch-clone): a table of node counts, equal for some types
+  switch (type) {
     case 1: return 2;  // line
     case 2: return 3;  // triangle
     case 3: return 4;  // quadrangle
@@ -33,6 +34,7 @@ int gmsh_node_count(long long type) {
     default: return -1;
   }
 }
+// NOLINTEND(bugprone-branch-clone)
 
 bool is_volume(long long type) { return type == 4 || type == 5 || type == 6 || type == 7 || type == 11; }
 
