@@ -10,3 +10,4 @@ mkdir -p "$root/bench/results"
   --benchmark_enable_random_interleaving=true \
   --benchmark_out="$root/bench/results/tissue.json" --benchmark_out_format=json "$@"
 python3 "$root/bench/summarize.py" "$root/bench/results/tissue.json"
+python3 "$root/bench/performance_tables.py" "$root"

@@ -88,5 +88,8 @@ grep FAILED "$tmp/console.log" | head -5
 python3 "$root/bench/soak_report.py" "$samples" "$out" "$warmup_s" "$minutes" "$scene_src" "$alive" "$rc_server" \
   "$(cat "$tmp/press.count" 2>/dev/null)" "$(cat "$tmp/grasp.count" 2>/dev/null)" "$(cat "$tmp/console.count" 2>/dev/null)"
 rc=$?
-if [ "$out" = "$root/bench/results" ] && [ -f "$out/soak.svg" ]; then cp "$out/soak.svg" "$root/docs/soak.svg"; fi
+if [ "$out" = "$root/bench/results" ] && [ -f "$out/soak.svg" ]; then
+  cp "$out/soak.svg" "$root/docs/soak.svg"
+  python3 "$root/bench/performance_tables.py" "$root"
+fi
 exit $rc

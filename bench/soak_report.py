@@ -62,7 +62,8 @@ def main():
     ts = [float(r["t_s"]) for r in rows]
     warm = float(warmup)
     keep = [i for i, t in enumerate(ts) if t >= warm] or list(range(len(ts)))
-    result = {"date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "machine": f"{platform.machine()}, {os.cpu_count()} CPUs",
+    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), platform.machine())
+    result = {"date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "machine": f"{cpu}, {os.cpu_count()} CPUs",
               "minutes": float(minutes), "scene": os.path.basename(scene), "samples": len(rows), "warmup_s": warm,
               "server_alive_throughout": alive == "1", "server_exit_status": int(rc_server),
               "press_runs": counts[0][0], "press_failed": counts[0][1], "grasp_runs": counts[1][0], "grasp_failed": counts[1][1],

@@ -20,7 +20,7 @@ def main(path):
     meshes = ["liver2_1.5k", "liver2_12k", "liver2_96k"]
     models = ["gps", "gps_energy", "corotational", "linear"]
     for kind in ["Force", "Step"]:
-        print(f"\n{kind}: ns per tet (median) and tet updates per second per core")
+        print(f"\n{kind}: ns per tet (median) and tet updates per second per core\n")
         print("| mesh | tets | " + " | ".join(models) + " | gps / corotational speed-up |")
         print("|---|---|" + "---|" * (len(models) + 1))
         for m in meshes:
@@ -40,6 +40,7 @@ def main(path):
     print("\nViscoelastic step (3 memory variables) / elastic step, same mesh:")
     print("The last column: the model the bundled scenes run (energy form, volume term 0.5, the same")
     print("memory), the explicit sub-step a server tick repeats (data/scenes, docs/SCENE.md).")
+    print()
     print("| mesh | gps step | gps_visco3 step | ratio | scene model step |")
     print("|---|---|---|---|---|")
     for m in meshes:
@@ -47,7 +48,7 @@ def main(path):
         if a and b:
             scene = f"{c['real_time']:.1f} us" if c else "-"
             print(f"| {m} | {a['real_time']:.1f} us | {b['real_time']:.1f} us | {b['real_time']/a['real_time']:.2f}x | {scene} |")
-    print("\nMemory limit for the GPS force loop (296 bytes streamed per tet):")
+    print("\nMemory limit for the GPS force loop (296 bytes streamed per tet):\n")
     print("| working set | read bandwidth | limit ns/tet | gps ns/tet | gps / limit |")
     print("|---|---|---|---|---|")
     for m in meshes:

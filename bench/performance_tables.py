@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Regenerates the tables of docs/PERFORMANCE.md from the benchmarks' results in bench/results:
+tissue.json (bench/run.sh), tick.json (bench/tick.sh), haptics.json (bench/haptics.sh) and
+soak.json (bench/soak.sh). Each table goes between its markers <!-- begin NAME --> and
+<!-- end NAME -->, with the machine and the date of the run it comes from; the prose around the
+markers is left as it is. Usage: performance_tables.py [ROOT]"""
+import contextlib
+import io
+import json
+import os
+import re
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import summarize  # noqa: E402  (bench/summarize.py: the tissue tables)
+
+
+def tissue(path):
+    data = json.load(open(path))
+    ctx = data["context"]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        summarize.main(path)
+    return f"Run of {ctx.get('date', '?')[:16]} (`bench/run.sh`), " + out.getvalue()
+
+
+def tick(path):
+    data = json.load(open(path))
+    ctx = data["context"]
+    rows = ["| scene | tets | sub-steps per tick | tick on 1 thread [us] | tick on 2 threads [us] | budget [us] |", "|---|---|---|---|---|---|"]
+    med = {b["run_name"]: b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
+    scenes = sorted({n.split("/")[1] for n in med})
+    for s in scenes:
+        one, two = med.get(f"Tick/{s}/threads:1"), med.get(f"Tick/{s}/threads:2")
+        ref = one or two
+        if not ref:
+            continue
+        us = lambda b: f"{b['real_time']:.0f}" if b else "-"
+        rows.append(f"| {s} | {int(ref['tets'])} | {int(ref['sub_steps'])} | {us(one)} | {us(two)} | {ref['tick_budget_us']:.0f} |")
+    return f"Run of {ctx.get('date', '?')[:16]} (`bench/tick.sh`), {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, medians of 3:\n\n" + "\n".join(rows) + "\n"
+
+
+def haptics(path):
+    data = json.load(open(path))
+    rows = data["rows"]
+    dds = next((r for r in rows if r["kind"] == "ddsperf"), None)
+    head = ["| run | mesh frames [Hz] | round trip p50 / p99 / max [us] | physics [Hz] | step p50 / p99 [us] | late ticks | missed slots | resets | client rendering [Hz] |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    if dds:
+        head.append(f"| ddsperf ping-pong, 64 B at 1 kHz (the floor) | - | {dds['p50_us']:.0f} / {dds['p99_us']:.0f} / {dds['max_us']:.0f} | - | - | - | - | - | - |")
+    for r in rows:
+        if r["kind"] != "viscera":
+            continue
+        head.append(f"| {r['scene']} ({r['tets']} tets), {r['seconds']:.0f} s pressing | {r['frames_hz']:.0f} | {r['p50_us']:.0f} / {r['p99_us']:.0f} / {r['max_us']:.0f} | "
+                    f"{r['rate_hz']:.0f} | {r['step_p50_us']:.0f} / {r['step_p99_us']:.0f} | {r['late_ticks']} | {r['missed_slots']} | {r['physics_resets']} | {r['render_hz']:.0f} |")
+    ratios = []
+    v = [r for r in rows if r["kind"] == "viscera"]
+    for off, on in zip(v[0::2], v[1::2]):
+        if off["scene"] == on["scene"] and off["mesh_hz"] == 0 and on["mesh_hz"] > 0:
+            ratios.append(f"{off['scene']}: p99 with 60 Hz frames / without = {on['p99_us'] / off['p99_us']:.2f}")
+            if dds:
+                ratios.append(f"{off['scene']}: p50 {off['p50_us']:.0f} us against 3 x ddsperf's p50 + the step's p50 = "
+                              f"{3 * dds['p50_us'] + off['step_p50_us']:.0f} us")
+    return (f"Run of {data['date_utc']} UTC (`bench/haptics.sh`), {data['machine']}:\n\n" + "\n".join(head) + "\n\n" +
+            "".join(f"- {x}\n" for x in ratios))
+
+
+def soak(path):
+    r = json.load(open(path))
+    s = r["series"]
+    return (f"Run of {r['date_utc']} UTC (`bench/soak.sh {r['minutes']:g}`), {r['machine']}, scene {r['scene']}: {r['press_runs']} press runs, "
+            f"{r['grasp_runs']} grasp runs, {r['console_requests']} console requests, failures {r['press_failed'] + r['grasp_failed'] + r['console_failed']}; "
+            f"server {'alive throughout' if r['server_alive_throughout'] else 'DIED'}, exit status {r['server_exit_status']}.\n\n"
+            "| | first | last | min | max | growth per hour after the warm-up | noise (RMS about the fit) |\n|---|---|---|---|---|---|---|\n"
+            + "".join(f"| {name} | {s[k]['first']:.4g} | {s[k]['last']:.4g} | {s[k]['min']:.4g} | {s[k]['max']:.4g} | {s[k]['growth_per_hour']:+.3g} | {s[k]['noise_rms']:.3g} |\n"
+                      for k, name in [("rss_kb", "resident memory [MB]"), ("threads", "threads"), ("fds", "file descriptors")])
+            + "\n![the soak's samples](soak.svg)\n")
+
+
+def main(root):
+    doc_path = os.path.join(root, "docs", "PERFORMANCE.md")
+    doc = open(doc_path).read()
+    results = os.path.join(root, "bench", "results")
+    for name, fn in [("tissue", tissue), ("tick", tick), ("haptics", haptics), ("soak", soak)]:
+        path = os.path.join(results, f"{name}.json")
+        if not os.path.exists(path):
+            continue
+        table = fn(path)
+        pattern = re.compile(rf"(<!-- begin {name} -->\n).*?(<!-- end {name} -->)", re.S)
+        if not pattern.search(doc):
+            print(f"performance_tables: no markers for {name} in {doc_path}", file=sys.stderr)
+            continue
+        doc = pattern.sub(lambda m: m.group(1) + table + m.group(2), doc)
+    open(doc_path, "w").write(doc)
+    print(f"performance_tables: wrote {doc_path}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
