@@ -67,6 +67,120 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
   return 0;
 }
 
+/// What the command line asks for, checked before anything connects.
+struct Request {
+  std::string action, argument;
+  viscera::protocol::MaterialChange change;
+  double rate_hz = 0, duration_s = 10;
+  std::chrono::milliseconds timeout{60'000};
+};
+
+Request parse(const viscera::common::CommandLine& cl) {
+  using viscera::common::UsageError;
+  Request r;
+  const auto& rest = cl.positional();
+  const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, health, events or annotate TEXT";
+  if (rest.empty()) throw UsageError("missing ACTION (" + actions + ")");
+  r.action = rest[0];
+  const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false},  {"load", true},    {"material", false},
+                                             {"rate", true},   {"show", false},   {"health", false}, {"events", false}, {"annotate", true}};
+  const auto k = known.find(r.action);
+  if (k == known.end()) throw UsageError("ACTION '" + r.action + "' is not " + actions);
+  if (k->second != (rest.size() == 2)) throw UsageError(k->second ? r.action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
+  if (rest.size() == 2) r.argument = rest[1];
+  if (r.action == "annotate" && r.argument.size() > 1024) throw UsageError("TEXT is " + std::to_string(r.argument.size()) + " bytes (at most 1024)");
+  const auto material_flag = [&](const char* name, double lo, double hi, std::optional<double>& out) {
+    if (cl.has(name)) out = cl.number_in(name, lo, hi);
+  };
+  material_flag("youngs-modulus-pa", 1.0, 1e9, r.change.youngs_modulus_pa);
+  material_flag("poisson-ratio", 0.0, 0.4999, r.change.poisson_ratio);
+  material_flag("density-kg-m3", 1.0, 1e5, r.change.density_kg_m3);
+  material_flag("shear-q", 0.5, 1e4, r.change.shear_q);
+  material_flag("damping-per-s", 0.0, 1e4, r.change.damping_per_s);
+  if ((r.action == "material") != !r.change.empty())
+    throw UsageError(r.action == "material"
+                         ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
+                         : "material flags are for the material action");
+  if (r.action == "load") {
+    const std::string& n = r.argument;
+    const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' && std::all_of(n.begin(), n.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+    });
+    if (!plain) throw UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
+  }
+  if (r.action == "rate") {
+    char* end = nullptr;
+    r.rate_hz = std::strtod(r.argument.c_str(), &end);
+    if (*end || !(r.rate_hz >= 10 && r.rate_hz <= 10000) || r.rate_hz != std::floor(r.rate_hz))
+      throw UsageError("rate '" + r.argument + "' is not a whole number of hertz in [10, 10000]");
+  }
+  r.duration_s = cl.number_in("duration", 0.1, 1e6);
+  r.timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));
+  return r;
+}
+
+/// Prints the session's events and annotations for `duration_s`.
+int follow_events(viscera::client::Client& client, const viscera::protocol::Scene& scene, double duration_s) {
+  client.poll_events();  // subscribe
+  std::printf("following the events of scene %s for %.1f s\n", scene.name.c_str(), duration_s);
+  std::fflush(stdout);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+  while (std::chrono::steady_clock::now() < end) {
+    if (server_gone(client)) return kServerGone;
+    for (const auto& e : client.poll_events()) {
+      std::printf("event %s sim %.3f s instrument %u client %u%s%s\n", viscera::protocol::event_name(e.kind), e.sim_time_s, e.instrument_id,
+                  e.client_id, e.text.empty() ? "" : ": ", e.text.c_str());
+      std::fflush(stdout);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return 0;
+}
+
+/// load, material, rate (an outcome), or pause, resume, reset (the state confirms it). 0 when done.
+int control(viscera::client::Client& client, const Request& r) {
+  using viscera::protocol::Action;
+  if (r.action == "load" || r.action == "material" || r.action == "rate") {
+    const auto outcome = r.action == "load"       ? client.load_scene(r.argument, r.timeout)
+                         : r.action == "material" ? client.set_material(r.change, r.timeout)
+                                                  : client.set_physics_rate(r.rate_hz, r.timeout);
+    if (!outcome) {
+      std::fprintf(stderr, "viscera-control: no outcome of '%s' from the server within %.1f s\n", r.action.c_str(),
+                   1e-3 * static_cast<double>(r.timeout.count()));
+      return 1;
+    }
+    if (!outcome->accepted) {
+      std::fprintf(stderr, "viscera-control: refused: %s\n", outcome->message.c_str());
+      return 1;
+    }
+    std::printf("%s\n", outcome->message.c_str());
+    return 0;
+  }
+  const Action a = r.action == "pause" ? Action::pause : r.action == "resume" ? Action::resume : Action::reset;
+  if (!client.control(a, std::chrono::seconds(5))) {
+    std::fprintf(stderr, "viscera-control: the server did not confirm '%s' within 5 s\n", r.action.c_str());
+    return 1;
+  }
+  return 0;
+}
+
+void print_scene(const viscera::protocol::Scene& scene) {
+  std::printf("scene %s: %s, physics %.0f Hz, instruments:", scene.name.c_str(), scene.paused ? "paused" : "running", scene.physics_rate_hz);
+  for (const auto& i : scene.instruments)
+    std::printf(" %u (%s, %s)", i.instrument_id, i.grasper ? "grasper" : "probe",
+                i.owner_client_id ? ("client " + std::to_string(i.owner_client_id)).c_str() : "free");
+  const auto& m = scene.material;
+  std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s", scene.generation,
+              m.name.c_str(), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q, m.damping_per_s);
+  if (m.added_mass_fraction > 0) std::printf(", mass scaling +%.2f%% (smallest elements)", 100 * m.added_mass_fraction);
+  std::printf("\n");
+  std::string list;
+  for (const auto& n : scene.available_scenes) list += " " + n;
+  std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene.preparing.empty() ? "" : "; preparing ",
+              scene.preparing.c_str());
+  for (const auto& u : scene.unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -83,8 +197,8 @@ int main(int argc, char** argv) {
       "                  rejected messages) for --duration seconds, then what changed over them\n"
       "  events          print the session's events and annotations for --duration seconds\n"
       "  annotate TEXT   a note for recorders and consoles\n"
-      "Exit status: 0 done, 1 refused or not confirmed, 2 bad arguments, 3 no server, 4 the server went away (health, events).\n"
-      "Usage: viscera-control ACTION [ARGUMENT] [--domain ID] [--duration S] [material flags]");
+      "Exit status: 0 done, 1 refused or not confirmed, 2 bad arguments, 3 no server, 4 the server went away (health, events).");
+  cl.usage("viscera-control ACTION [ARGUMENT] [--domain ID] [--duration S] [material flags]");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
   cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
@@ -97,47 +211,7 @@ int main(int argc, char** argv) {
   cl.allow_positional(2);
   try {
     if (!cl.parse(argc, argv)) return 0;
-    const auto& rest = cl.positional();
-    const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, health, events or annotate TEXT";
-    if (rest.empty()) throw viscera::common::UsageError("missing ACTION (" + actions + ")");
-    const std::string action = rest[0];
-    const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false},  {"load", true},    {"material", false},
-                                               {"rate", true},   {"show", false},   {"health", false}, {"events", false}, {"annotate", true}};
-    const auto k = known.find(action);
-    if (k == known.end()) throw viscera::common::UsageError("ACTION '" + action + "' is not " + actions);
-    if (k->second != (rest.size() == 2))
-      throw viscera::common::UsageError(k->second ? action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
-    if (action == "annotate" && rest[1].size() > 1024)
-      throw viscera::common::UsageError("TEXT is " + std::to_string(rest[1].size()) + " bytes (at most 1024)");
-    viscera::protocol::MaterialChange change;
-    const auto material_flag = [&](const char* name, double lo, double hi, std::optional<double>& out) {
-      if (cl.has(name)) out = cl.number_in(name, lo, hi);
-    };
-    material_flag("youngs-modulus-pa", 1.0, 1e9, change.youngs_modulus_pa);
-    material_flag("poisson-ratio", 0.0, 0.4999, change.poisson_ratio);
-    material_flag("density-kg-m3", 1.0, 1e5, change.density_kg_m3);
-    material_flag("shear-q", 0.5, 1e4, change.shear_q);
-    material_flag("damping-per-s", 0.0, 1e4, change.damping_per_s);
-    if ((action == "material") != !change.empty())
-      throw viscera::common::UsageError(
-          action == "material" ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
-                               : "material flags are for the material action");
-    if (action == "load") {
-      const std::string& n = rest[1];
-      const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' && std::all_of(n.begin(), n.end(), [](char c) {
-        return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
-      });
-      if (!plain) throw viscera::common::UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
-    }
-    double rate_hz = 0;
-    if (action == "rate") {
-      char* end = nullptr;
-      rate_hz = std::strtod(rest[1].c_str(), &end);
-      if (*end || !(rate_hz >= 10 && rate_hz <= 10000) || rate_hz != std::floor(rate_hz))
-        throw viscera::common::UsageError("rate '" + rest[1] + "' is not a whole number of hertz in [10, 10000]");
-    }
-    const double duration = cl.number_in("duration", 0.1, 1e6);
-    const auto timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));
+    const Request r = parse(cl);
     viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)),
                                    static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9)));
     auto scene = client.wait_for_scene(std::chrono::seconds(10));
@@ -145,66 +219,18 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "viscera-control: no viscera-server found in 10 s (same domain and CYCLONEDDS_URI?)\n");
       return 3;
     }
-    using viscera::protocol::Action;
-    if (action == "events") {
-      client.poll_events();  // subscribe
-      std::printf("following the events of scene %s for %.1f s\n", scene->name.c_str(), duration);
-      std::fflush(stdout);
-      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration);
-      while (std::chrono::steady_clock::now() < end) {
-        if (server_gone(client)) return kServerGone;
-        for (const auto& e : client.poll_events()) {
-          std::printf("event %s sim %.3f s instrument %u client %u%s%s\n", viscera::protocol::event_name(e.kind), e.sim_time_s, e.instrument_id,
-                      e.client_id, e.text.empty() ? "" : ": ", e.text.c_str());
-          std::fflush(stdout);
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-      return 0;
-    }
-    if (action == "health") return watch_health(client, *scene, duration);
-    if (action == "annotate") {
-      client.annotate(rest[1]);  // waits for the readers' acknowledgements
+    if (r.action == "events") return follow_events(client, *scene, r.duration_s);
+    if (r.action == "health") return watch_health(client, *scene, r.duration_s);
+    if (r.action == "annotate") {
+      client.annotate(r.argument);  // waits for the readers' acknowledgements
       std::printf("annotated scene %s\n", scene->name.c_str());
       return 0;
     }
-    if (action == "load" || action == "material" || action == "rate") {
-      const auto outcome = action == "load"       ? client.load_scene(rest[1], timeout)
-                           : action == "material" ? client.set_material(change, timeout)
-                                                  : client.set_physics_rate(rate_hz, timeout);
-      if (!outcome) {
-        std::fprintf(stderr, "viscera-control: no outcome of '%s' from the server within %.1f s\n", action.c_str(),
-                     1e-3 * static_cast<double>(timeout.count()));
-        return 1;
-      }
-      if (!outcome->accepted) {
-        std::fprintf(stderr, "viscera-control: refused: %s\n", outcome->message.c_str());
-        return 1;
-      }
-      std::printf("%s\n", outcome->message.c_str());
-      scene = client.wait_for_scene(std::chrono::seconds(1));
-    } else if (action != "show") {
-      const Action a = action == "pause" ? Action::pause : action == "resume" ? Action::resume : Action::reset;
-      if (!client.control(a, std::chrono::seconds(5))) {
-        std::fprintf(stderr, "viscera-control: the server did not confirm '%s' within 5 s\n", action.c_str());
-        return 1;
-      }
+    if (r.action != "show") {
+      if (const int rc = control(client, r); rc != 0) return rc;
       scene = client.wait_for_scene(std::chrono::seconds(1));
     }
-    std::printf("scene %s: %s, physics %.0f Hz, instruments:", scene->name.c_str(), scene->paused ? "paused" : "running", scene->physics_rate_hz);
-    for (const auto& i : scene->instruments)
-      std::printf(" %u (%s, %s)", i.instrument_id, i.grasper ? "grasper" : "probe",
-                  i.owner_client_id ? ("client " + std::to_string(i.owner_client_id)).c_str() : "free");
-    const auto& m = scene->material;
-    std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s", scene->generation,
-                m.name.c_str(), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q, m.damping_per_s);
-    if (m.added_mass_fraction > 0) std::printf(", mass scaling +%.2f%% (smallest elements)", 100 * m.added_mass_fraction);
-    std::printf("\n");
-    std::string list;
-    for (const auto& n : scene->available_scenes) list += " " + n;
-    std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene->preparing.empty() ? "" : "; preparing ",
-                scene->preparing.c_str());
-    for (const auto& u : scene->unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
+    print_scene(*scene);
     return 0;
   } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-control: %s\n", e.what());

@@ -86,10 +86,7 @@ double max_displacement(const State& s, const TetMesh& mesh) {
   return d;
 }
 
-int run(int argc, char** argv) {
-  viscera::common::CommandLine cl("viscera-sim",
-                                  "Runs an organ mesh under gravity with a fixed region and writes VTU frames for ParaView.\n"
-                                  "Units are SI: metres, seconds, pascals, kilograms.");
+void declare_flags(viscera::common::CommandLine& cl) {
   cl.flag("mesh", "PATH", "tetrahedral mesh (.msh Gmsh v1/v2/v4.1, .vtk legacy, .vtu)");
   cl.flag("scale", "M_PER_UNIT", "metres per mesh unit (organ meshes carry no units)", "1");
   cl.flag("material", "FILE.json", "material file (docs/MATERIAL.md)");
@@ -110,96 +107,107 @@ int run(int argc, char** argv) {
   cl.flag("frame-rate", "HZ", "VTU frames per simulated second", "30");
   cl.flag("out", "DIR", "output folder for frames (frame_NNNN.vtu + frames.pvd)", "viscera-sim-out");
   cl.option_switch("no-output", "write no frames");
-  if (!cl.parse(argc, argv)) return 0;
+}
 
+/// The organ as the command line describes it: mesh, material, model, boundary conditions and the
+/// integrator, printed as they are built.
+struct Organ {
+  std::shared_ptr<TetMesh> mesh;
+  Material material;
+  std::unique_ptr<ForceModel> model;
+  std::unique_ptr<ExplicitIntegrator> explicit_integrator;
+  std::unique_ptr<ImplicitIntegrator> implicit_integrator;
+  double implicit_dt_s = 0;
+};
+
+Material material_of(const viscera::common::CommandLine& cl) {
+  if (cl.has("material")) return read_material_file(cl.text("material"));
+  Material material;
+  material.name = "command line";
+  material.density_kg_m3 = cl.number("density");
+  if (!(material.density_kg_m3 > 0)) throw viscera::common::UsageError("--density must be positive");
+  material.elasticity = elasticity_matrix(IsotropicElasticity{cl.number("youngs-modulus"), cl.number("poisson-ratio")}, "command line");
+  return material;
+}
+
+Organ build(const viscera::common::CommandLine& cl) {
+  Organ o;
   const std::string mesh_path = cl.text("mesh");
-  auto mesh = std::make_shared<TetMesh>(read_tet_mesh(mesh_path));
+  o.mesh = std::make_shared<TetMesh>(read_tet_mesh(mesh_path));
   const double scale = cl.number("scale");
   if (!(scale > 0)) throw viscera::common::UsageError("--scale must be positive");
-  scale_mesh(*mesh, scale);
-
-  Material material;
-  if (cl.has("material")) {
-    material = read_material_file(cl.text("material"));
-  } else {
-    material.name = "command line";
-    material.density_kg_m3 = cl.number("density");
-    if (!(material.density_kg_m3 > 0)) throw viscera::common::UsageError("--density must be positive");
-    material.elasticity = elasticity_matrix(IsotropicElasticity{cl.number("youngs-modulus"), cl.number("poisson-ratio")}, "command line");
-  }
+  scale_mesh(*o.mesh, scale);
+  o.material = material_of(cl);
   const double volume = cl.number_in("volume-term", 0.0, 0.999);
-  Mat6 elasticity = material.elasticity;
+  Mat6 elasticity = o.material.elasticity;
   GpsViscoelasticity viscoelasticity;
-  if (material.viscoelasticity) {
-    const ViscoelasticSetup ve = make_viscoelastic(material.elasticity, *material.viscoelasticity, cl.text("material"));
+  if (o.material.viscoelasticity) {
+    const ViscoelasticSetup ve = make_viscoelastic(o.material.elasticity, *o.material.viscoelasticity, cl.text("material"));
     std::printf("viscoelasticity\n%s", ve.table.c_str());
     elasticity = ve.unrelaxed_elasticity;
     viscoelasticity = ve.gps;
   }
-  const auto model = make_force_model(cl.text("model"), mesh, {elasticity}, volume, viscoelasticity);
-
+  o.model = make_force_model(cl.text("model"), o.mesh, {elasticity}, volume, viscoelasticity);
   BoundaryConditions bc;
   const auto g = cl.numbers("gravity", 3);
   bc.gravity_m_s2 = Vec3(g[0], g[1], g[2]);
-  bc.fixed_nodes = fixed_nodes(cl, *mesh);
+  bc.fixed_nodes = fixed_nodes(cl, *o.mesh);
   const double damping = cl.number_in("damping", 0.0, 1e6);
-  const double duration = cl.number_in("duration", 0.0, 1e6);
-  const double frame_rate = cl.number_in("frame-rate", 1e-3, 1e4);
-  const std::string integrator_name = cl.text("integrator");
-  if (integrator_name != "explicit" && integrator_name != "implicit")
-    throw viscera::common::UsageError("--integrator: '" + integrator_name + "' is not explicit or implicit");
+  const std::string integrator = cl.text("integrator");
+  if (integrator != "explicit" && integrator != "implicit")
+    throw viscera::common::UsageError("--integrator: '" + integrator + "' is not explicit or implicit");
 
-  const Box box = bounding_box(*mesh);
+  const Box box = bounding_box(*o.mesh);
   const Vec3 size = box.hi - box.lo;
-  std::printf("mesh      %s: %zu nodes, %zu tetrahedra, %zu surface triangles\n", mesh_path.c_str(), mesh->node_count(), mesh->tet_count(),
-              extract_boundary(*mesh).triangles.size());
+  std::printf("mesh      %s: %zu nodes, %zu tetrahedra, %zu surface triangles\n", mesh_path.c_str(), o.mesh->node_count(), o.mesh->tet_count(),
+              extract_boundary(*o.mesh).triangles.size());
   std::printf("          scaled by %g m/unit to %.3f x %.3f x %.3f m, volume %.3g m^3, mass %.3g kg\n", scale, size.x(), size.y(), size.z(),
-              mesh_volume(*mesh), mesh_volume(*mesh) * material.density_kg_m3);
-  std::printf("material  %s, density %g kg/m^3\n", material.name.c_str(), material.density_kg_m3);
-  std::printf("model     %s; %zu fixed nodes; gravity (%g, %g, %g) m/s^2; damping %g 1/s\n", std::string(model->name()).c_str(),
+              mesh_volume(*o.mesh), mesh_volume(*o.mesh) * o.material.density_kg_m3);
+  std::printf("material  %s, density %g kg/m^3\n", o.material.name.c_str(), o.material.density_kg_m3);
+  std::printf("model     %s; %zu fixed nodes; gravity (%g, %g, %g) m/s^2; damping %g 1/s\n", std::string(o.model->name()).c_str(),
               bc.fixed_nodes.size(), g[0], g[1], g[2], damping);
   if (bc.fixed_nodes.empty()) std::printf("warning   no node is fixed: the organ will fall freely\n");
 
-  const std::vector<double> rho(mesh->tet_count(), material.density_kg_m3);
-  std::unique_ptr<ExplicitIntegrator> explicit_integrator;
-  std::unique_ptr<ImplicitIntegrator> implicit_integrator;
-  if (integrator_name == "explicit") {
-    explicit_integrator = std::make_unique<ExplicitIntegrator>(*model, rho, bc, ExplicitOptions{0.9, 0.0, damping, 2.0});
-    const auto& c = explicit_integrator->critical_step();
-    std::printf("explicit  critical step %.3g s (element %zu), using %.3g s (safety 0.9)\n", c.dt_s, c.element, explicit_integrator->dt_s());
+  const std::vector<double> rho(o.mesh->tet_count(), o.material.density_kg_m3);
+  if (integrator == "explicit") {
+    o.explicit_integrator = std::make_unique<ExplicitIntegrator>(*o.model, rho, bc, ExplicitOptions{0.9, 0.0, damping, 2.0});
+    const auto& c = o.explicit_integrator->critical_step();
+    std::printf("explicit  critical step %.3g s (element %zu), using %.3g s (safety 0.9)\n", c.dt_s, c.element, o.explicit_integrator->dt_s());
   } else {
-    implicit_integrator = std::make_unique<ImplicitIntegrator>(*model, rho, bc, ImplicitOptions{cl.number_in("dt", 1e-7, 10), damping, 1e-8, 50});
-    std::printf("implicit  backward Euler, dt %.3g s, Newton to 1e-8 relative residual, CHOLMOD\n", cl.number("dt"));
+    o.implicit_dt_s = cl.number_in("dt", 1e-7, 10);
+    o.implicit_integrator = std::make_unique<ImplicitIntegrator>(*o.model, rho, bc, ImplicitOptions{o.implicit_dt_s, damping, 1e-8, 50});
+    std::printf("implicit  backward Euler, dt %.3g s, Newton to 1e-8 relative residual, CHOLMOD\n", o.implicit_dt_s);
   }
+  return o;
+}
 
-  const bool write = !cl.has("no-output");
-  const fs::path out = cl.text("out");
+/// Frames every 1/frame_rate of simulated time (none when `out` is empty), progress every tenth of
+/// the duration.
+void simulate(Organ& o, double duration, double frame_rate, const fs::path& out) {
   std::vector<std::pair<double, std::string>> frames;
-  State state = State::at_rest(*mesh);
+  State state = State::at_rest(*o.mesh);
   const auto write_frame = [&] {
-    if (!write) return;
+    if (out.empty()) return;
     char name[32];
     std::snprintf(name, sizeof name, "frame_%04zu.vtu", frames.size());
-    write_vtu((out / name).string(), *mesh, state.x, state.v);
+    write_vtu((out / name).string(), *o.mesh, state.x, state.v);
     frames.emplace_back(state.time_s, name);
   };
-  if (write) fs::create_directories(out);
+  if (!out.empty()) fs::create_directories(out);
   write_frame();
-
   const auto wall0 = std::chrono::steady_clock::now();
   long steps = 0;
   int newton_total = 0;
-  const double frame_dt = 1.0 / frame_rate;
   double next_report = 0.0;
   while (state.time_s < duration - 1e-12) {
-    const double span = std::min(frame_dt, duration - state.time_s);
-    if (explicit_integrator) {
-      steps += explicit_integrator->advance(state, span);
+    const double span = std::min(1.0 / frame_rate, duration - state.time_s);
+    if (o.explicit_integrator) {
+      steps += o.explicit_integrator->advance(state, span);
     } else {
       const double end = state.time_s + span;
       while (state.time_s < end - 1e-12) {
-        implicit_integrator->set_dt(std::min(cl.number("dt"), end - state.time_s));
-        newton_total += implicit_integrator->step(state).iterations;
+        o.implicit_integrator->set_dt(std::min(o.implicit_dt_s, end - state.time_s));
+        newton_total += o.implicit_integrator->step(state).iterations;
         ++steps;
       }
     }
@@ -207,18 +215,29 @@ int run(int argc, char** argv) {
     if (state.time_s >= next_report - 1e-12 || state.time_s >= duration - 1e-12) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
       std::printf("t = %6.3f s  %8ld steps  %9.0f steps/s  %6.2fx real time  max displacement %.2f mm%s\n", state.time_s, steps,
-                  static_cast<double>(steps) / std::max(wall, 1e-9), state.time_s / std::max(wall, 1e-9), 1e3 * max_displacement(state, *mesh),
-                  implicit_integrator
+                  static_cast<double>(steps) / std::max(wall, 1e-9), state.time_s / std::max(wall, 1e-9), 1e3 * max_displacement(state, *o.mesh),
+                  o.implicit_integrator
                       ? (" Newton iterations/step " + std::to_string(static_cast<double>(newton_total) / static_cast<double>(steps))).c_str()
                       : "");
       std::fflush(stdout);
       next_report += 0.1 * duration;
     }
   }
-  if (write) {
+  if (!out.empty()) {
     write_pvd((out / "frames.pvd").string(), frames);
     std::printf("wrote %zu frames to %s (open frames.pvd in ParaView)\n", frames.size(), out.c_str());
   }
+}
+
+int run(int argc, char** argv) {
+  viscera::common::CommandLine cl("viscera-sim",
+                                  "Runs an organ mesh under gravity with a fixed region and writes VTU frames for ParaView.\n"
+                                  "Units are SI: metres, seconds, pascals, kilograms.");
+  declare_flags(cl);
+  if (!cl.parse(argc, argv)) return 0;
+  const double duration = cl.number_in("duration", 0.0, 1e6), frame_rate = cl.number_in("frame-rate", 1e-3, 1e4);  // before the slow part
+  Organ organ = build(cl);
+  simulate(organ, duration, frame_rate, cl.has("no-output") ? fs::path() : fs::path(cl.text("out")));
   return 0;
 }
 
