@@ -53,12 +53,23 @@ Eigen::Matrix3d ContactCompliance::wait_node(std::int32_t n) {
   }
 }
 
+namespace {
+// CHOLMOD's dense kernels run on Debian's serial OpenBLAS, which must not be called from two
+// threads at once (two organs' workers factorising together, during a material change or a scene
+// load, crashed in dpotrf under ThreadSanitizer's timing): every factorisation and solve of every
+// compliance in the process takes this lock.
+std::mutex g_blas_mutex;
+}  // namespace
+
 void ContactCompliance::work(const ForceModel& model, std::vector<double> density, BoundaryConditions bc) {
   pthread_setname_np(pthread_self(), "compliance");
   const auto& rest = model.rest_mesh().nodes;
   // dt is irrelevant to the static stiffness; the integrator only needs a valid one.
   ImplicitIntegrator system(model, std::move(density), std::move(bc), ImplicitOptions{1e-3});
-  factorised_ = system.factorize_stiffness(rest) ? 1 : -1;
+  {
+    std::lock_guard blas(g_blas_mutex);
+    factorised_ = system.factorize_stiffness(rest) ? 1 : -1;
+  }
   done_cv_.notify_all();
   if (factorised_ < 0) return;
   std::vector<Vec3> f(rest.size(), Vec3::Zero()), u(rest.size());
@@ -72,6 +83,7 @@ void ContactCompliance::work(const ForceModel& model, std::vector<double> densit
       requests_.pop_front();
     }
     const auto i = static_cast<std::size_t>(n);
+    std::lock_guard blas(g_blas_mutex);
     for (int d = 0; d < 3; ++d) {
       f[i] = Vec3::Unit(d);
       system.compliance(f, u);

@@ -128,6 +128,12 @@ TEST(ServerThreads, CommandsAnsweredWhileThePhysicsStepsAndAMaterialIsBuilt) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
+  // The material is built in the background: wait for its outcome (seconds under ThreadSanitizer).
+  for (int k = 0; k < 600; ++k) {
+    const auto now = endpoints.decoded<proto::Scene>(endpoints.scenes, proto::decode_scene);
+    if (now.back().material.youngs_modulus_pa == 7000 && now.back().physics_rate_hz == 500) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   stop = true;
   physics.join();
