@@ -17,7 +17,13 @@ packages=(
   python3                  # bench summary and test scripts that read JSON
   libpugixml-dev           # XML parsing of VTU meshes
   clang libclang-rt-14-dev # libFuzzer for the message-decoder fuzz target
+  clang-format clang-tidy  # lint tests: the layout of every C++ file, clang-tidy on recent changes
+  libzstd-dev liblz4-dev   # MCAP chunk compression (zstd, lz4) in session recordings
+  libssl-dev               # SHA-256 of the files a scene was built from (recordings name them)
 )
+# Node.js and npm: the official MCAP reader (@mcap/core) that judges recordings in the tests. Debian's
+# packages, unless a node and an npm are on the PATH already (a NodeSource install bundles npm).
+node_packages=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -26,13 +32,25 @@ for p in "${packages[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  missing+=("${node_packages[@]}")
 fi
 
-echo "install-deps: installing ${missing[*]}" >&2
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}" >&2
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# npm packages the tests run (tests/node/package.json, pinned by its lock file): installed again only
+# when the lock file changed.
+root="$(cd "$(dirname "$0")/.." && pwd)"
+node_dir="$root/tests/node"
+if ! cmp -s "$node_dir/package-lock.json" "$node_dir/node_modules/.installed-lock.json"; then
+  echo "install-deps: npm ci in tests/node" >&2
+  (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  cp "$node_dir/package-lock.json" "$node_dir/node_modules/.installed-lock.json"
+fi

@@ -36,8 +36,8 @@ struct Client::Impl {
   std::atomic<bool> scene_stale{false};  // the server was lost: its last scene state no longer holds
   std::mutex callback_mutex;
   std::function<void(ServerState)> callback;
-  explicit Impl(std::uint32_t domain)
-      : participant(domain),
+  Impl(std::uint32_t domain, const std::string& partition)
+      : participant(domain, partition),
         commands(participant, proto::Stream::instrument_command),
         sessions(participant, proto::Stream::session_request),
         forces(participant, proto::Stream::force_feedback),
@@ -69,7 +69,8 @@ struct Client::Impl {
   }
 };
 
-Client::Client(std::uint32_t domain_id, std::uint32_t client_id) : impl_(std::make_unique<Impl>(domain_id)), client_id_(client_id) {}
+Client::Client(std::uint32_t domain_id, std::uint32_t client_id, const std::string& partition)
+    : impl_(std::make_unique<Impl>(domain_id, partition)), client_id_(client_id) {}
 Client::~Client() = default;
 
 std::optional<proto::Scene> Client::wait_for_scene(std::chrono::milliseconds timeout) {

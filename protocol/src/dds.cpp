@@ -1,5 +1,7 @@
 #include "viscera/protocol/dds.hpp"
 
+#include <cstring>
+
 #include <dds/dds.h>
 
 #include "envelope.h"
@@ -12,8 +14,12 @@ int32_t check(int32_t rc, const char* what) {
   return rc;
 }
 
-dds_qos_t* qos_for(Stream s) {
+dds_qos_t* qos_for(Stream s, const std::string& partition) {
   dds_qos_t* q = dds_create_qos();
+  if (!partition.empty()) {
+    const char* names[] = {partition.c_str()};
+    dds_qset_partition(q, 1, names);
+  }
   switch (s) {
     case Stream::instrument_command:
     case Stream::force_feedback:
@@ -35,9 +41,16 @@ dds_qos_t* qos_for(Stream s) {
       break;
     case Stream::scene_state:
     case Stream::surface_topology:
+    case Stream::scene_files:
       dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
       dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
       dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+      break;
+    case Stream::lockstep_step:
+    case Stream::lockstep_result:
+      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
+      dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
+      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
       break;
   }
   // A client that dies or goes silent loses its liveliness within this lease.
@@ -58,11 +71,26 @@ const char* topic_name(Stream s) {
     case Stream::surface_topology: return "viscera_surface_topology";
     case Stream::mesh_frame: return "viscera_mesh_frame";
     case Stream::event: return "viscera_event";
+    case Stream::scene_files: return "viscera_scene_files";
+    case Stream::lockstep_step: return "viscera_lockstep_step";
+    case Stream::lockstep_result: return "viscera_lockstep_result";
   }
   return "?";
 }
 
-Participant::Participant(std::uint32_t domain_id) : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")) {}
+const char* stream_name(Stream s) { return topic_name(s) + std::strlen("viscera_"); }
+
+bool parse_stream(const std::string& name, Stream* out) {
+  for (int k = 0; k < kStreamCount; ++k)
+    if (name == stream_name(static_cast<Stream>(k))) {
+      *out = static_cast<Stream>(k);
+      return true;
+    }
+  return false;
+}
+
+Participant::Participant(std::uint32_t domain_id, std::string partition)
+    : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")), partition_(std::move(partition)) {}
 
 Participant::~Participant() { dds_delete(handle_); }
 
@@ -73,7 +101,7 @@ int32_t Participant::topic(Stream s) {
 }
 
 Writer::Writer(Participant& p, Stream s) {
-  dds_qos_t* q = qos_for(s);
+  dds_qos_t* q = qos_for(s, p.partition());
   handle_ = dds_create_writer(p.handle(), p.topic(s), q, nullptr);
   dds_delete_qos(q);
   check(handle_, "create writer");
@@ -112,8 +140,9 @@ bool Writer::wait_for_acks(std::chrono::milliseconds timeout) const {
   return dds_wait_for_acks(handle_, DDS_MSECS(timeout.count())) == DDS_RETCODE_OK;
 }
 
-Reader::Reader(Participant& p, Stream s) {
-  dds_qos_t* q = qos_for(s);
+Reader::Reader(Participant& p, Stream s, ReaderOptions options) {
+  dds_qos_t* q = qos_for(s, p.partition());
+  if (options.history_depth > 0) dds_qset_history(q, DDS_HISTORY_KEEP_LAST, options.history_depth);
   handle_ = dds_create_reader(p.handle(), p.topic(s), q, nullptr);
   dds_delete_qos(q);
   check(handle_, "create reader");
@@ -140,7 +169,7 @@ int Reader::take(const std::function<void(const Received&)>& f) {
     for (int32_t k = 0; k < n; ++k) {
       if (!infos[k].valid_data) continue;
       const auto* e = static_cast<const viscera_Envelope*>(samples[k]);
-      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}});
+      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}, infos[k].publication_handle});
       ++total;
     }
     dds_return_loan(handle_, samples, n);

@@ -11,6 +11,7 @@
 #include "session_generated.h"
 #include "surface_mesh_generated.h"
 #include "telemetry_generated.h"
+#include "verified_root.hpp"
 
 namespace viscera::protocol {
 
@@ -27,21 +28,7 @@ Vector3 from_fb(const fb::Vec3* v) { return v ? Vector3{v->x(), v->y(), v->z()} 
 bool finite(const Vector3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 bool within(const Vector3& v, double limit) { return std::abs(v[0]) <= limit && std::abs(v[1]) <= limit && std::abs(v[2]) <= limit; }
 
-/// identifier: the schema's file identifier (4 characters), or nullptr for the schema-1 messages,
-/// which have none.
-template <typename T>
-const T* verified_root(std::span<const std::uint8_t> bytes, std::string* why, const char* identifier = nullptr) {
-  if (bytes.size() < 8) {
-    *why = "payload of " + std::to_string(bytes.size()) + " bytes is too short";
-    return nullptr;
-  }
-  flatbuffers::Verifier v(bytes.data(), bytes.size(), 64, 10000);
-  if (!v.VerifyBuffer<T>(identifier)) {
-    *why = "FlatBuffers verification failed (truncated, garbage or another schema)";
-    return nullptr;
-  }
-  return flatbuffers::GetRoot<T>(bytes.data());
-}
+using detail::verified_root;
 
 template <typename B>
 std::vector<std::uint8_t> finish(flatbuffers::FlatBufferBuilder& b, flatbuffers::Offset<B> root) {
@@ -65,7 +52,7 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
   return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force,
-                                           &torque, model, f.step_time_ns, f.penetration_m));
+                                           &torque, model, f.step_time_ns, f.penetration_m, f.tick));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -82,7 +69,7 @@ std::vector<std::uint8_t> encode(const SessionRequest& r) {
     material = m.Finish();
   }
   return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id, r.request_seq, name, material,
-                                            r.physics_rate_hz));
+                                            r.physics_rate_hz, r.seek_s));
 }
 
 std::vector<std::uint8_t> encode(const Scene& s) {
@@ -128,14 +115,15 @@ std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
 std::vector<std::uint8_t> encode(const MeshFrame& m) {
   flatbuffers::FlatBufferBuilder b(64 + 4 * m.positions.size());
   const auto positions = b.CreateVector(m.positions);
-  b.Finish(fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions), fb::MeshFrameIdentifier());
+  b.Finish(fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions, m.tick), fb::MeshFrameIdentifier());
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
 
 std::vector<std::uint8_t> encode(const Event& e) {
   flatbuffers::FlatBufferBuilder b(128 + e.text.size());
   const auto text = b.CreateString(e.text);
-  b.Finish(fb::CreateEvent(b, e.source_client_id, static_cast<fb::EventKind>(e.kind), e.instrument_id, e.client_id, e.sim_time_s, e.stamp_ns, text),
+  b.Finish(fb::CreateEvent(b, e.source_client_id, static_cast<fb::EventKind>(e.kind), e.instrument_id, e.client_id, e.sim_time_s, e.stamp_ns, text,
+                           e.tick, e.request_seq),
            fb::EventIdentifier());
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
@@ -150,6 +138,7 @@ const char* action_name(Action a) {
     case Action::load_scene: return "load_scene";
     case Action::set_material: return "set_material";
     case Action::set_physics_rate: return "set_physics_rate";
+    case Action::seek: return "seek";
   }
   return "unknown";
 }
@@ -225,6 +214,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   f.force = from_fb(m->force());
   f.torque = from_fb(m->torque());
   f.penetration_m = m->penetration_m();
+  f.tick = m->tick();
   if (const auto* lm = m->local_model()) {
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());
@@ -248,7 +238,7 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
   const auto* m = verified_root<fb::SessionRequest>(bytes, why);
   if (!m) return std::nullopt;
   const auto a = static_cast<int>(m->action());
-  if (a < 0 || a > static_cast<int>(Action::set_physics_rate)) {
+  if (a < 0 || a > static_cast<int>(Action::seek)) {
     *why = "unknown action " + std::to_string(a);
     return std::nullopt;
   }
@@ -256,7 +246,7 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
     *why = "client_id 0 is reserved";
     return std::nullopt;
   }
-  SessionRequest r{m->client_id(), static_cast<Action>(a), m->instrument_id(), m->request_seq(), {}, {}, m->physics_rate_hz()};
+  SessionRequest r{m->client_id(), static_cast<Action>(a), m->instrument_id(), m->request_seq(), {}, {}, m->physics_rate_hz(), m->seek_s()};
   if (r.action == Action::load_scene) {
     r.scene_name = m->scene_name() ? m->scene_name()->str() : "";
     const bool plain = std::all_of(r.scene_name.begin(), r.scene_name.end(),
@@ -295,6 +285,10 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
   }
   if (r.action == Action::set_physics_rate && !(r.physics_rate_hz >= 10.0 && r.physics_rate_hz <= 10000.0)) {
     *why = "physics_rate_hz = " + std::to_string(r.physics_rate_hz) + " is outside [10, 10000] Hz";
+    return std::nullopt;
+  }
+  if (r.action == Action::seek && !(std::isfinite(r.seek_s) && r.seek_s >= 0.0)) {
+    *why = "seek_s = " + std::to_string(r.seek_s) + " is not a time from the start [s]";
     return std::nullopt;
   }
   return r;
@@ -422,7 +416,7 @@ std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, 
     *why = "sim_time_s not finite or negative";
     return std::nullopt;
   }
-  return MeshFrame{m->mesh_id(), m->frame(), m->sim_time_s(), m->server_stamp_ns(), {m->positions()->begin(), m->positions()->end()}};
+  return MeshFrame{m->mesh_id(), m->frame(), m->sim_time_s(), m->server_stamp_ns(), {m->positions()->begin(), m->positions()->end()}, m->tick()};
 }
 
 std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::string* why) {
@@ -443,8 +437,8 @@ std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::stri
     *why = "sim_time_s not finite or negative";
     return std::nullopt;
   }
-  return Event{m->source_client_id(), static_cast<EventKind>(k),        m->instrument_id(), m->client_id(), m->sim_time_s(),
-               m->stamp_ns(),         m->text() ? m->text()->str() : ""};
+  return Event{m->source_client_id(), static_cast<EventKind>(k),         m->instrument_id(), m->client_id(),  m->sim_time_s(),
+               m->stamp_ns(),         m->text() ? m->text()->str() : "", m->tick(),          m->request_seq()};
 }
 
 }  // namespace viscera::protocol

@@ -22,6 +22,12 @@ std::string short_number(double v) {
   return b;
 }
 
+std::string exact_number(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
 std::string printable(std::string_view text, std::size_t max_chars) {
   std::string out;
   for (const char c : text) {

@@ -10,13 +10,13 @@ void add_grasp(ContactResult& result, const GraspHold::Reaction& r) {
   result.in_contact = true;
 }
 
-std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance) {
+std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance, bool wait) {
   if (!r.in_contact || r.deepest_triangle[0] < 0) return r.stiffness;
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> penalty(r.stiffness.data());
   const double k_penalty = r.normal.dot(penalty * r.normal);
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
   for (int k = 0; k < 3; ++k) {
-    const auto block = compliance.node(r.deepest_triangle[k]);
+    const auto block = wait ? std::optional<Eigen::Matrix3d>(compliance.wait_node(r.deepest_triangle[k])) : compliance.node(r.deepest_triangle[k]);
     if (!block) return r.stiffness;
     C += r.deepest_weights[k] * *block;
   }
@@ -62,8 +62,9 @@ std::shared_ptr<const Snapshot> CommandResponder::latest() const {
   return snapshot_;
 }
 
-ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c) const {
+ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c, std::uint64_t* tick) const {
   const auto snap = latest();
+  if (tick) *tick = snap->tick;
   const Vec3 tip(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
   ContactResult result = queries_.at(instrument_id)->query(tip, snap->x);
   if (const auto g = snap->grasped.find(instrument_id); g != snap->grasped.end() && !g->second.empty()) {

@@ -16,14 +16,31 @@ class DdsMeshStream final : public MeshStream {
 };
 }  // namespace
 
-DdsEndpoints::DdsEndpoints(std::uint32_t domain_id)
-    : participant_(domain_id),
+DdsEndpoints::DdsEndpoints(std::uint32_t domain_id, const std::string& partition, bool lockstep)
+    : participant_(domain_id, partition),
       commands_(participant_, proto::Stream::instrument_command),
       sessions_(participant_, proto::Stream::session_request),
       forces_(participant_, proto::Stream::force_feedback),
       scene_(participant_, proto::Stream::scene_state),
       telemetry_(participant_, proto::Stream::telemetry),
-      events_(participant_, proto::Stream::event) {}
+      events_(participant_, proto::Stream::event),
+      scene_files_(participant_, proto::Stream::scene_files) {
+  if (lockstep) {
+    steps_ = std::make_unique<proto::Reader>(participant_, proto::Stream::lockstep_step);
+    results_ = std::make_unique<proto::Writer>(participant_, proto::Stream::lockstep_result);
+  }
+}
+
+int DdsEndpoints::take_steps(std::chrono::nanoseconds timeout, const std::function<void(std::span<const std::uint8_t>)>& f) {
+  if (!steps_) return 0;
+  int n = steps_->take([&](const proto::Received& r) { f(r.payload); });
+  if (n == 0 && steps_->wait(timeout)) n = steps_->take([&](const proto::Received& r) { f(r.payload); });
+  return n;
+}
+
+void DdsEndpoints::write_result(std::span<const std::uint8_t> p) {
+  if (results_) results_->write(0, p);
+}
 
 std::unique_ptr<MeshStream> DdsEndpoints::open_mesh_stream() { return std::make_unique<DdsMeshStream>(participant_); }
 

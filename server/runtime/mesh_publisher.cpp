@@ -6,6 +6,11 @@ namespace viscera::runtime {
 
 namespace proto = viscera::protocol;
 
+void copy_surface(std::span<const tissue::Vec3> x, std::span<const std::int32_t> nodes, float* out) {
+  for (const auto n : nodes)
+    for (int d = 0; d < 3; ++d) *out++ = static_cast<float>(x[n][d]);
+}
+
 MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, const proto::SurfaceTopology& topology, std::vector<std::int32_t> surface_nodes,
                              double rate_hz)
     : stream_(std::move(stream)), nodes_(std::move(surface_nodes)), mesh_id_(topology.mesh_id), period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
@@ -27,7 +32,7 @@ MeshPublisher::~MeshPublisher() {
   thread_.join();
 }
 
-void MeshPublisher::offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns) {
+void MeshPublisher::offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns, std::uint64_t tick) {
   if (now_ns < next_due_ns_) return;
   next_due_ns_ = std::max(next_due_ns_ + period_ns_, now_ns);  // steady cadence, no burst after a stall
   std::unique_lock lock(mutex_, std::try_to_lock);
@@ -36,10 +41,9 @@ void MeshPublisher::offer(std::span<const tissue::Vec3> x, double sim_time_s, st
     return;
   }
   if (ready_) ++skipped_;  // the previous snapshot was never taken: the newer one replaces it
-  float* p = pending_.positions.data();
-  for (const auto n : nodes_)
-    for (int d = 0; d < 3; ++d) *p++ = static_cast<float>(x[n][d]);
+  copy_surface(x, nodes_, pending_.positions.data());
   pending_.frame = ++offered_;
+  pending_.tick = tick;
   pending_.sim_time_s = sim_time_s;
   pending_.server_stamp_ns = now_ns;
   ready_ = true;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/mesh/refinement.hpp"
@@ -62,11 +63,10 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   organ.integrator = std::make_unique<ExplicitIntegrator>(
       *organ.model, density, bc, ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
   check_tick_budget(organ.integrator->dt_s(), 0, rate_hz, budget, source, field);
-  if (s.physics_threads > 1) {
-    organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, s.physics_threads);
-    organ.integrator->set_force_evaluation(
-        [p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return (*p)(x, f, m); });
-  }
+  // The same chunks on any number of threads: the same bits (a session re-simulates on another).
+  organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, kForceChunks);
+  organ.integrator->set_force_evaluation(
+      [p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return (*p)(x, f, m); });
   // The compliance predicts the simulated response, so it sees the same inertia.
   organ.substep_cost_s = time_substep(organ);
   check_tick_budget(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget, source, field);
@@ -107,6 +107,14 @@ std::string Organ::describe_step(double rate_hz) const {
 std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& budget) {
   auto organ = std::make_unique<Organ>();
   organ->scene = scene;
+  for (const auto& [role, path] : {std::pair{"scene", scene.source}, {"mesh", scene.mesh}, {"material", scene.material}}) {
+    try {
+      auto bytes = common::read_file_bytes(path);
+      organ->sources.push_back({role, path, protocol::sha256_hex(bytes), std::move(bytes)});
+    } catch (const InputError&) {
+      // a scene made in code (tests) has no file; the mesh and material were just read
+    }
+  }
   organ->mesh = std::make_shared<TetMesh>(read_tet_mesh(scene.mesh));
   for (int k = 0; k < scene.refine; ++k) *organ->mesh = refine_uniform(*organ->mesh);
   scale_mesh(*organ->mesh, scene.scale_m_per_unit);
@@ -124,6 +132,7 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   next->mesh = organ.mesh;
   next->bounds = organ.bounds;
   next->boundary = organ.boundary;
+  next->sources = organ.sources;
   Material& m = next->material;
   const std::string source = "set_material (material " + m.name + ")";
   if (change.youngs_modulus_pa || change.poisson_ratio) {

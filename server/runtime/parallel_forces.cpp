@@ -18,7 +18,7 @@ using tissue::ForceStats;
 using tissue::Vec3;
 
 ParallelForces::ParallelForces(const tissue::ForceModel& model, int threads, int chunks) : model_(model), chunks_(static_cast<std::size_t>(chunks)) {
-  if (threads < 2 || chunks < threads) throw std::invalid_argument("ParallelForces: needs threads >= 2 and chunks >= threads");
+  if (threads < 1 || chunks < threads) throw std::invalid_argument("ParallelForces: needs threads >= 1 and chunks >= threads");
   buffers_.assign(chunks_ - 1, std::vector<Vec3>(model.node_count()));
   stats_.resize(chunks_);
   for (int t = 1; t < threads; ++t) helpers_.emplace_back([this] { helper(); });

@@ -69,6 +69,10 @@ std::optional<std::string> SessionControl::start_material(const protocol::Sessio
   return std::nullopt;
 }
 
+void SessionControl::wait_ready() const {
+  if (preparing_) preparing_->organ.wait();
+}
+
 std::optional<Prepared> SessionControl::take_ready() {
   if (!preparing_ || !ready(preparing_->organ)) return std::nullopt;
   Prepared p{preparing_->request, preparing_->what, nullptr, {}};

@@ -9,8 +9,12 @@
 
 #include <pthread.h>
 
+#include <nlohmann/json.hpp>
+
 #include "viscera/common/input_error.hpp"
 #include "viscera/protocol/messages.hpp"
+#include "viscera/protocol/request_json.hpp"
+#include "viscera/runtime/build_info.hpp"
 #include "viscera/runtime/command_responder.hpp"
 #include "viscera/runtime/instrument_table.hpp"
 #include "viscera/runtime/mesh_publisher.hpp"
@@ -27,6 +31,11 @@ using namespace viscera::tissue;
 using common::InputError;
 using Status = std::function<void(const std::string&)>;
 
+namespace {
+/// The server's version and build: a session re-simulates bit for bit on the same build.
+std::string server_build() { return std::string("viscera-server ") + VISCERA_BUILD; }
+}  // namespace
+
 struct SimulationServer::Impl {
   // Two threads: the physics thread (run()) steps the organ at the fixed rate; the command thread
   // answers every command the moment it arrives (CommandResponder), so the round trip never waits
@@ -41,8 +50,17 @@ struct SimulationServer::Impl {
   std::mutex organ_mutex;
   State state;
   double sim_time_s = 0;
+  std::uint64_t ticks_run = 0;  // physics thread; the tick in progress (or the next) is ticks_run + 1
   std::uint32_t generation = 1;  // +1 per scene loaded: the surface's mesh_id
   bool paused = false;
+  // What the scene was loaded with and changed by since (SceneFiles, for recordings).
+  std::uint64_t scene_first_tick = 1;
+  double scene_sim_time_s = 0;
+  nlohmann::json scene_changes = nlohmann::json::array();
+  // Lockstep (run_lockstep): no wall clock, no lease, builds waited for; forces and events of the
+  // tick go into its result.
+  bool lockstep = false;
+  proto::LockstepResult* capture = nullptr;
 
   InstrumentTable instruments;  // both threads (thread-safe)
   struct Tool {  // physics thread only
@@ -58,10 +76,11 @@ struct SimulationServer::Impl {
   std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, forces_sent{0};
   ServerStats stats;  // physics thread
 
-  Impl(const SceneSpec& s, ServerEndpoints& e, std::string dir, const TickBudget& b)
+  Impl(const SceneSpec& s, ServerEndpoints& e, std::string dir, const TickBudget& b, bool lockstep_mode)
       : scene(s),
         endpoints(e),
         budget(b),
+        lockstep(lockstep_mode),
         session(
             std::move(dir), [b](const SceneSpec& spec) { return std::shared_ptr<Organ>(build_organ(spec, b)); },
             [b](const std::shared_ptr<const Organ>& current, const proto::MaterialChange& change, double rate_hz) {
@@ -69,7 +88,11 @@ struct SimulationServer::Impl {
             }) {
     adopt(build_organ(s, budget), true);
     publish_scene();
+    publish_scene_files();
   }
+
+  /// The tick in progress, or between ticks the next one.
+  std::uint64_t current_tick() const { return ticks_run + 1; }
 
   // --- The organ ----------------------------------------------------------------------------
 
@@ -98,14 +121,17 @@ struct SimulationServer::Impl {
         responder.set_instruments(scene.instruments, organ->boundary.triangles, organ->mesh->nodes, scene.contact_stiffness_n_per_m);
         state = State::at_rest(*organ->mesh);
         if (old) ++generation;
+        scene_first_tick = current_tick();
+        scene_sim_time_s = sim_time_s;
+        scene_changes = nlohmann::json::array();
       } else {
         scene.physics_rate_hz = rate;  // a set_physics_rate outlives a material change
         if (state.memory.size() != organ->model->memory_size()) state.memory.clear();  // relaxed
       }
-      publish_snapshot();
+      publish_snapshot(ticks_run);
     }
     for (const auto& o : released) event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "the scene was replaced by " + scene.name);
-    if (new_scene) {
+    if (new_scene && !lockstep) {
       if (mesh_publisher) {
         mesh_frames_before += mesh_publisher->frames_published();
         mesh_skipped_before += mesh_publisher->frames_skipped();
@@ -174,30 +200,61 @@ struct SimulationServer::Impl {
     endpoints.write_scene(proto::encode(sc));
   }
 
-  /// A session event for recorders, trainers and consoles (physics thread).
-  void event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text = {}) {
-    endpoints.write_event(proto::encode(proto::Event{0, kind, instrument_id, client_id, sim_time_s, proto::now_ns(), std::move(text)}));
+  /// What it takes to re-run the scene (recordings): its files, the server's build and settings,
+  /// the material and rate changes since it was loaded, its first tick.
+  void publish_scene_files() {
+    proto::SceneFiles f;
+    f.generation = generation;
+    f.server_version = server_build();
+    f.files = organ->sources;
+    f.first_tick = scene_first_tick;
+    f.sim_time_s = scene_sim_time_s;
+    const nlohmann::json settings = {{"max_tick_ms", 1e3 * budget.max_tick_s},
+                                     {"scene_dir", session.scene_dir()},
+                                     {"physics_rate_hz", scene.physics_rate_hz},
+                                     {"changes", scene_changes}};
+    f.settings_json = settings.dump();
+    endpoints.write_scene_files(proto::encode(f));
   }
 
-  /// After a tick (physics thread): the command thread answers from this state from now on.
-  void publish_snapshot() {
+  /// A session event for recorders, trainers and consoles (physics thread), stamped with the tick
+  /// in progress (the request it concludes, if any).
+  void event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text = {}, std::uint64_t request_seq = 0) {
+    auto payload =
+        proto::encode(proto::Event{0, kind, instrument_id, client_id, sim_time_s, proto::now_ns(), std::move(text), current_tick(), request_seq});
+    if (capture)
+      capture->events.push_back(std::move(payload));
+    else
+      endpoints.write_event(payload);
+  }
+
+  /// After tick `tick` (physics thread): the command thread answers from this state from now on.
+  void publish_snapshot(std::uint64_t tick) {
     auto snap = std::make_shared<Snapshot>();
+    snap->tick = tick;
     snap->x = state.x;
     for (const auto& [id, t] : tools)
       if (!t.tool.held().empty()) snap->grasped[id] = t.tool.held();
     responder.publish(std::move(snap));
   }
 
-  void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns) {
-    endpoints.write_force(id,
-                          proto::encode(force_message(id, owner, command, r, local_stiffness(r, *organ->compliance), proto::now_ns(), step_time_ns)));
+  /// `tick`: the tick that stepped with the command, or whose state answered it.
+  void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns,
+                     std::uint64_t tick) {
+    proto::Force f = force_message(id, owner, command, r, local_stiffness(r, *organ->compliance, lockstep), proto::now_ns(), step_time_ns);
+    f.tick = tick;
+    auto payload = proto::encode(f);
+    if (capture)
+      capture->forces.push_back(std::move(payload));
+    else
+      endpoints.write_force(id, payload);
     ++forces_sent;
   }
 
   /// After a tick: every active tool's force, and its contact and grasp events.
   void publish_forces(std::int64_t step_time_ns) {
     for (auto& [id, t] : tools) {
-      if (t.tool.active()) publish_force(id, t.tool.owner(), t.tool.command(), t.result, step_time_ns);
+      if (t.tool.active()) publish_force(id, t.tool.owner(), t.tool.command(), t.result, std::max<std::int64_t>(step_time_ns, 1), current_tick());
       if (const ToolEvent e = t.tool.update_contact(t.result.in_contact, sim_time_s); e != ToolEvent::none)
         event(e == ToolEvent::contact_started ? proto::EventKind::contact_started : proto::EventKind::contact_ended, id, t.tool.owner());
     }
@@ -229,7 +286,55 @@ struct SimulationServer::Impl {
         case CommandResult::unknown_instrument: ++rejected_unknown_instrument; break;
       }
     });
-    for (const auto& u : updated) publish_force(u.id, u.owner, u.command, responder.answer(u.id, u.command), 0);
+    for (const auto& u : updated) {
+      std::uint64_t tick = 0;
+      const ContactResult r = responder.answer(u.id, u.command, &tick);
+      publish_force(u.id, u.owner, u.command, r, 0, tick);
+    }
+  }
+
+  /// Lockstep: the step's answers, on the state the previous tick left (as the command thread
+  /// answers them live); they do not become the instruments' commands.
+  void answer_in_lockstep(const std::vector<std::vector<std::uint8_t>>& answers) {
+    for (const auto& payload : answers) {
+      std::string why;
+      const auto c = proto::decode_command(payload, &why);
+      if (!c) {
+        ++rejected_malformed;
+        continue;
+      }
+      const auto owner = instruments.owner(c->instrument_id);
+      if (!owner) {
+        ++rejected_unknown_instrument;
+        continue;
+      }
+      if (*owner != c->client_id) {
+        ++rejected_not_owner;
+        continue;
+      }
+      std::uint64_t tick = 0;
+      const ContactResult r = responder.answer(c->instrument_id, *c, &tick);
+      publish_force(c->instrument_id, c->client_id, *c, r, 0, tick);
+    }
+  }
+
+  /// Lockstep: the step's commands become their instruments' newest (the live command thread's
+  /// other half).
+  void command_in_lockstep(const std::vector<std::vector<std::uint8_t>>& commands) {
+    for (const auto& payload : commands) {
+      std::string why;
+      const auto c = proto::decode_command(payload, &why);
+      if (!c) {
+        ++rejected_malformed;
+        continue;
+      }
+      switch (instruments.command(*c, 0)) {
+        case CommandResult::accepted:
+        case CommandResult::stale: break;
+        case CommandResult::not_owner: ++rejected_not_owner; break;
+        case CommandResult::unknown_instrument: ++rejected_unknown_instrument; break;
+      }
+    }
   }
 
   // --- Session requests (physics thread) -----------------------------------------------------
@@ -237,11 +342,11 @@ struct SimulationServer::Impl {
   /// Claim and release an instrument (its owner only); pause, resume and reset the organ, load a
   /// scene, change the material or the physics rate (any client: an instructor's console or a
   /// trainer).
-  void take_sessions(const Status& status) {
+  void take_sessions(const Status& status, const proto::LockstepStep* step) {
     bool changed = false;
-    endpoints.take_session_requests([&](const proto::Received& r) {
+    const auto take = [&](std::span<const std::uint8_t> payload) {
       std::string why;
-      const auto req = proto::decode_session_request(r.payload, &why);
+      const auto req = proto::decode_session_request(payload, &why);
       if (!req) {
         ++rejected_malformed;
         return;
@@ -268,6 +373,7 @@ struct SimulationServer::Impl {
           control(*req, status);
           changed = true;
           return;
+        case proto::Action::seek: conclude(*req, false, "seek: a live session cannot seek (replayers only: viscera-replay play)", status); return;
         case proto::Action::claim_instrument:
           // The scene state lists the instruments and their owners: a client sees there at once
           // that an instrument does not exist or is taken (Client::claim says which).
@@ -292,7 +398,11 @@ struct SimulationServer::Impl {
           }
           return;
       }
-    });
+    };
+    if (step)
+      for (const auto& payload : step->requests) take(payload);
+    else
+      endpoints.take_session_requests([&](const proto::Received& r) { take(r.payload); });
     if (changed) publish_scene();
   }
 
@@ -322,8 +432,10 @@ struct SimulationServer::Impl {
     if (status) status("client " + std::to_string(req.client_id) + " asked for " + session.preparing() + "; preparing it");
   }
 
-  /// Physics thread, between ticks: a prepared scene or material that is ready replaces the organ.
+  /// Physics thread, between ticks: a prepared scene or material that is ready replaces the organ
+  /// (in lockstep, once it is ready: the tick that asked for it uses it).
   void finish_preparing(const Status& status) {
+    if (lockstep) session.wait_ready();
     auto done = session.take_ready();
     if (!done) return;
     const bool new_scene = done->request.action == proto::Action::load_scene;
@@ -341,14 +453,20 @@ struct SimulationServer::Impl {
   /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
   void conclude(const proto::SessionRequest& req, bool accepted, const std::string& message, const Status& status) {
     session.record(req, accepted, message);
+    if (accepted && req.action != proto::Action::load_scene) {
+      nlohmann::json change = proto::to_json(req);
+      change["tick"] = current_tick();
+      scene_changes.push_back(std::move(change));
+    }
     const proto::EventKind kind = !accepted                                   ? proto::EventKind::request_refused
                                   : req.action == proto::Action::load_scene   ? proto::EventKind::scene_loaded
                                   : req.action == proto::Action::set_material ? proto::EventKind::material_changed
                                                                               : proto::EventKind::physics_rate_changed;
-    event(kind, 0, req.client_id, message.substr(0, 1000));
+    event(kind, 0, req.client_id, message.substr(0, 1000), req.request_seq);
     if (status)
       status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + (accepted ? "" : "refused: ") + message);
     publish_scene();
+    if (accepted) publish_scene_files();
   }
 
   /// A client that died or went silent for longer than the lease loses its instrument, which is
@@ -368,11 +486,15 @@ struct SimulationServer::Impl {
   /// Session requests, a finished build, the lease; then the organ stepped by 1/rate with each
   /// owned instrument's newest command; then the snapshot, the forces and a surface frame.
   /// Returns the step's duration [ns].
-  std::int64_t tick(const Status& status) {
-    take_sessions(status);
+  /// In lockstep (`step`), the requests and commands are the step's, and no lease runs out.
+  std::int64_t tick(const Status& status, const proto::LockstepStep* step = nullptr) {
+    take_sessions(status, step);
     finish_preparing(status);
     const double dt = 1.0 / scene.physics_rate_hz;  // session control may change it
-    release_silent(status);
+    if (step)
+      command_in_lockstep(step->commands);
+    else
+      release_silent(status);
     for (const TickCommand& c : instruments.tick_commands()) tools.at(c.instrument_id).tool.begin_tick(c.active, c.owner, c.command);
     const auto t0 = std::chrono::steady_clock::now();
     if (!paused) {
@@ -396,11 +518,48 @@ struct SimulationServer::Impl {
       }
     }
     const auto step_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
-    publish_snapshot();
+    publish_snapshot(current_tick());
     publish_forces(step_ns);
-    if (mesh_publisher) mesh_publisher->offer(state.x, sim_time_s, proto::now_ns());
+    if (mesh_publisher) mesh_publisher->offer(state.x, sim_time_s, proto::now_ns(), current_tick());
+    ++ticks_run;
     ++stats.ticks;
     return step_ns;
+  }
+
+  /// The surface after the last tick, as the mesh publisher sends it.
+  std::vector<std::uint8_t> surface_frame() const {
+    proto::MeshFrame f;
+    f.mesh_id = generation;
+    f.frame = ticks_run;
+    f.sim_time_s = sim_time_s;
+    f.server_stamp_ns = proto::now_ns();
+    f.tick = ticks_run;
+    f.positions.resize(3 * organ->boundary.nodes.size());
+    copy_surface(state.x, organ->boundary.nodes, f.positions.data());
+    return proto::encode(f);
+  }
+
+  /// Lockstep: one step from the driver, and its result.
+  proto::LockstepResult lockstep_tick(const proto::LockstepStep& step, bool first, const Status& status) {
+    proto::LockstepResult result;
+    result.tick = step.tick;
+    if (first) {  // the recording's clock: its tick numbers and simulated time
+      ticks_run = step.tick - 1;
+      sim_time_s = step.sim_time_s;
+      scene_first_tick = step.tick;
+      scene_sim_time_s = sim_time_s;
+      publish_snapshot(ticks_run);
+    } else if (step.tick != current_tick()) {
+      result.error = "step for tick " + std::to_string(step.tick) + ", expected tick " + std::to_string(current_tick());
+      return result;
+    }
+    capture = &result;
+    answer_in_lockstep(step.answers);
+    tick(status, &step);
+    capture = nullptr;
+    result.sim_time_s = sim_time_s;
+    if (step.want_frame) result.frame = surface_frame();
+    return result;
   }
 
   /// The counters the other threads keep, into stats.
@@ -425,13 +584,14 @@ struct SimulationServer::Impl {
   }
 };
 
-SimulationServer::SimulationServer(const SceneSpec& scene, ServerEndpoints& endpoints, const std::string& scene_dir, const TickBudget& budget)
+SimulationServer::SimulationServer(const SceneSpec& scene, ServerEndpoints& endpoints, const std::string& scene_dir, const TickBudget& budget,
+                                   bool lockstep)
     : impl_(std::make_unique<Impl>(scene, endpoints,
                                    !scene_dir.empty() ? scene_dir
                                    : std::filesystem::path(scene.source).has_parent_path()
                                        ? std::filesystem::path(scene.source).parent_path().string()
                                        : std::string("."),
-                                   budget)) {}
+                                   budget, lockstep)) {}
 SimulationServer::~SimulationServer() = default;
 
 int SimulationServer::abandoned_work() { return SessionControl::abandoned(); }
@@ -442,6 +602,29 @@ std::string SimulationServer::describe() const {
                 impl_->organ->mesh->node_count(), impl_->organ->mesh->tet_count(), std::string(impl_->organ->model->name()).c_str(),
                 impl_->tools.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
   return b + impl_->organ->describe_step(impl_->scene.physics_rate_hz);
+}
+
+ServerStats SimulationServer::run_lockstep(const std::atomic<bool>& stop, LockstepLink& link, const Status& status) {
+  Impl& s = *impl_;
+  s.stop = &stop;
+  bool first = true;
+  while (!stop.load()) {
+    link.take_steps(std::chrono::milliseconds(50), [&](std::span<const std::uint8_t> payload) {
+      std::string why;
+      const auto step = proto::decode_lockstep_step(payload, &why);
+      proto::LockstepResult result;
+      if (!step) {
+        ++s.rejected_malformed;
+        result.error = "not a lockstep step: " + why;
+      } else {
+        result = s.lockstep_tick(*step, first, status);
+        first = first && !result.error.empty();
+      }
+      link.write_result(proto::encode(result));
+    });
+  }
+  s.collect_counts();
+  return s.stats;
 }
 
 ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration_s, const Status& status) {

@@ -36,16 +36,20 @@ int main(int argc, char** argv) {
       "and serves instruments over Cyclone DDS (domain from the scene; configuration from CYCLONEDDS_URI, see\n"
       "deploy/cyclonedds.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n"
       "Clients may load another scene of the scene directory, change the material or the physics rate while it runs\n"
-      "(viscera-control; docs/PROTOCOL.md).");
+      "(viscera-control; docs/PROTOCOL.md). With --lockstep it runs no clock of its own: a driver (viscera-replay\n"
+      "resimulate) sends each tick and reads what it produced (docs/RECORDING.md).");
   cl.flag("scene", "FILE", "scene file (required)");
   cl.flag("scene-dir", "DIR", "scenes that clients may load by name (default: the scene file's directory)");
   cl.flag("duration", "S", "stop after S seconds; 0 runs until signalled", "0");
   cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "100");
+  cl.flag("partition", "NAME", "DDS partition of every stream (default: none; a replay or a re-simulation uses its own)", "");
+  cl.option_switch("lockstep", "ticks advance when a driver says so (deterministic; no tick budget unless --max-tick-ms is given)");
   cl.option_switch("quiet", "no status lines");
   std::string scene, scene_dir;
   double duration = 0;
   viscera::runtime::TickBudget budget;
-  bool quiet = false;
+  bool quiet = false, lockstep = false;
+  std::string partition;
   try {
     if (!cl.parse(argc, argv)) return 0;
     scene = cl.text("scene");
@@ -56,6 +60,9 @@ int main(int argc, char** argv) {
     duration = cl.number_in("duration", 0.0, 1e9);
     budget.max_tick_s = 1e-3 * cl.number_in("max-tick-ms", 0.1, 10000);
     quiet = cl.has("quiet");
+    lockstep = cl.has("lockstep");
+    partition = cl.text("partition");
+    if (lockstep && !cl.given("max-tick-ms")) budget.max_tick_s = 1e9;  // no real time to keep
   } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
     return 2;
@@ -69,17 +76,18 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
     const viscera::runtime::SceneSpec spec = viscera::runtime::read_scene_file(scene);
-    viscera::runtime::DdsEndpoints endpoints(spec.domain_id);
-    auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget);
-    std::printf("viscera-server: %s\n", server->describe().c_str());
+    viscera::runtime::DdsEndpoints endpoints(spec.domain_id, partition, lockstep);
+    auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget, lockstep);
+    std::printf("viscera-server: %s%s\n", lockstep ? "lockstep, " : "", server->describe().c_str());
     std::fflush(stdout);
     g_running = true;
-    const auto stats = server->run(g_stop, duration, [&](const std::string& line) {
+    const auto status = [&](const std::string& line) {
       if (!quiet) {
         std::printf("viscera-server: %s\n", line.c_str());
         std::fflush(stdout);
       }
-    });
+    };
+    const auto stats = lockstep ? server->run_lockstep(g_stop, endpoints, status) : server->run(g_stop, duration, status);
     std::printf(
         "viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected "
         "(malformed %llu, not owner %llu, unknown instrument %llu), %llu mesh frames\n",

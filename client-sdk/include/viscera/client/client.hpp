@@ -40,7 +40,9 @@ struct LatencyStats {
 
 class Client {
  public:
-  Client(std::uint32_t domain_id, std::uint32_t client_id);
+  /// `partition`: the DDS partition to work in ("" : the default, where live servers are; a replay
+  /// publishes in a partition of its own, viscera-replay --partition).
+  Client(std::uint32_t domain_id, std::uint32_t client_id, const std::string& partition = {});
   ~Client();
 
   /// Waits for the server's scene state (published reliably, transient local).

@@ -27,17 +27,28 @@ enum class Stream {
   surface_topology,  ///< reliable, keep last 1 per key, transient local (late joiners get it)
   mesh_frame,  ///< reliable, keep last 1 per key, volatile (slow readers skip frames)
   event,  ///< reliable, keep last 64, volatile (server events and client annotations)
+  // schema 7:
+  scene_files,  ///< reliable, keep last 1, transient local (what the scene was built from)
+  lockstep_step,  ///< reliable, keep all, volatile (a lockstep driver's ticks)
+  lockstep_result,  ///< reliable, keep all, volatile (what each lockstep tick produced)
 };
-constexpr int kStreamCount = 8;
+constexpr int kStreamCount = 11;
 
 /// The liveliness lease of every writer: a client or server silent this long is gone. The server
 /// also releases the instruments of an owner silent this long.
 inline constexpr std::chrono::milliseconds kLivelinessLease{500};
+/// The DDS topic ("viscera_force_feedback") and the stream's own name ("force_feedback").
 const char* topic_name(Stream s);
+const char* stream_name(Stream s);
+/// The stream with that name; false if there is none.
+bool parse_stream(const std::string& name, Stream* out);
 
 class Participant {
  public:
-  explicit Participant(std::uint32_t domain_id);
+  /// `partition`: the DDS partition of every reader and writer made on it ("" : the default). A
+  /// replay runs in a partition of its own, so it never drives a live server's instruments.
+  explicit Participant(std::uint32_t domain_id, std::string partition = {});
+  const std::string& partition() const { return partition_; }
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
@@ -48,6 +59,7 @@ class Participant {
  private:
   int32_t handle_;
   int32_t topics_[kStreamCount] = {};
+  std::string partition_;
 };
 
 struct Received {
@@ -55,6 +67,13 @@ struct Received {
   std::uint64_t seq;
   std::int64_t stamp_ns;
   std::span<const std::uint8_t> payload;  ///< valid during the callback only
+  std::uint64_t writer = 0;  ///< the writing DDS entity (its instance handle), for counting its sequence gaps
+};
+
+/// A reader's history, for a reader that must keep every sample (a recorder) rather than the
+/// stream's own (keep last 1 for the 1 kHz streams).
+struct ReaderOptions {
+  int history_depth = 0;  ///< > 0: keep the last N per key; 0: the stream's history
 };
 
 class Writer {
@@ -79,7 +98,7 @@ class Writer {
 
 class Reader {
  public:
-  Reader(Participant& p, Stream s);
+  Reader(Participant& p, Stream s, ReaderOptions options = {});
   ~Reader();
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
@@ -101,7 +120,7 @@ class Reader {
   std::function<void(int)> on_alive_;
 };
 
-/// Monotonic clock in nanoseconds (the stamps of the protocol).
+/// The stamps of the protocol: wall-clock time in nanoseconds since the Unix epoch (dds_time).
 std::int64_t now_ns();
 
 }  // namespace viscera::protocol

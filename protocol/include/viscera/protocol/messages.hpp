@@ -32,6 +32,9 @@ struct Force {
   Vector3 contact_point{}, contact_normal{};
   std::array<double, 9> stiffness{};  ///< row-major [N/m]
   double penetration_m = 0;  ///< [m] tip depth in the tissue (added in schema 2)
+  /// schema 7: the tick that stepped with the command (step_time_ns > 0), or whose state answered
+  /// it at once (step_time_ns 0); 0 from older servers
+  std::uint64_t tick = 0;
 };
 
 enum class Action : std::int8_t {
@@ -42,7 +45,8 @@ enum class Action : std::int8_t {
   reset = 4,
   load_scene = 5,
   set_material = 6,
-  set_physics_rate = 7  // schema 3
+  set_physics_rate = 7,  // schema 3
+  seek = 8  // schema 7: replayers only
 };
 const char* action_name(Action a);
 
@@ -61,6 +65,7 @@ struct SessionRequest {
   std::string scene_name;  ///< load_scene: [A-Za-z0-9._-], at most 64, not starting with '.'
   MaterialChange material;  ///< set_material: at least one parameter
   double physics_rate_hz = 0;  ///< set_physics_rate: [10, 10000]
+  double seek_s = 0;  ///< seek (schema 7): [s] from the recording's start, >= 0
 };
 
 struct InstrumentInfo {
@@ -131,6 +136,7 @@ struct MeshFrame {
   double sim_time_s = 0;
   std::int64_t server_stamp_ns = 0;
   std::vector<float> positions;  ///< [m] 3 per vertex
+  std::uint64_t tick = 0;  ///< schema 7: the tick after which it was taken
 };
 
 enum class EventKind : std::int8_t {
@@ -161,7 +167,45 @@ struct Event {
   double sim_time_s = 0;
   std::int64_t stamp_ns = 0;
   std::string text;  ///< at most 1024 bytes
+  std::uint64_t tick = 0;  ///< schema 7: the tick at whose start it took effect (server events)
+  std::uint64_t request_seq = 0;  ///< schema 7: the session request it concludes (0: none)
 };
+
+/// A file the server built its organ from (schema 7).
+struct LoadedFile {
+  std::string role;  ///< scene | mesh | material
+  std::string path, sha256;
+  std::vector<std::uint8_t> content;
+};
+
+/// What it takes to run the current scene again (schema 7).
+struct SceneFiles {
+  std::uint32_t generation = 0;
+  std::string server_version, settings_json;
+  std::vector<LoadedFile> files;
+  std::uint64_t first_tick = 0;  ///< the scene's first tick
+  double sim_time_s = 0;  ///< [s] at the scene's first tick's start
+};
+
+/// One lockstep tick asked for (schema 7): session requests and commands as their payloads.
+struct LockstepStep {
+  std::uint64_t tick = 0;
+  double sim_time_s = 0;  ///< the first step only: the simulated time at its start
+  std::vector<std::vector<std::uint8_t>> requests, commands, answers;
+  bool want_frame = false;
+};
+
+/// What a lockstep tick produced: payloads of forces and events, the frame if asked.
+struct LockstepResult {
+  std::uint64_t tick = 0;
+  double sim_time_s = 0;
+  std::vector<std::vector<std::uint8_t>> forces, events;
+  std::vector<std::uint8_t> frame;  ///< empty: none
+  std::string error;
+};
+
+/// The protocol's schema version: what this build writes and the newest it reads.
+inline constexpr int kSchemaVersion = 7;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);
@@ -171,6 +215,9 @@ std::vector<std::uint8_t> encode(const TelemetryReport& t);
 std::vector<std::uint8_t> encode(const SurfaceTopology& t);
 std::vector<std::uint8_t> encode(const MeshFrame& m);
 std::vector<std::uint8_t> encode(const Event& e);
+std::vector<std::uint8_t> encode(const SceneFiles& f);
+std::vector<std::uint8_t> encode(const LockstepStep& s);
+std::vector<std::uint8_t> encode(const LockstepResult& r);
 
 std::optional<Command> decode_command(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::string* why);
@@ -182,5 +229,13 @@ std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint
 /// count matches the topology of its mesh_id is the receiver's check (it holds the topology).
 std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, std::string* why);
 std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::string* why);
+/// Checks each file's digest against its content.
+std::optional<SceneFiles> decode_scene_files(std::span<const std::uint8_t> bytes, std::string* why);
+/// The payloads inside are not decoded here (each has its own decoder).
+std::optional<LockstepStep> decode_lockstep_step(std::span<const std::uint8_t> bytes, std::string* why);
+std::optional<LockstepResult> decode_lockstep_result(std::span<const std::uint8_t> bytes, std::string* why);
+
+/// SHA-256 of bytes, as 64 lowercase hex digits (OpenSSL's libcrypto).
+std::string sha256_hex(std::span<const std::uint8_t> bytes);
 
 }  // namespace viscera::protocol

@@ -31,7 +31,10 @@ class CommandLine {
   /// Parses argv. Returns false if --help was given (help already printed to stdout).
   bool parse(int argc, char** argv);
 
+  /// Given on the command line, or declared with a default.
   bool has(const std::string& name) const;
+  /// Given on the command line (a default does not count).
+  bool given(const std::string& name) const { return values_.count(name) > 0; }
   std::string text(const std::string& name) const;
   double number(const std::string& name) const;
   /// A number that must satisfy lo <= v <= hi.

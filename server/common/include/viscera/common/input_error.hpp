@@ -24,6 +24,8 @@ class InputError : public std::runtime_error {
 
 /// A number for messages: six significant digits ("1e+300", "0.0123", "inf").
 std::string short_number(double v);
+/// A number that reads back as the same double (17 significant digits).
+std::string exact_number(double v);
 /// Text from a file for messages: at most `max_chars` characters, bytes that are not printable
 /// ASCII shown as \xNN, "..." when cut.
 std::string printable(std::string_view text, std::size_t max_chars = 40);

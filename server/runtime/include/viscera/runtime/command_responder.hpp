@@ -21,6 +21,7 @@ namespace viscera::runtime {
 
 /// The organ after a tick and the tissue each grasper holds; never changed once published.
 struct Snapshot {
+  std::uint64_t tick = 0;  ///< the tick after which it was taken
   std::vector<Vec3> x;
   std::map<std::uint32_t, GraspHold> grasped;
 };
@@ -30,8 +31,9 @@ void add_grasp(ContactResult& result, const GraspHold::Reaction& reaction);
 
 /// The local force model's stiffness: the contact penalty in series with the tissue condensed onto
 /// the contact, along the contact normal (the contact is frictionless); the penalty alone (an upper
-/// bound) until the tissue's compliance at the contact is known.
-std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance);
+/// bound) until the tissue's compliance at the contact is known; with `wait`, it waits for it
+/// (lockstep: the same bits whenever the compliance worker is done).
+std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance, bool wait = false);
 
 /// The force message answering `command` of `owner`'s instrument.
 protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, const protocol::Command& command, const ContactResult& r,
@@ -46,8 +48,9 @@ class CommandResponder {
   /// Physics thread, after each tick.
   void publish(std::shared_ptr<const Snapshot> snapshot);
   std::shared_ptr<const Snapshot> latest() const;
-  /// Command thread: the reaction on `instrument_id` at the commanded pose on the newest snapshot.
-  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command) const;
+  /// Command thread: the reaction on `instrument_id` at the commanded pose on the newest snapshot
+  /// (`tick`, if given, gets the snapshot's tick).
+  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command, std::uint64_t* tick = nullptr) const;
 
  private:
   std::map<std::uint32_t, std::unique_ptr<ProbeContact>> queries_;

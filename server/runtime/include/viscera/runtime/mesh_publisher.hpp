@@ -19,6 +19,9 @@
 
 namespace viscera::runtime {
 
+/// The surface vertices' positions as frames carry them: x, y, z of node `nodes[k]` at out[3k..3k+2].
+void copy_surface(std::span<const tissue::Vec3> x, std::span<const std::int32_t> nodes, float* out);
+
 class MeshPublisher {
  public:
   /// `surface_nodes[k]` is the mesh node of surface vertex k; `triangles` index surface vertices.
@@ -28,8 +31,8 @@ class MeshPublisher {
   MeshPublisher(const MeshPublisher&) = delete;
   MeshPublisher& operator=(const MeshPublisher&) = delete;
 
-  /// Physics thread: hands over a snapshot if one is due at `now_ns`; never blocks.
-  void offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns);
+  /// Physics thread: hands over the state after `tick` if a frame is due at `now_ns`; never blocks.
+  void offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns, std::uint64_t tick);
   std::uint64_t frames_published() const;
   /// Frames that were due while the publisher was still writing the previous one.
   std::uint64_t frames_skipped() const { return skipped_; }

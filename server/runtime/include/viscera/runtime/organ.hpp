@@ -23,11 +23,14 @@ struct Organ {
   tissue::Box bounds;
   tissue::BoundarySurface boundary;
   std::unique_ptr<tissue::ForceModel> model;
-  std::unique_ptr<ParallelForces> parallel_forces;  ///< scene physics_threads > 1; used by the integrator
+  std::unique_ptr<ParallelForces> parallel_forces;  ///< on the scene's physics_threads, kForceChunks chunks; used by the integrator
   std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
   std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
   /// One explicit sub-step of this organ on this machine [s] (the median of five, timed when built).
   double substep_cost_s = 0;
+  /// The scene, mesh and material files it was built from, as read when it was built (what a
+  /// recording keeps to re-run the session); a file that could not be read again is left out.
+  std::vector<protocol::LoadedFile> sources;
 
   /// The material as the scene state shows it.
   protocol::MaterialInfo material_info() const;

@@ -3,7 +3,10 @@
 // of chunks; the calling thread computes chunk 0 straight into the force array, and it and the
 // helper threads take the other chunks as they come, each into the chunk's own buffer. The
 // buffers are added after in chunk order, so the forces are the same bit for bit whichever thread
-// computed which chunk (deterministic; they differ from one-thread evaluation only by rounding).
+// computed which chunk, and for any number of threads with the same chunks (deterministic; they
+// differ from ForceModel::add_forces in one piece only by rounding). One thread takes every chunk
+// itself: the server always evaluates in kForceChunks chunks, so that a session re-simulated on
+// another number of threads gives the same bits (docs/RECORDING.md).
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
 // calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
 // caller, waiting for a helper's chunk, spins briefly and then sleeps.
@@ -16,9 +19,12 @@
 
 namespace viscera::runtime {
 
+/// The chunks the server cuts the elements into, whatever its number of threads (at most this).
+inline constexpr int kForceChunks = 8;
+
 class ParallelForces {
  public:
-  /// `threads` >= 2 (the calling thread and threads - 1 helpers); `chunks` >= threads.
+  /// `threads` >= 1 (the calling thread and threads - 1 helpers); `chunks` >= threads.
   ParallelForces(const tissue::ForceModel& model, int threads, int chunks = 4);
   ~ParallelForces();
   ParallelForces(const ParallelForces&) = delete;

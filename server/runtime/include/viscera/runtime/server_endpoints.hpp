@@ -1,12 +1,14 @@
 #pragma once
 // What the server reads from its clients and writes to them, as payloads (FlatBuffers, verified
-// by the server). DdsEndpoints is the real one, over Cyclone DDS (protocol/); a test or a lockstep
-// driver passes its own, so the server's logic runs without a network.
+// by the server). DdsEndpoints is the real one, over Cyclone DDS (protocol/); a test passes its
+// own, so the server's logic runs without a network. In lockstep a driver sends the ticks and
+// reads what each produced through a LockstepLink.
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
+#include <string>
 
 #include "viscera/protocol/dds.hpp"
 
@@ -34,13 +36,25 @@ class ServerEndpoints {
   virtual void write_scene(std::span<const std::uint8_t> payload) = 0;
   virtual void write_telemetry(std::span<const std::uint8_t> payload) = 0;
   virtual void write_event(std::span<const std::uint8_t> payload) = 0;
+  /// The files the organ was built from (schema 7, SceneFiles).
+  virtual void write_scene_files(std::span<const std::uint8_t> payload) = 0;
   virtual std::unique_ptr<MeshStream> open_mesh_stream() = 0;
 };
 
-/// The server's endpoints on a DDS domain: one participant, the streams' QoS of docs/PROTOCOL.md.
-class DdsEndpoints final : public ServerEndpoints {
+/// A lockstep driver's ticks (LockstepStep payloads) and the server's answers (LockstepResult).
+class LockstepLink {
  public:
-  explicit DdsEndpoints(std::uint32_t domain_id);
+  virtual ~LockstepLink() = default;
+  /// Calls `f` for each step that arrived within `timeout`, in the order sent; returns how many.
+  virtual int take_steps(std::chrono::nanoseconds timeout, const std::function<void(std::span<const std::uint8_t>)>& f) = 0;
+  virtual void write_result(std::span<const std::uint8_t> payload) = 0;
+};
+
+/// The server's endpoints on a DDS domain: one participant in one partition ("" : the default),
+/// the streams' QoS of docs/PROTOCOL.md; with `lockstep`, also the lockstep streams.
+class DdsEndpoints final : public ServerEndpoints, public LockstepLink {
+ public:
+  explicit DdsEndpoints(std::uint32_t domain_id, const std::string& partition = {}, bool lockstep = false);
   int take_commands(const Take& f) override { return commands_.take(f); }
   bool wait_commands(std::chrono::nanoseconds timeout) override { return commands_.wait(timeout); }
   int take_session_requests(const Take& f) override { return sessions_.take(f); }
@@ -48,12 +62,18 @@ class DdsEndpoints final : public ServerEndpoints {
   void write_scene(std::span<const std::uint8_t> p) override { scene_.write(0, p); }
   void write_telemetry(std::span<const std::uint8_t> p) override { telemetry_.write(0, p); }
   void write_event(std::span<const std::uint8_t> p) override { events_.write(0, p); }
+  void write_scene_files(std::span<const std::uint8_t> p) override { scene_files_.write(0, p); }
   std::unique_ptr<MeshStream> open_mesh_stream() override;
+  /// Lockstep only (constructed with `lockstep`).
+  int take_steps(std::chrono::nanoseconds timeout, const std::function<void(std::span<const std::uint8_t>)>& f) override;
+  void write_result(std::span<const std::uint8_t> p) override;
 
  private:
   protocol::Participant participant_;
   protocol::Reader commands_, sessions_;
-  protocol::Writer forces_, scene_, telemetry_, events_;
+  protocol::Writer forces_, scene_, telemetry_, events_, scene_files_;
+  std::unique_ptr<protocol::Reader> steps_;
+  std::unique_ptr<protocol::Writer> results_;
 };
 
 }  // namespace viscera::runtime

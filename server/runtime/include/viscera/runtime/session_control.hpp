@@ -50,6 +50,8 @@ class SessionControl {
   std::optional<std::string> start_material(const protocol::SessionRequest& request, std::shared_ptr<const Organ> current, double rate_hz);
   /// The finished build, if any (never blocks).
   std::optional<Prepared> take_ready();
+  /// Blocks until the build in progress, if any, has finished (lockstep).
+  void wait_ready() const;
   /// What is being built ("" when nothing).
   std::string preparing() const { return preparing_ ? preparing_->what : std::string(); }
 

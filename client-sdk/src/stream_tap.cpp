@@ -1,0 +1,64 @@
+#include "viscera/client/stream_tap.hpp"
+
+#include <map>
+
+namespace viscera::client {
+
+namespace proto = viscera::protocol;
+
+std::vector<proto::Stream> session_streams() {
+  return {proto::Stream::instrument_command, proto::Stream::force_feedback, proto::Stream::session_request,
+          proto::Stream::scene_state,        proto::Stream::telemetry,      proto::Stream::surface_topology,
+          proto::Stream::mesh_frame,         proto::Stream::event,          proto::Stream::scene_files};
+}
+
+struct StreamTap::Impl {
+  proto::Participant participant;
+  std::vector<std::pair<proto::Stream, std::unique_ptr<proto::Reader>>> readers;
+  Impl(std::uint32_t domain, const std::string& partition) : participant(domain, partition) {}
+};
+
+StreamTap::StreamTap(std::uint32_t domain_id, const std::string& partition, const std::vector<proto::Stream>& streams, int depth)
+    : impl_(std::make_unique<Impl>(domain_id, partition)) {
+  for (const proto::Stream s : streams) {
+    // The streams whose history is their state (kept last per key) keep it; the others keep `depth`.
+    const bool state = s == proto::Stream::scene_state || s == proto::Stream::surface_topology || s == proto::Stream::scene_files;
+    impl_->readers.emplace_back(s, std::make_unique<proto::Reader>(impl_->participant, s, proto::ReaderOptions{state ? 0 : depth}));
+  }
+}
+
+StreamTap::~StreamTap() = default;
+
+void StreamTap::wait(std::chrono::milliseconds timeout) {
+  // Each reader has a wait set of its own: waiting on the first bounds the others' latency by the
+  // timeout, which callers keep to a few milliseconds.
+  if (!impl_->readers.empty()) impl_->readers.front().second->wait(timeout);
+}
+
+int StreamTap::take(const std::function<void(const TapSample&)>& f) {
+  int n = 0;
+  for (auto& [stream, reader] : impl_->readers)
+    n += reader->take([&, s = stream](const proto::Received& r) { f({s, r.source_id, r.seq, r.stamp_ns, r.writer, r.payload}); });
+  return n;
+}
+
+struct StreamPublisher::Impl {
+  proto::Participant participant;
+  std::map<proto::Stream, std::unique_ptr<proto::Writer>> writers;
+  Impl(std::uint32_t domain, const std::string& partition) : participant(domain, partition) {}
+};
+
+StreamPublisher::StreamPublisher(std::uint32_t domain_id, const std::string& partition) : impl_(std::make_unique<Impl>(domain_id, partition)) {}
+StreamPublisher::~StreamPublisher() = default;
+
+void StreamPublisher::publish(proto::Stream stream, std::uint32_t source_id, std::span<const std::uint8_t> payload) {
+  auto& w = impl_->writers[stream];
+  if (!w) w = std::make_unique<proto::Writer>(impl_->participant, stream);
+  w->write(source_id, payload);
+}
+
+void StreamPublisher::wait_for_readers(std::chrono::milliseconds timeout) {
+  for (auto& [stream, w] : impl_->writers) w->wait_for_readers(timeout);
+}
+
+}  // namespace viscera::client

@@ -1,0 +1,272 @@
+// The MCAP writer and reader against the specification's own check values and against each
+// other's independent halves: what is written is read back whole (every message, in order, on its
+// channel), chunk by chunk through the summary's index as through the data section; a file cut at
+// any byte gives exactly the messages of its complete chunks, and recover() makes it whole; a
+// damaged byte is found by the CRCs. (The official reader, @mcap/core, judges the files in the
+// integration test tests/integration/recording_test.sh.)
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "viscera/common/file_bytes.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/mcap/compression.hpp"
+#include "viscera/mcap/mcap_reader.hpp"
+#include "viscera/mcap/mcap_writer.hpp"
+
+namespace {
+
+using namespace viscera::mcap;
+namespace fs = std::filesystem;
+
+struct TempDir {
+  fs::path path;
+  TempDir() : path(fs::temp_directory_path() / ("viscera-mcap-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++))) {
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+  static int& counter() {
+    static int n = 0;
+    return n;
+  }
+};
+
+/// A payload whose bytes depend on (channel, k): any mix-up shows.
+std::vector<std::uint8_t> payload(int channel, int k, std::size_t size) {
+  std::vector<std::uint8_t> p(size);
+  for (std::size_t i = 0; i < size; ++i) p[i] = static_cast<std::uint8_t>(channel * 31 + k * 7 + static_cast<int>(i) * 13);
+  return p;
+}
+
+struct Written {
+  std::vector<Message> messages;  // in the order written
+  int chunks_expected_at_least = 0;
+};
+
+/// Three channels on two schemas, `n` messages each at 1 kHz of log time, of mixed sizes.
+Written write_file(const std::string& path, const std::string& compression, int n, std::size_t chunk_bytes) {
+  WriterOptions o;
+  o.compression = compression;
+  o.chunk_bytes = chunk_bytes;
+  o.profile = "test";
+  McapWriter w(path, o);
+  const auto s1 = w.add_schema("a.A", "flatbuffer", {1, 2, 3});
+  const auto s2 = w.add_schema("b.B", "flatbuffer", {4, 5});
+  const std::uint16_t ch[3] = {w.add_channel(s1, "/a", "flatbuffer", {{"source_id", "1"}}),
+                               w.add_channel(s1, "/a", "flatbuffer", {{"source_id", "2"}}), w.add_channel(s2, "/b", "flatbuffer")};
+  Written out;
+  std::size_t bytes = 0;
+  for (int k = 0; k < n; ++k)
+    for (int c = 0; c < 3; ++c) {
+      Message m{ch[c], static_cast<std::uint32_t>(k), 1'000'000'000ull + 1'000'000ull * static_cast<std::uint64_t>(k),
+                777ull + static_cast<std::uint64_t>(k), payload(c, k, 16 + static_cast<std::size_t>((k * 37 + c * 101) % 900))};
+      w.add_message(m.channel_id, m.sequence, m.log_time, m.publish_time, m.data);
+      bytes += m.data.size() + 31;
+      out.messages.push_back(std::move(m));
+    }
+  w.add_attachment({5, 6, "scene/liver.json", "application/json", {'{', '}'}});
+  w.add_metadata({"viscera.test", {{"k", "v"}, {"n", std::to_string(n)}}});
+  w.close();
+  out.chunks_expected_at_least = static_cast<int>(bytes / chunk_bytes);
+  return out;
+}
+
+std::vector<Message> read_all(const std::string& path, DataEnd* end = nullptr) {
+  McapReader r(path);
+  std::vector<Message> got;
+  DataVisitor v;
+  v.message = [&](const Message& m) { got.push_back(m); };
+  const DataEnd e = r.read_data(v);
+  if (end) *end = e;
+  return got;
+}
+
+void expect_same(const std::vector<Message>& a, const std::vector<Message>& b, std::size_t n) {
+  ASSERT_GE(a.size(), n);
+  ASSERT_GE(b.size(), n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(a[i].channel_id, b[i].channel_id) << i;
+    ASSERT_EQ(a[i].sequence, b[i].sequence) << i;
+    ASSERT_EQ(a[i].log_time, b[i].log_time) << i;
+    ASSERT_EQ(a[i].publish_time, b[i].publish_time) << i;
+    ASSERT_EQ(a[i].data, b[i].data) << i;
+  }
+}
+
+TEST(Crc32, MatchesTheStandardCheckValue) {
+  // CRC-32/ISO-HDLC (zlib's, MCAP's) of "123456789" is 0xCBF43926 (the catalogue's check value).
+  const std::string s = "123456789";
+  EXPECT_EQ(crc32(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()), 0xCBF43926u);
+  // Updating in pieces gives the same.
+  std::uint32_t c = crc32_update(kCrc32Init, reinterpret_cast<const std::uint8_t*>(s.data()), 4);
+  c = crc32_update(c, reinterpret_cast<const std::uint8_t*>(s.data()) + 4, 5);
+  EXPECT_EQ(crc32_final(c), 0xCBF43926u);
+}
+
+TEST(Compression, ZstdAndLz4RoundTripAndRefuseAWrongSize) {
+  const auto data = payload(3, 9, 100000);
+  for (const std::string c : {"zstd", "lz4", ""}) {
+    const auto packed = compress(c, data);
+    EXPECT_EQ(decompress(c, packed, data.size()), data) << c;
+    EXPECT_THROW(decompress(c, packed, data.size() + 1), FormatError) << c;
+  }
+  EXPECT_THROW(compress("gzip", data), std::invalid_argument);
+}
+
+TEST(McapFile, EveryMessageReadsBackInOrderThroughTheDataSectionAndTheChunkIndex) {
+  for (const std::string compression : {"zstd", "lz4", ""}) {
+    TempDir dir;
+    const std::string path = dir.file("a.mcap");
+    const Written w = write_file(path, compression, 600, 64 * 1024);
+    DataEnd end;
+    const auto got = read_all(path, &end);
+    EXPECT_TRUE(end.complete) << end.error;
+    ASSERT_EQ(got.size(), w.messages.size());
+    expect_same(got, w.messages, got.size());
+
+    McapReader r(path);
+    EXPECT_EQ(r.profile(), "test");
+    const auto s = r.summary();
+    ASSERT_TRUE(s) << compression;
+    ASSERT_TRUE(s->statistics);
+    EXPECT_EQ(s->statistics->message_count, w.messages.size());
+    EXPECT_EQ(s->statistics->channel_count, 3u);
+    EXPECT_EQ(s->statistics->schema_count, 2);
+    EXPECT_EQ(s->statistics->message_start_time, w.messages.front().log_time);
+    EXPECT_EQ(s->statistics->message_end_time, w.messages.back().log_time);
+    for (const auto& [channel, count] : s->statistics->channel_message_counts) EXPECT_EQ(count, 600u) << channel;
+    EXPECT_GE(static_cast<int>(s->chunks.size()), w.chunks_expected_at_least);
+    EXPECT_EQ(s->statistics->chunk_count, s->chunks.size());
+    ASSERT_EQ(s->channels.size(), 3u);
+    EXPECT_EQ(s->channels[1].metadata.at("source_id"), "2");
+    // Chunk by chunk through the index: the same messages, each chunk's log times within its bounds.
+    std::vector<Message> by_chunk;
+    for (const auto& c : s->chunks) {
+      EXPECT_EQ(c.compression, compression);
+      for (auto& m : r.read_chunk(c)) {
+        EXPECT_GE(m.log_time, c.start_time);
+        EXPECT_LE(m.log_time, c.end_time);
+        by_chunk.push_back(std::move(m));
+      }
+    }
+    ASSERT_EQ(by_chunk.size(), w.messages.size());
+    expect_same(by_chunk, w.messages, by_chunk.size());
+    ASSERT_EQ(s->attachments.size(), 1u);
+    const Attachment a = r.read_attachment(s->attachments[0]);
+    EXPECT_EQ(a.name, "scene/liver.json");
+    EXPECT_EQ(a.data, (std::vector<std::uint8_t>{'{', '}'}));
+    ASSERT_EQ(s->metadata.size(), 1u);
+    EXPECT_EQ(r.read_metadata(s->metadata[0]).values.at("n"), "600");
+  }
+}
+
+TEST(McapFile, AFileCutAtAnyByteGivesTheMessagesOfItsCompleteChunksAndRecoverMakesItWhole) {
+  TempDir dir;
+  const std::string path = dir.file("whole.mcap");
+  const Written w = write_file(path, "zstd", 300, 16 * 1024);
+  const auto bytes = viscera::common::read_file_bytes(path);
+  McapReader whole(path);
+  const auto summary = whole.summary();
+  ASSERT_TRUE(summary);
+  DataEnd whole_end;
+  read_all(path, &whole_end);
+  const std::uint64_t data_end = whole_end.offset + 9 + 4;  // Data End: opcode, length, CRC
+  // Messages up to the end of each chunk, from the index (independent of read_data).
+  std::vector<std::pair<std::uint64_t, std::size_t>> chunk_ends;  // (end offset, messages so far)
+  std::size_t so_far = 0;
+  for (const auto& c : summary->chunks) {
+    so_far += whole.read_chunk(c).size();
+    chunk_ends.emplace_back(c.offset + c.length, so_far);
+  }
+  std::mt19937 rng(7);
+  std::vector<std::size_t> cuts = {9,
+                                   20,
+                                   static_cast<std::size_t>(chunk_ends[0].first),
+                                   static_cast<std::size_t>(chunk_ends[0].first) + 1,
+                                   static_cast<std::size_t>(data_end) - 1,
+                                   static_cast<std::size_t>(data_end),
+                                   bytes.size() - 1};
+  for (int k = 0; k < 12; ++k) cuts.push_back(std::uniform_int_distribution<std::size_t>(30, bytes.size() - 40)(rng));
+  for (const std::size_t cut : cuts) {
+    const std::string part = dir.file("cut.mcap");
+    viscera::common::write_file_bytes(part, std::span<const std::uint8_t>(bytes).first(cut));
+    std::size_t expected = 0;
+    for (const auto& [end, n] : chunk_ends)
+      if (end <= cut) expected = n;
+    if (cut < 8 + 9 + 4) {  // not even a whole header
+      EXPECT_THROW(McapReader{part}, viscera::common::InputError);
+      continue;
+    }
+    DataEnd end;
+    const auto got = read_all(part, &end);
+    if (cut >= data_end) {  // only the summary is cut: the data section is whole
+      EXPECT_TRUE(end.complete) << cut;
+      expected = w.messages.size();
+    } else {
+      EXPECT_FALSE(end.complete) << cut;
+      EXPECT_FALSE(end.error.empty()) << cut;
+    }
+    EXPECT_EQ(got.size(), expected) << "cut at byte " << cut;
+    expect_same(got, w.messages, got.size());
+    EXPECT_FALSE(McapReader(part).summary()) << cut;  // no footer: no summary
+    const std::string fixed = dir.file("fixed.mcap");
+    const DataEnd r = recover(part, fixed);
+    EXPECT_EQ(r.messages, expected);
+    DataEnd fixed_end;
+    const auto again = read_all(fixed, &fixed_end);
+    EXPECT_TRUE(fixed_end.complete) << fixed_end.error;
+    ASSERT_EQ(again.size(), expected);
+    expect_same(again, w.messages, expected);
+    const auto s = McapReader(fixed).summary();
+    ASSERT_TRUE(s);
+    EXPECT_EQ(s->statistics->message_count, expected);
+  }
+}
+
+TEST(McapFile, ADamagedByteIsFoundByTheCrcs) {
+  TempDir dir;
+  const std::string path = dir.file("a.mcap");
+  write_file(path, "", 200, 16 * 1024);  // uncompressed: a flipped byte stays a valid stream
+  auto bytes = viscera::common::read_file_bytes(path);
+  McapReader whole(path);
+  const auto summary = whole.summary();
+  ASSERT_TRUE(summary && summary->chunks.size() >= 3);
+  // A byte in the middle of the second chunk's records.
+  const auto& c = summary->chunks[1];
+  bytes[static_cast<std::size_t>(c.offset + c.length / 2)] ^= 0x40;
+  const std::string damaged = dir.file("damaged.mcap");
+  viscera::common::write_file_bytes(damaged, bytes);
+  DataEnd end;
+  read_all(damaged, &end);
+  EXPECT_FALSE(end.complete);
+  EXPECT_NE(end.error.find("CRC"), std::string::npos) << end.error;
+  EXPECT_EQ(end.chunks, 1u);
+  McapReader r(damaged);
+  EXPECT_THROW(r.read_chunk(r.summary()->chunks[1]), viscera::common::InputError);
+  // A byte of the summary: its CRC.
+  auto tail = viscera::common::read_file_bytes(path);
+  tail[tail.size() - 40] ^= 0x01;
+  const std::string bad_summary = dir.file("bad-summary.mcap");
+  viscera::common::write_file_bytes(bad_summary, tail);
+  EXPECT_THROW(McapReader(bad_summary).summary(), viscera::common::InputError);
+}
+
+TEST(McapFile, NotAnMcapFileIsOneClearErrorNamingTheFile) {
+  TempDir dir;
+  const std::string path = dir.file("notes.mcap");
+  std::ofstream(path) << "these are not the bytes you are looking for";
+  try {
+    McapReader r(path);
+    FAIL() << "accepted";
+  } catch (const viscera::common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("not an MCAP file"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(McapReader(dir.path.string()), viscera::common::InputError);  // a directory
+  EXPECT_THROW(McapReader(dir.file("missing.mcap")), viscera::common::InputError);
+}
+
+}  // namespace

@@ -1,0 +1,217 @@
+// Lockstep (SimulationServer::run_lockstep): the same steps give the same bits, run after run and
+// on one physics thread or two; a change of one command by a micrometre shows (the comparison can
+// fail); and the steps do what they say: the claim, the press, the material change and the pause
+// take effect at the ticks named, with the recording's clock. The whole server in one process,
+// its endpoints in memory.
+#include <cstring>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "viscera/protocol/messages.hpp"
+#include "viscera/runtime/scene_file.hpp"
+#include "viscera/runtime/simulation_server.hpp"
+
+#include "memory_endpoints.hpp"
+
+namespace viscera::runtime {
+namespace {
+
+namespace proto = viscera::protocol;
+using testing::MemoryEndpoints;
+using testing::MemoryLockstepLink;
+
+constexpr std::uint64_t kFirstTick = 1001;  // a recording's clock: not the server's own 1
+constexpr double kFirstSimTime = 1.0;
+constexpr int kTicks = 400;
+
+/// Press down on the organ's top at 1 kHz; change the material at +150, pause at +250 and resume
+/// at +260; a frame every 20 ticks. `nudge_at`: the tick whose command is moved by 1 um.
+std::vector<proto::LockstepStep> script(const proto::Scene& scene, std::uint64_t nudge_at = 0) {
+  const double cx = 0.5 * (scene.bounds_min[0] + scene.bounds_max[0]), cy = 0.5 * (scene.bounds_min[1] + scene.bounds_max[1]);
+  const double z0 = scene.bounds_max[2] + 0.002;
+  std::vector<proto::LockstepStep> steps;
+  proto::LockstepStep first;
+  first.tick = kFirstTick;
+  first.sim_time_s = kFirstSimTime;
+  first.requests.push_back(proto::encode(proto::SessionRequest{7, proto::Action::claim_instrument, 1}));
+  steps.push_back(first);
+  for (int k = 1; k <= kTicks; ++k) {
+    proto::LockstepStep s;
+    s.tick = kFirstTick + static_cast<std::uint64_t>(k);
+    proto::Command c;
+    c.instrument_id = 1;
+    c.client_id = 7;
+    c.seq = static_cast<std::uint64_t>(k);
+    c.client_stamp_ns = 1000 * k;
+    c.tip_position = {cx, cy, z0 - 0.02 * k / kTicks};
+    if (s.tick == nudge_at) c.tip_position[0] += 1e-6;
+    s.commands.push_back(proto::encode(c));
+    s.answers.push_back(proto::encode(c));
+    if (k == 150) {
+      proto::SessionRequest r{8, proto::Action::set_material, 0, 1};
+      r.material.youngs_modulus_pa = 7000;
+      s.requests.push_back(proto::encode(r));
+    }
+    if (k == 250) s.requests.push_back(proto::encode(proto::SessionRequest{8, proto::Action::pause, 0, 2}));
+    if (k == 260) s.requests.push_back(proto::encode(proto::SessionRequest{8, proto::Action::resume, 0, 3}));
+    s.want_frame = k % 20 == 0;
+    steps.push_back(s);
+  }
+  return steps;
+}
+
+struct LockstepRun {
+  std::vector<proto::LockstepResult> results;
+  proto::Scene scene;
+};
+
+/// One lockstep server on `threads` physics threads, through the steps of script().
+LockstepRun run(int threads, std::uint64_t nudge_at = 0) {
+  SceneSpec spec = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  spec.physics_threads = threads;
+  MemoryEndpoints endpoints;
+  MemoryLockstepLink link;
+  SimulationServer server(spec, endpoints, {}, {}, true);
+  LockstepRun r;
+  r.scene = endpoints.decoded<proto::Scene>(endpoints.scenes, proto::decode_scene).back();
+  std::atomic<bool> stop{false};
+  std::thread t([&] { server.run_lockstep(stop, link, {}); });
+  const auto steps = script(r.scene, nudge_at);
+  for (const auto& s : steps) link.push_step(s);
+  r.results = link.wait_results(steps.size(), std::chrono::seconds(300));
+  stop = true;
+  t.join();
+  return r;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+template <std::size_t N>
+bool same_bits(const std::array<double, N>& a, const std::array<double, N>& b) {
+  return std::memcmp(a.data(), b.data(), sizeof(double) * N) == 0;
+}
+
+/// The first difference between two runs, "" if none: every force (all but the wall-clock
+/// stamps), every event (all but its text and stamp), every frame (positions to the bit).
+std::string first_difference(const LockstepRun& a, const LockstepRun& b) {
+  if (a.results.size() != b.results.size()) return "result counts differ";
+  std::string why;
+  for (std::size_t i = 0; i < a.results.size(); ++i) {
+    const auto& x = a.results[i];
+    const auto& y = b.results[i];
+    const std::string at = "tick " + std::to_string(x.tick) + ": ";
+    if (x.tick != y.tick || !same_bits(x.sim_time_s, y.sim_time_s) || x.error != y.error) return at + "clock or error";
+    if (x.forces.size() != y.forces.size()) return at + "force counts";
+    for (std::size_t k = 0; k < x.forces.size(); ++k) {
+      const auto f = proto::decode_force(x.forces[k], &why), g = proto::decode_force(y.forces[k], &why);
+      if (!f || !g) return at + "undecodable force";
+      if (f->instrument_id != g->instrument_id || f->command_seq != g->command_seq || f->tick != g->tick ||
+          (f->step_time_ns > 0) != (g->step_time_ns > 0) || f->in_contact != g->in_contact || !same_bits(f->force, g->force) ||
+          !same_bits(f->torque, g->torque) || !same_bits(f->contact_point, g->contact_point) || !same_bits(f->contact_normal, g->contact_normal) ||
+          !same_bits(f->stiffness, g->stiffness) || !same_bits(f->penetration_m, g->penetration_m))
+        return at + "force " + std::to_string(k);
+    }
+    if (x.events.size() != y.events.size()) return at + "event counts";
+    for (std::size_t k = 0; k < x.events.size(); ++k) {
+      const auto e = proto::decode_event(x.events[k], &why), h = proto::decode_event(y.events[k], &why);
+      if (!e || !h || e->kind != h->kind || e->tick != h->tick || e->request_seq != h->request_seq || !same_bits(e->sim_time_s, h->sim_time_s))
+        return at + "event " + std::to_string(k);
+    }
+    if (x.frame.empty() != y.frame.empty()) return at + "frame presence";
+    if (!x.frame.empty()) {
+      const auto m = proto::decode_mesh_frame(x.frame, &why), n = proto::decode_mesh_frame(y.frame, &why);
+      if (!m || !n || m->tick != n->tick || !same_bits(m->sim_time_s, n->sim_time_s) || m->positions.size() != n->positions.size() ||
+          std::memcmp(m->positions.data(), n->positions.data(), m->positions.size() * sizeof(float)) != 0)
+        return at + "frame";
+    }
+  }
+  return "";
+}
+
+TEST(Lockstep, TheSameStepsGiveTheSameBitsOnOneThreadAndOnTwoAndANudgedCommandShows) {
+  const LockstepRun a = run(1), again = run(1), two = run(2);
+  ASSERT_EQ(a.results.size(), static_cast<std::size_t>(kTicks + 1));
+  EXPECT_EQ(first_difference(a, again), "");
+  EXPECT_EQ(first_difference(a, two), "");
+  const LockstepRun nudged = run(1, kFirstTick + 200);
+  const std::string d = first_difference(a, nudged);
+  EXPECT_NE(d, "");
+  // The nudged command is answered before tick +200 and stepped in it: the difference shows there.
+  EXPECT_EQ(d.rfind("tick " + std::to_string(kFirstTick + 200) + ":", 0), 0u) << d;
+}
+
+TEST(Lockstep, StepsTakeEffectAtTheTicksTheyNameOnTheRecordingsClock) {
+  const LockstepRun a = run(1);
+  ASSERT_EQ(a.results.size(), static_cast<std::size_t>(kTicks + 1));
+  std::string why;
+  std::size_t in_contact = 0, answers = 0, stepped = 0;
+  std::vector<proto::Event> events;
+  for (const auto& r : a.results) {
+    EXPECT_EQ(r.error, "") << r.tick;
+    for (const auto& p : r.forces) {
+      const auto f = proto::decode_force(p, &why);
+      ASSERT_TRUE(f) << why;
+      in_contact += f->in_contact;
+      // A stepped force carries its own tick; an answer the tick whose state answered it (the one before).
+      if (f->step_time_ns > 0) {
+        ++stepped;
+        EXPECT_EQ(f->tick, r.tick);
+      } else {
+        ++answers;
+        EXPECT_EQ(f->tick, r.tick - 1);
+      }
+    }
+    for (const auto& p : r.events) events.push_back(*proto::decode_event(p, &why));
+  }
+  EXPECT_EQ(stepped, static_cast<std::size_t>(kTicks));  // from the tick after the claim: one per tick
+  EXPECT_EQ(answers, static_cast<std::size_t>(kTicks));
+  EXPECT_GT(in_contact, 200u);
+  const auto find = [&](proto::EventKind k) -> const proto::Event* {
+    for (const auto& e : events)
+      if (e.kind == k) return &e;
+    return nullptr;
+  };
+  ASSERT_TRUE(find(proto::EventKind::instrument_claimed));
+  EXPECT_EQ(find(proto::EventKind::instrument_claimed)->tick, kFirstTick);
+  ASSERT_TRUE(find(proto::EventKind::material_changed));  // built before the tick went on
+  EXPECT_EQ(find(proto::EventKind::material_changed)->tick, kFirstTick + 150);
+  EXPECT_EQ(find(proto::EventKind::material_changed)->request_seq, 1u);
+  ASSERT_TRUE(find(proto::EventKind::paused));
+  EXPECT_EQ(find(proto::EventKind::paused)->tick, kFirstTick + 250);
+  // Simulated time: 1 ms a tick from the recording's 1 s, none while paused (+250 .. +259).
+  const double dt = 1.0 / a.scene.physics_rate_hz;
+  EXPECT_NEAR(a.results.back().sim_time_s, kFirstSimTime + (kTicks + 1 - 10) * dt, 1e-9);
+  // The organ deformed: the last frame is not the first.
+  const proto::LockstepResult* first_frame = nullptr;
+  for (const auto& r : a.results)
+    if (!r.frame.empty() && !first_frame) first_frame = &r;
+  ASSERT_TRUE(first_frame);
+  const auto f0 = proto::decode_mesh_frame(first_frame->frame, &why), f1 = proto::decode_mesh_frame(a.results.back().frame, &why);
+  ASSERT_TRUE(f0 && f1);
+  EXPECT_EQ(f1->tick, kFirstTick + kTicks);
+  double moved = 0;
+  for (std::size_t i = 0; i < f0->positions.size(); ++i) moved = std::max(moved, static_cast<double>(std::abs(f1->positions[i] - f0->positions[i])));
+  EXPECT_GT(moved, 1e-3);
+}
+
+TEST(Lockstep, AStepForAnotherTickIsRefusedWithItsReason) {
+  SceneSpec spec = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  MemoryEndpoints endpoints;
+  MemoryLockstepLink link;
+  SimulationServer server(spec, endpoints, {}, {}, true);
+  std::atomic<bool> stop{false};
+  std::thread t([&] { server.run_lockstep(stop, link, {}); });
+  link.push_step({5, 0.0, {}, {}, {}, false});
+  link.push_step({7, 0.0, {}, {}, {}, false});  // 6 expected
+  link.push_step({6, 0.0, {}, {}, {}, false});
+  const auto results = link.wait_results(3, std::chrono::seconds(60));
+  stop = true;
+  t.join();
+  ASSERT_EQ(results.size(), 3u);
+  EXPECT_EQ(results[0].error, "");
+  EXPECT_NE(results[1].error.find("expected tick 6"), std::string::npos) << results[1].error;
+  EXPECT_EQ(results[2].error, "");
+}
+
+}  // namespace
+}  // namespace viscera::runtime
