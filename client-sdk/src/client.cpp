@@ -171,6 +171,13 @@ std::optional<proto::RequestOutcome> Client::set_physics_rate(double rate_hz, st
   return request(std::move(r), timeout);
 }
 
+std::optional<proto::RequestOutcome> Client::seek(double seconds, std::chrono::milliseconds timeout) {
+  proto::SessionRequest r;
+  r.action = proto::Action::seek;
+  r.seek_s = seconds;
+  return request(std::move(r), timeout);
+}
+
 void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad) {
   proto::Command c;
   c.instrument_id = instrument_id;

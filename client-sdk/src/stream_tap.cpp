@@ -51,14 +51,23 @@ struct StreamPublisher::Impl {
 StreamPublisher::StreamPublisher(std::uint32_t domain_id, const std::string& partition) : impl_(std::make_unique<Impl>(domain_id, partition)) {}
 StreamPublisher::~StreamPublisher() = default;
 
-void StreamPublisher::publish(proto::Stream stream, std::uint32_t source_id, std::span<const std::uint8_t> payload) {
+void StreamPublisher::open(proto::Stream stream) {
   auto& w = impl_->writers[stream];
   if (!w) w = std::make_unique<proto::Writer>(impl_->participant, stream);
-  w->write(source_id, payload);
+}
+
+void StreamPublisher::publish(proto::Stream stream, std::uint32_t source_id, std::span<const std::uint8_t> payload) {
+  open(stream);
+  impl_->writers[stream]->write(source_id, payload);
 }
 
 void StreamPublisher::wait_for_readers(std::chrono::milliseconds timeout) {
-  for (auto& [stream, w] : impl_->writers) w->wait_for_readers(timeout);
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  for (auto& [stream, w] : impl_->writers) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return;
+    w->wait_for_readers(left);
+  }
 }
 
 }  // namespace viscera::client

@@ -26,6 +26,7 @@ const T* verified(std::span<const std::uint8_t> bytes, const char* identifier, s
 flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<fb::Payload>>> payloads(flatbuffers::FlatBufferBuilder& b,
                                                                                     const std::vector<std::vector<std::uint8_t>>& items) {
   std::vector<flatbuffers::Offset<fb::Payload>> out;
+  out.reserve(items.size());
   for (const auto& p : items) out.push_back(fb::CreatePayload(b, b.CreateVector(p)));
   return b.CreateVector(out);
 }

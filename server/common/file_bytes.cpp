@@ -10,6 +10,7 @@ namespace viscera::common {
 
 namespace {
 struct Close {
+  // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): the deleter of the unique_ptr that owns the file
   void operator()(std::FILE* f) const { std::fclose(f); }
 };
 }  // namespace

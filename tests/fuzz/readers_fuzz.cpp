@@ -1,6 +1,6 @@
 // libFuzzer target for every reader of a file a user edits or hands over: scene, material,
-// data set (its dataset.json and its CSV), fitted model, and the Gmsh, legacy VTK and VTU mesh
-// readers. Whatever the bytes, a reader returns or throws InputError (one line naming the file);
+// data set (its dataset.json and its CSV), fitted model, the Gmsh, legacy VTK and VTU mesh
+// readers, and the MCAP reader of session recordings. Whatever the bytes, a reader returns or throws InputError (one line naming the file);
 // any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan +
 // UBSan by tests/fuzz/run_fuzz.sh).
 //
@@ -17,6 +17,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/lab/dataset.hpp"
+#include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
@@ -49,11 +50,24 @@ const char* kDatasetJson =
         "tests": [{"file": "a.csv", "control": "strain"}, {"file": "b.csv", "control": "stress"}]})";
 const char* kCsv = "time_s,strain,stress_pa\n0,0,0\n1,0.01,10\n2,0.02,21\n";
 
+// A session recording as the replayer and `viscera-record info` read it: the summary and every
+// chunk, attachment and metadata record it indexes; then the data section walked as `recover`
+// walks it, into a new file.
+void read_mcap(const std::string& path) {
+  viscera::mcap::McapReader reader(path);
+  if (const auto summary = reader.summary()) {
+    for (const auto& c : summary->chunks) (void)reader.read_chunk(c);
+    for (const auto& a : summary->attachments) (void)reader.read_attachment(a);
+    for (const auto& m : summary->metadata) (void)reader.read_metadata(m);
+  }
+  (void)viscera::mcap::recover(path, (folder() / "recovered.mcap").string());
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  const std::uint8_t pick = data[0] % 9;
+  const std::uint8_t pick = data[0] % 10;
   ++data;
   --size;
   using namespace viscera;
@@ -78,6 +92,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)lab::read_dataset(folder().string());
         break;
       case 8: (void)common::parse_json(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"); break;
+      case 9: read_mcap(write("session.mcap", data, size)); break;
     }
   } catch (const common::InputError&) {
     // the one error a reader may give

@@ -16,7 +16,7 @@ rm -rf "$out/seeds-decoders"; mkdir -p "$out/corpus-decoders"
 "$out/decoders_fuzz" -max_total_time="$seconds" -print_final_stats=1 "$out/corpus-decoders" "$out/seeds-decoders" 2>&1 | tail -8
 
 # Readers: the first byte picks the reader (readers_fuzz.cpp), the rest is the shipped file.
-seeds="$out/seeds-readers"; rm -rf "$seeds"; mkdir -p "$seeds" "$out/corpus-readers"
+seeds="$out/seeds-readers"; rm -rf "$seeds" "$out/seeds-mcap"; mkdir -p "$seeds" "$out/corpus-readers"
 seed() {  # selector file
   { printf "\\$(printf '%03o' "$1")"; head -c 200000 "$2"; } > "$seeds/$1-$(basename "$2")"
 }
@@ -27,6 +27,8 @@ seed 4 "$src/data/meshes/heart_imstk-unity.vtk"
 seed 5 "$src/data/meshes/volumetricTongue0.vtu"
 seed 6 "$src/data/titin-passive-muscle/dataset.json"
 for f in "$src"/data/titin-passive-muscle/*.csv; do seed 7 "$f"; done
+"$out/mcap_seeds" "$out/seeds-mcap"
+for f in "$out"/seeds-mcap/*.mcap; do seed 9 "$f"; done
 printf '\002{"model": "m", "fitted_to": "d", "units": "SI", "mechanisms": ["broadband_relaxation", "strain_stiffening"], "modulus_pa": 1000, "viscosity_pa_s": 10, "relaxation_time_s": [0.1, 10], "relaxation_modulus_pa": [100, 50], "stiffening_b": 3}' > "$seeds/2-model.json"
 "$out/readers_fuzz" -max_total_time="$seconds" -max_len=262144 -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
   "$out/corpus-readers" "$seeds" 2>&1 | tail -8

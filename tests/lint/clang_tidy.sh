@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # clang-tidy with the project's .clang-tidy (its findings are errors) on the C++ sources changed in
-# the last COMMITS commits (default 10, a landing; "all" for every source, about 15 minutes on two cores).
+# the last COMMITS commits (default 3, the work just landed; "all" for every source, about 15 minutes on two cores).
 # Usage: clang_tidy.sh BUILD_DIR SOURCE_DIR [COMMITS|all]
 set -u
-build="$1"; src="$2"; range="${3:-10}"
+build="$1"; src="$2"; range="${3:-3}"
 cd "$src" || exit 2
 [ -f "$build/compile_commands.json" ] || { echo "clang_tidy: $build/compile_commands.json missing (configure first)"; exit 2; }
 if [ "$range" = all ] || ! git rev-parse -q --verify "HEAD~$range" > /dev/null; then

@@ -4,6 +4,7 @@
 // any byte gives exactly the messages of its complete chunks, and recover() makes it whole; a
 // damaged byte is found by the CRCs. (The official reader, @mcap/core, judges the files in the
 // integration test tests/integration/recording_test.sh.)
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -112,8 +113,29 @@ TEST(Compression, ZstdAndLz4RoundTripAndRefuseAWrongSize) {
     const auto packed = compress(c, data);
     EXPECT_EQ(decompress(c, packed, data.size()), data) << c;
     EXPECT_THROW(decompress(c, packed, data.size() + 1), FormatError) << c;
+    EXPECT_THROW(decompress(c, packed, data.size() - 1), FormatError) << c;
   }
   EXPECT_THROW(compress("gzip", data), std::invalid_argument);
+}
+
+TEST(Compression, AForgedSizeCostsNoMemoryAndIsNamed) {
+  // A chunk whose header claims 1 GiB but holds 100 kB: refused with both sizes, at once (the
+  // output grows with what decompresses; the fuzzer found the 4 GiB allocation this replaced).
+  const auto data = payload(4, 9, 100000);
+  for (const std::string c : {"zstd", "lz4"}) {
+    const auto packed = compress(c, data);
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      (void)decompress(c, packed, kMaxChunkBytes);
+      ADD_FAILURE() << c << ": accepted";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("decompressed to 100000 bytes, its header says 1073741824"), std::string::npos) << e.what();
+    }
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0) << c;
+    EXPECT_THROW(decompress(c, packed, kMaxChunkBytes + 1), FormatError) << c;
+    // Cut short: the frame is incomplete.
+    EXPECT_THROW(decompress(c, std::span(packed).first(packed.size() / 2), data.size()), FormatError) << c;
+  }
 }
 
 TEST(McapFile, EveryMessageReadsBackInOrderThroughTheDataSectionAndTheChunkIndex) {

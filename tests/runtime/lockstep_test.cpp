@@ -3,6 +3,8 @@
 // fail); and the steps do what they say: the claim, the press, the material change and the pause
 // take effect at the ticks named, with the recording's clock. The whole server in one process,
 // its endpoints in memory.
+#include <bit>
+#include <cstdint>
 #include <cstring>
 #include <thread>
 
@@ -85,10 +87,12 @@ LockstepRun run(int threads, std::uint64_t nudge_at = 0) {
   return r;
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
 template <std::size_t N>
 bool same_bits(const std::array<double, N>& a, const std::array<double, N>& b) {
-  return std::memcmp(a.data(), b.data(), sizeof(double) * N) == 0;
+  for (std::size_t i = 0; i < N; ++i)
+    if (!same_bits(a[i], b[i])) return false;
+  return true;
 }
 
 /// The first difference between two runs, "" if none: every force (all but the wall-clock

@@ -380,7 +380,7 @@ DataEnd recover(const std::string& in, const std::string& out, const std::string
   v.message = [&](const Message& m) { writer.add_message(channel_id.at(m.channel_id), m.sequence, m.log_time, m.publish_time, m.data); };
   v.attachment = [&](const Attachment& a) { writer.add_attachment(a); };
   v.metadata = [&](const Metadata& m) { writer.add_metadata(m); };
-  const DataEnd end = reader.read_data(v);
+  DataEnd end = reader.read_data(v);
   writer.close();
   return end;
 }

@@ -13,7 +13,7 @@ std::uint8_t op(Opcode o) { return static_cast<std::uint8_t>(o); }
 McapWriter::McapWriter(const std::string& path, WriterOptions options) : path_(path), options_(std::move(options)) {
   if (!options_.compression.empty() && options_.compression != "zstd" && options_.compression != "lz4")
     throw std::invalid_argument("compression '" + options_.compression + "' is not zstd, lz4 or none");
-  file_ = std::fopen(path.c_str(), "wb");
+  file_ = std::unique_ptr<std::FILE, CloseFile>(std::fopen(path.c_str(), "wb"));
   if (!file_) throw std::runtime_error(path + ": cannot create the file");
   ByteWriter w;
   w.raw(kMagic);
@@ -22,7 +22,7 @@ McapWriter::McapWriter(const std::string& path, WriterOptions options) : path_(p
   w.string(options_.library);
   w.end_record(at);
   write(w.bytes());
-  std::fflush(file_);
+  std::fflush(file_.get());
 }
 
 McapWriter::~McapWriter() {
@@ -34,7 +34,7 @@ McapWriter::~McapWriter() {
 }
 
 void McapWriter::write(const std::vector<std::uint8_t>& bytes, bool data_section) {
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) throw std::runtime_error(path_ + ": write failed (disk full?)");
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file_.get()) != bytes.size()) throw std::runtime_error(path_ + ": write failed (disk full?)");
   if (data_section) data_crc_ = crc32_update(data_crc_, bytes.data(), bytes.size());
   position_ += bytes.size();
 }
@@ -140,7 +140,7 @@ void McapWriter::close_chunk() {
   }
   entry.message_index_length = index.bytes().size();
   write(index.bytes());
-  std::fflush(file_);
+  std::fflush(file_.get());
   chunk_indexes_.push_back(std::move(entry));
   ++stats_.chunk_count;
   chunk_.clear();
@@ -171,7 +171,7 @@ void McapWriter::add_attachment(const Attachment& a) {
   index.string(a.media_type);
   index.end_record(ia);
   write(w.bytes());
-  std::fflush(file_);
+  std::fflush(file_.get());
   attachment_indexes_.push_back(std::move(index.bytes()));
   ++stats_.attachment_count;
 }
@@ -189,7 +189,7 @@ void McapWriter::add_metadata(const Metadata& m) {
   index.string(m.name);
   index.end_record(ia);
   write(w.bytes());
-  std::fflush(file_);
+  std::fflush(file_.get());
   metadata_indexes_.push_back(std::move(index.bytes()));
   ++stats_.metadata_count;
 }
@@ -279,9 +279,9 @@ void McapWriter::close() {
   footer.u32(crc32_final(summary_crc));
   footer.raw(kMagic);
   write(footer.bytes(), false);
-  std::fflush(file_);
-  std::fclose(file_);
-  file_ = nullptr;
+  const bool flushed = std::fflush(file_.get()) == 0;
+  file_.reset();
+  if (!flushed) throw std::runtime_error(path_ + ": cannot write the file's end (disk full?)");
 }
 
 }  // namespace viscera::mcap

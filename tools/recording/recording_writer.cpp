@@ -72,15 +72,21 @@ void RecordingWriter::scene_files(const client::TapSample& s, std::uint64_t log_
                     {"settings_json", files->settings_json},
                     {"log_time_ns", std::to_string(log_time)}}};
   for (const auto& f : files->files) {
-    const std::string name = attachment_name(f.role, f.path);
-    m.values[f.role + ".attachment"] = name;
-    m.values[f.role + ".sha256"] = f.sha256;
-    m.values[f.role + ".path"] = f.path;
-    if (attached_.insert(f.sha256).second) {
+    auto known = attached_.find(f.sha256);
+    if (known == attached_.end()) {
+      // Each content once; a file of the same name with another content (edited between two
+      // loads) gets a name of its own.
+      std::string name = attachment_name(f.role, f.path);
+      for (int k = 2; names_.count(name); ++k) name = attachment_name(f.role, f.path) + "~" + std::to_string(k);
+      names_.insert(name);
       const std::string media = f.role == "mesh" ? "application/octet-stream" : "application/json";
       writer_.add_attachment({log_time, log_time, name, media, f.content});
       ++counts_.attachments;
+      known = attached_.emplace(f.sha256, name).first;
     }
+    m.values[f.role + ".attachment"] = known->second;
+    m.values[f.role + ".sha256"] = f.sha256;
+    m.values[f.role + ".path"] = f.path;
   }
   writer_.add_metadata(m);
 }

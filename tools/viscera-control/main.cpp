@@ -71,7 +71,7 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
 struct Request {
   std::string action, argument;
   viscera::protocol::MaterialChange change;
-  double rate_hz = 0, duration_s = 10;
+  double rate_hz = 0, duration_s = 10, seek_s = 0;
   std::chrono::milliseconds timeout{60'000};
 };
 
@@ -79,11 +79,12 @@ Request parse(const viscera::common::CommandLine& cl) {
   using viscera::common::UsageError;
   Request r;
   const auto& rest = cl.positional();
-  const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, show, health, events or annotate TEXT";
+  const std::string actions = "pause, resume, reset, load SCENE, material, rate HZ, seek S, show, health, events or annotate TEXT";
   if (rest.empty()) throw UsageError("missing ACTION (" + actions + ")");
   r.action = rest[0];
-  const std::map<std::string, bool> known = {{"pause", false}, {"resume", false}, {"reset", false},  {"load", true},    {"material", false},
-                                             {"rate", true},   {"show", false},   {"health", false}, {"events", false}, {"annotate", true}};
+  const std::map<std::string, bool> known = {{"pause", false},    {"resume", false},  {"reset", false}, {"load", true},
+                                             {"material", false}, {"rate", true},     {"show", false},  {"health", false},
+                                             {"events", false},   {"annotate", true}, {"seek", true}};
   const auto k = known.find(r.action);
   if (k == known.end()) throw UsageError("ACTION '" + r.action + "' is not " + actions);
   if (k->second != (rest.size() == 2)) throw UsageError(k->second ? r.action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
@@ -114,6 +115,11 @@ Request parse(const viscera::common::CommandLine& cl) {
     if (*end || !(r.rate_hz >= 10 && r.rate_hz <= 10000) || r.rate_hz != std::floor(r.rate_hz))
       throw UsageError("rate '" + r.argument + "' is not a whole number of hertz in [10, 10000]");
   }
+  if (r.action == "seek") {
+    char* end = nullptr;
+    r.seek_s = std::strtod(r.argument.c_str(), &end);
+    if (*end || !(r.seek_s >= 0 && r.seek_s <= 1e9)) throw UsageError("seek '" + r.argument + "' is not a time from the recording's start [s]");
+  }
   r.duration_s = cl.number_in("duration", 0.1, 1e6);
   r.timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));
   return r;
@@ -128,8 +134,8 @@ int follow_events(viscera::client::Client& client, const viscera::protocol::Scen
   while (std::chrono::steady_clock::now() < end) {
     if (server_gone(client)) return kServerGone;
     for (const auto& e : client.poll_events()) {
-      std::printf("event %s sim %.3f s instrument %u client %u%s%s\n", viscera::protocol::event_name(e.kind), e.sim_time_s, e.instrument_id,
-                  e.client_id, e.text.empty() ? "" : ": ", e.text.c_str());
+      std::printf("event %s tick %llu sim %.3f s instrument %u client %u%s%s\n", viscera::protocol::event_name(e.kind),
+                  static_cast<unsigned long long>(e.tick), e.sim_time_s, e.instrument_id, e.client_id, e.text.empty() ? "" : ": ", e.text.c_str());
       std::fflush(stdout);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -140,9 +146,10 @@ int follow_events(viscera::client::Client& client, const viscera::protocol::Scen
 /// load, material, rate (an outcome), or pause, resume, reset (the state confirms it). 0 when done.
 int control(viscera::client::Client& client, const Request& r) {
   using viscera::protocol::Action;
-  if (r.action == "load" || r.action == "material" || r.action == "rate") {
+  if (r.action == "load" || r.action == "material" || r.action == "rate" || r.action == "seek") {
     const auto outcome = r.action == "load"       ? client.load_scene(r.argument, r.timeout)
                          : r.action == "material" ? client.set_material(r.change, r.timeout)
+                         : r.action == "seek"     ? client.seek(r.seek_s, r.timeout)
                                                   : client.set_physics_rate(r.rate_hz, r.timeout);
     if (!outcome) {
       std::fprintf(stderr, "viscera-control: no outcome of '%s' from the server within %.1f s\n", r.action.c_str(),
@@ -192,14 +199,16 @@ int main(int argc, char** argv) {
       "  load SCENE      load a scene of the server's scene directory (show lists them); instruments are released\n"
       "  material        change material parameters (the flags below; the organ keeps its deformation)\n"
       "  rate HZ         change the physics rate [Hz]\n"
+      "  seek S          a replay (viscera-replay play, with --partition): jump to S seconds from the recording's start\n"
       "  show            print the scene state\n"
       "  health          print the server's health reports (physics rate, step times, late ticks, missed slots,\n"
       "                  rejected messages) for --duration seconds, then what changed over them\n"
       "  events          print the session's events and annotations for --duration seconds\n"
       "  annotate TEXT   a note for recorders and consoles\n"
       "Exit status: 0 done, 1 refused or not confirmed, 2 bad arguments, 3 no server, 4 the server went away (health, events).");
-  cl.usage("viscera-control ACTION [ARGUMENT] [--domain ID] [--duration S] [material flags]");
+  cl.usage("viscera-control ACTION [ARGUMENT] [--domain ID] [--partition NAME] [--duration S] [material flags]");
   cl.flag("domain", "ID", "DDS domain", "0");
+  cl.flag("partition", "NAME", "DDS partition: none for live servers, a replay's (viscera-replay play --partition) to follow and steer it", "");
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
   cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
   cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
@@ -213,10 +222,10 @@ int main(int argc, char** argv) {
     if (!cl.parse(argc, argv)) return 0;
     const Request r = parse(cl);
     viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)),
-                                   static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9)));
+                                   static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9)), cl.text("partition"));
     auto scene = client.wait_for_scene(std::chrono::seconds(10));
     if (!scene) {
-      std::fprintf(stderr, "viscera-control: no viscera-server found in 10 s (same domain and CYCLONEDDS_URI?)\n");
+      std::fprintf(stderr, "viscera-control: no viscera-server (or replay) found in 10 s (same domain, partition and CYCLONEDDS_URI?)\n");
       return 3;
     }
     if (r.action == "events") return follow_events(client, *scene, r.duration_s);

@@ -66,6 +66,9 @@ class Client {
   std::optional<protocol::RequestOutcome> load_scene(const std::string& name, std::chrono::milliseconds timeout);
   std::optional<protocol::RequestOutcome> set_material(const protocol::MaterialChange& change, std::chrono::milliseconds timeout);
   std::optional<protocol::RequestOutcome> set_physics_rate(double rate_hz, std::chrono::milliseconds timeout);
+  /// A replay (viscera-replay play, in its partition): jump to `seconds` from the recording's start.
+  /// A live server refuses it.
+  std::optional<protocol::RequestOutcome> seek(double seconds, std::chrono::milliseconds timeout);
   /// Sends the instrument's tip position [m] and jaw opening [rad] (next sequence number,
   /// current stamp).
   void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip, double jaw_opening_rad = 0.5);

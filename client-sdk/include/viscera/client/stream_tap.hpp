@@ -49,10 +49,12 @@ class StreamPublisher {
  public:
   StreamPublisher(std::uint32_t domain_id, const std::string& partition);
   ~StreamPublisher();
+  /// Makes the stream's writer now (so readers can discover it before the first sample).
+  void open(protocol::Stream stream);
   /// Publishes a recorded payload on its stream under its recorded key (a writer per stream,
   /// made on first use).
   void publish(protocol::Stream stream, std::uint32_t source_id, std::span<const std::uint8_t> payload);
-  /// Waits until every stream's writer has a matched reader or the timeout passes.
+  /// Waits until every stream's writer has a matched reader or the timeout (in all) passes.
   void wait_for_readers(std::chrono::milliseconds timeout);
 
  private:

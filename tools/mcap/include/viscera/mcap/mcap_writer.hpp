@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,7 +66,11 @@ class McapWriter {
 
   std::string path_;
   WriterOptions options_;
-  std::FILE* file_ = nullptr;
+  struct CloseFile {
+    // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): the deleter of the unique_ptr that owns the file
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, CloseFile> file_;
   std::uint64_t position_ = 0;
   std::uint32_t data_crc_ = kCrc32Init;
   std::map<std::uint16_t, Schema> schemas_;

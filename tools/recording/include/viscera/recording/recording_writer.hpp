@@ -58,7 +58,8 @@ class RecordingWriter {
   std::map<std::tuple<protocol::Stream, std::uint64_t, std::uint32_t>, std::uint16_t> channels_;
   std::map<std::uint64_t, std::uint64_t> writer_numbers_;  // DDS handle -> 1, 2, ...
   std::map<std::uint64_t, protocol::Stream> writer_streams_;
-  std::set<std::string> attached_;  // SHA-256 of the files attached
+  std::map<std::string, std::string> attached_;  // SHA-256 of each file attached -> its attachment's name
+  std::set<std::string> names_;  // attachment names used
   SequenceGaps gaps_;
   RecordingCounts counts_;
   std::uint64_t last_log_time_ = 0;
