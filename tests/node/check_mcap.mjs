@@ -3,19 +3,35 @@
 // Reads it twice, as a stream (every record, chunk CRCs checked) and through its index (summary,
 // chunk indexes, message indexes, attachment CRCs), and prints one JSON object: header, schemas,
 // channels with their message counts from both passes, statistics, attachments, metadata, whether
-// log times never decrease in file order, and per channel the sequence numbers' gaps. Exits 1
+// log times never decrease in file order, and per writer the sequence numbers missing between its
+// first and last. Exits 1
 // with the reader's error if either pass fails.
+//   node check_mcap.mjs --cut FILE.mcap
+// A file cut short (a recorder killed): only the stream pass, up to where the reader stops; prints
+// {"messages": N, "error": "..."}: the messages of its complete chunks.
 import { open } from "node:fs/promises";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { loadDecompressHandlers } from "@mcap/support";
 
-const path = process.argv[2];
+const cut = process.argv[2] === "--cut";
+const path = process.argv[cut ? 3 : 2];
 if (!path) {
   console.error("usage: node check_mcap.mjs FILE.mcap");
   process.exit(2);
 }
 
 const decompressHandlers = await loadDecompressHandlers();
+// In --cut mode the reader's first error ends the stream pass (a record cut in two).
+let cutError = null;
+function nextRecord(stream) {
+  if (!cut || cutError) return cutError ? undefined : stream.nextRecord();
+  try {
+    return stream.nextRecord();
+  } catch (e) {
+    cutError = e.message ?? String(e);
+    return undefined;
+  }
+}
 const out = { file: path };
 
 try {
@@ -23,8 +39,8 @@ try {
   const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true });
   const file = await open(path, "r");
   const streamCounts = new Map();
-  const lastSeq = new Map();
-  const gaps = new Map();
+  const writerOf = new Map();  // channel -> its writer (channels of one writer's keys share its numbers)
+  const sequences = new Map();  // writer -> the sequence numbers seen
   let lastLogTime = -1n;
   let monotonic = true;
   let records = 0;
@@ -33,22 +49,36 @@ try {
     const { bytesRead } = await file.read(buffer, 0, buffer.length, null);
     if (bytesRead === 0) break;
     stream.append(buffer.slice(0, bytesRead));
-    for (let r; (r = stream.nextRecord()); ) {
+    for (let r; (r = nextRecord(stream)); ) {
       ++records;
       if (r.type === "Header") out.header = { profile: r.profile, library: r.library };
+      if (r.type === "Channel") writerOf.set(r.id, r.metadata.get("writer") ? `writer ${r.metadata.get("writer")}` : `channel ${r.id}`);
       if (r.type === "Message") {
         streamCounts.set(r.channelId, (streamCounts.get(r.channelId) ?? 0) + 1);
         if (r.logTime < lastLogTime) monotonic = false;
         lastLogTime = r.logTime;
-        const prev = lastSeq.get(r.channelId);
-        if (prev !== undefined && r.sequence > prev + 1) gaps.set(r.channelId, (gaps.get(r.channelId) ?? 0) + (r.sequence - prev - 1));
-        lastSeq.set(r.channelId, r.sequence);
+        const writer = writerOf.get(r.channelId) ?? `channel ${r.channelId}`;
+        if (!sequences.has(writer)) sequences.set(writer, new Set());
+        sequences.get(writer).add(r.sequence);
       }
     }
   }
   await file.close();
+  if (cut) {
+    console.log(JSON.stringify({ messages: [...streamCounts.values()].reduce((a, b) => a + b, 0), records, complete: stream.done(), error: cutError }));
+    process.exit(0);
+  }
   if (!stream.done()) throw new Error(`stream reader: the file ends before its footer (${stream.bytesRemaining()} bytes left unparsed)`);
   out.stream = { records, monotonicLogTimes: monotonic };
+  // Per writer: the numbers between its first and last that are not in the file.
+  out.writers = Object.fromEntries(
+    [...sequences].map(([w, set]) => {
+      const seqs = [...set];
+      const lo = seqs.reduce((a, b) => (a < b ? a : b));
+      const hi = seqs.reduce((a, b) => (a > b ? a : b));
+      return [w, { first: lo, last: hi, messages: set.size, missing: hi - lo + 1 - set.size }];
+    }),
+  );
 
   // 2. Index: summary, chunk and message indexes.
   const handle = await open(path, "r");
@@ -80,7 +110,6 @@ try {
     metadata: Object.fromEntries(c.metadata),
     streamCount: streamCounts.get(c.id) ?? 0,
     indexCount: indexCounts.get(c.id) ?? 0,
-    sequenceGaps: gaps.get(c.id) ?? 0,
   }));
   const st = reader.statistics;
   out.statistics = st

@@ -221,6 +221,22 @@ TEST(SequenceGaps, CountsEachWritersMissingNumbersAndRunsApart) {
   EXPECT_EQ(b.first, 20u);
   EXPECT_EQ(b.missing, 0u);
   EXPECT_EQ(b.out_of_order, 1u);
+  // Two keys of one writer handed over interleaved: 4 before 3 is late, not lost; a late number in
+  // the middle of a run splits it, at its end shortens it.
+  SequenceGaps late;
+  for (std::uint64_t s : {1, 2, 4, 3, 5, 10, 7, 11}) late.add(1, s);  // 6, 8, 9 lost: runs {6} {8, 9}
+  EXPECT_EQ(late.writers().at(1).missing, 3u);
+  EXPECT_EQ(late.writers().at(1).gaps, 2u);
+  EXPECT_EQ(late.writers().at(1).out_of_order, 2u);
+  late.add(1, 9);
+  EXPECT_EQ(late.writers().at(1).missing, 2u);
+  EXPECT_EQ(late.writers().at(1).gaps, 2u);
+  late.add(1, 6);
+  EXPECT_EQ(late.writers().at(1).missing, 1u);
+  EXPECT_EQ(late.writers().at(1).gaps, 1u);
+  late.add(1, 6);  // a repeat changes nothing but the count
+  EXPECT_EQ(late.writers().at(1).missing, 1u);
+  EXPECT_EQ(late.writers().at(1).out_of_order, 5u);
 }
 
 TEST(Recording, WhatIsWrittenReadsBackAndDecodesByTheSchemasItCarries) {

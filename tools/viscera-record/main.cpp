@@ -12,6 +12,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/protocol/messages.hpp"
+#include "viscera/recording/payload_verification.hpp"
 #include "viscera/recording/recording.hpp"
 #include "viscera/recording/recording_writer.hpp"
 
@@ -135,7 +136,7 @@ std::string seconds(std::uint64_t ns) {
   return b;
 }
 
-int info(const std::vector<std::string>& args) {
+int info(const std::vector<std::string>& args, bool verify) {
   if (args.size() != 2) throw UsageError("info takes FILE.mcap");
   rec::Recording r(args[1]);
   const auto& s = r.summary();
@@ -168,7 +169,22 @@ int info(const std::vector<std::string>& args) {
   } else {
     std::printf("  drops: not recorded (the recording was recovered after its recorder stopped abruptly)\n");
   }
-  return 0;
+  if (!verify) return 0;
+  std::uint64_t good = 0, bad = 0;
+  std::string first_bad;
+  r.for_each([&](const rec::RecordedChannel& ch, const viscera::mcap::Message& m) {
+    std::string why;
+    if (rec::payload_decodes(ch.stream, m.data, &why)) {
+      ++good;
+    } else if (++bad == 1) {
+      first_bad = std::string(proto::stream_name(ch.stream)) + " message " + std::to_string(m.sequence) + " (log time " + std::to_string(m.log_time) +
+                  "): " + why;
+    }
+    return true;
+  });
+  std::printf("  payloads: %llu decode with viscera's decoders, %llu do not%s%s\n", static_cast<unsigned long long>(good),
+              static_cast<unsigned long long>(bad), bad ? "; the first: " : "", first_bad.c_str());
+  return bad == 0 ? 0 : 1;
 }
 
 }  // namespace
@@ -184,8 +200,8 @@ int main(int argc, char** argv) {
       "is readable up to its last chunk (recover).\n"
       "  viscera-record --out FILE.mcap [--duration S] [--topics a,b,...]   record\n"
       "  viscera-record recover IN.mcap OUT.mcap                            a complete, indexed copy of what is there\n"
-      "  viscera-record info FILE.mcap                                      channels, schemas, counts, time span, drops");
-  cl.usage("viscera-record --out FILE.mcap [options] | recover IN.mcap OUT.mcap | info FILE.mcap");
+      "  viscera-record info FILE.mcap [--verify]                           channels, schemas, counts, time span, drops");
+  cl.usage("viscera-record --out FILE.mcap [options] | recover IN.mcap OUT.mcap | info FILE.mcap [--verify]");
   cl.flag("out", "FILE.mcap", "the recording to write (replaced if it exists)");
   cl.flag("duration", "S", "stop after S seconds; 0: until SIGINT/SIGTERM", "0");
   cl.flag("topics", "a,b,...", "streams to record (default: all; names as in docs/PROTOCOL.md, e.g. force_feedback,event)", "");
@@ -196,12 +212,13 @@ int main(int argc, char** argv) {
   cl.flag("chunk-s", "S", "or when its messages span this long [s] (the most a killed recorder loses)", "1");
   cl.flag("depth", "N", "samples kept per key between two reads of the recorder (1 kHz streams)", "4096");
   cl.option_switch("quiet", "no status line each second");
+  cl.option_switch("verify", "info: also decode every payload with viscera's own decoders (exit 1 if one does not)");
   cl.allow_positional(3);
   try {
     if (!cl.parse(argc, argv)) return 0;
     const auto& args = cl.positional();
     if (!args.empty() && args[0] == "recover") return recover(args);
-    if (!args.empty() && args[0] == "info") return info(args);
+    if (!args.empty() && args[0] == "info") return info(args, cl.has("verify"));
     if (!args.empty()) throw UsageError("unknown command '" + args[0] + "' (recover, info, or --out FILE to record)");
     return record(cl);
   } catch (const UsageError& e) {
