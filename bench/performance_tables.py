@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates the tables of docs/PERFORMANCE.md from the benchmarks' results in bench/results:
-tissue.json (bench/run.sh), tick.json (bench/tick.sh), haptics.json (bench/haptics.sh) and
-soak.json (bench/soak.sh). Each table goes between its markers <!-- begin NAME --> and
+tissue.json (bench/run.sh), tick.json (bench/tick.sh), haptics.json (bench/haptics.sh),
+soak.json (bench/soak.sh) and record.json (bench/record.sh). Each table goes between its markers <!-- begin NAME --> and
 <!-- end NAME -->, with the machine and the date of the run it comes from; the prose around the
 markers is left as it is. Usage: performance_tables.py [ROOT]"""
 import contextlib
@@ -77,11 +77,32 @@ def soak(path):
             + "\n![the soak's samples](soak.svg)\n")
 
 
+def record(path):
+    r = json.load(open(path))
+    m = r["messages"]
+    lost_forces = r["forces_published"] - r["forces_recorded"]
+    lost_frames = r["frames_published"] - r["frames_recorded"]
+    rows = [
+        "| | value |", "|---|---|",
+        f"| session | {r['seconds']:g} s of a 1 kHz press on {r['scene']}, surface frames at 60 Hz; recording span {r['recording_span_s']:.0f} s |",
+        f"| messages | {sum(m.values())}: commands {m.get('instrument_command', 0)}, forces {m.get('force_feedback', 0)}, frames {m.get('mesh_frame', 0)}, "
+        f"telemetry {m.get('telemetry', 0)}, events {m.get('event', 0)} |",
+        f"| file | {r['file_mb']:.0f} MB ({r['compression']}; {r['mb_per_minute']:.0f} MB per minute; payloads {r['payload_mb']:.0f} MB, ratio {r['compression_ratio']:.2f}) |",
+        f"| recorder CPU | {r['recorder_cpu_percent_of_one_core']:.1f}% of one core |",
+        f"| recorder peak memory | {r['recorder_peak_rss_mb']:.0f} MB |",
+        f"| lost, by sequence numbers | {r['missing_by_sequence']} |",
+        f"| forces published / recorded | {r['forces_published']} / {r['forces_recorded']} ({'all of them' if lost_forces == 0 else f'{lost_forces} not in the file'}) |",
+        f"| frames published / recorded | {r['frames_published']} / {r['frames_recorded']} ({'all of them' if lost_frames == 0 else f'{lost_frames} not in the file'}) |",
+        f"| the server's physics while recording | {r['physics_ticks']} ticks in {r['recording_span_s']:.0f} s ({r['physics_ticks'] / r['recording_span_s']:.0f} per second on average; the slowest second {r['physics_rate_hz_min']:.0f}) |",
+    ]
+    return f"Run of {r['date_utc']} UTC (`bench/record.sh {r['seconds']:g}`), {r['machine']}:\n\n" + "\n".join(rows) + "\n"
+
+
 def main(root):
     doc_path = os.path.join(root, "docs", "PERFORMANCE.md")
     doc = open(doc_path).read()
     results = os.path.join(root, "bench", "results")
-    for name, fn in [("tissue", tissue), ("tick", tick), ("haptics", haptics), ("soak", soak)]:
+    for name, fn in [("tissue", tissue), ("tick", tick), ("haptics", haptics), ("soak", soak), ("record", record)]:
         path = os.path.join(results, f"{name}.json")
         if not os.path.exists(path):
             continue

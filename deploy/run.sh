@@ -7,6 +7,8 @@
 # print live: the server its physics rate, step times, jitter, late ticks, missed slots and the force on the
 # tools; the client the force it feels, the command-to-force round trip and the surface frames it
 # receives; the console what the server did, and the server's health reports while the probe presses again.
+# viscera-record records the whole session to out/demo.mcap; at the end the demo prints the
+# recording's summary and re-runs the session on a fresh server in lockstep, bit for bit.
 #   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene
 #   DURATION=20 ./deploy/run.sh                           a longer press (seconds)
 set -euo pipefail
@@ -17,9 +19,14 @@ duration="${DURATION:-8}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$root/deploy/cyclonedds.xml}"
 domain=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('domain_id', 0))" "$scene")
 bin="$root/build"
+mkdir -p "$root/out"
+recording="$root/out/demo.mcap"
+"$bin/tools/viscera-record/viscera-record" --out "$recording" --domain "$domain" --quiet > >(sed -u 's/^/[record] /') 2>&1 &
+recorder=$!
 "$bin/server/runtime/viscera-server" --scene "$scene" > >(sed -u 's/^/[server] /') 2>&1 &
 server=$!
-trap 'kill -INT "$server" 2>/dev/null || true; wait "$server" 2>/dev/null || true; sleep 0.2' EXIT
+trap 'kill -INT "$server" "$recorder" 2>/dev/null || true; wait "$server" "$recorder" 2>/dev/null || true; sleep 0.2' EXIT
+sleep 1  # the recorder discovers the server before the first command
 echo "[demo] probe 1 presses 3 cm into the liver and comes back (${duration} s)"
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
   --duration "$duration" --watch-mesh 2>&1 | sed -u 's/^/[haptic] /'
@@ -34,4 +41,13 @@ console=$!
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
   --duration "$duration" 2>&1 | sed -u 's/^/[haptic] /'
 wait "$console" || true
-echo "[demo] done; the server stops"
+echo "[demo] done; the server and the recorder stop"
+kill -INT "$server" "$recorder"; wait "$server" "$recorder" || true
+trap - EXIT
+sleep 0.2
+echo "[demo] the recording ($recording):"
+"$bin/tools/viscera-record/viscera-record" info "$recording" --verify 2>&1 | sed -u 's/^/[record] /'
+echo "[demo] the session re-run on a fresh server in lockstep, compared bit for bit with the recording"
+"$bin/tools/viscera-replay/viscera-replay" resimulate "$recording" --report "$root/out/demo-resimulation.json" --domain "$domain" 2>&1 \
+  | sed -u 's/^/[replay] /' || echo "[demo] the re-simulation did not reproduce the session: see the first divergence above"
+echo "[demo] replay it: $bin/tools/viscera-replay/viscera-replay play $recording"

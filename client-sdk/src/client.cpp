@@ -103,7 +103,12 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
           list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.grasper ? " (grasper)" : " (probe)");
         return {false, "scene " + s->name + " has no instrument " + std::to_string(instrument_id) + " (its instruments: " + list + ")"};
       }
-      if (it->owner_client_id == client_id_) return {true, {}};
+      if (it->owner_client_id == client_id_) {
+        // Before the first command: every reader of commands (the server's, a recorder's) knows
+        // this client's writer, or the first commands are lost to the one that learns of it last.
+        impl_->commands.wait_for_settled_readers(std::chrono::milliseconds(100), std::chrono::milliseconds(500));
+        return {true, {}};
+      }
       // Taken: keep asking until the timeout, its owner may release it (or lose it to the lease).
       why = it->owner_client_id != 0 ? "taken by client " + std::to_string(it->owner_client_id) : "the server did not confirm the claim";
     }

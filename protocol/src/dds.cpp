@@ -136,6 +136,22 @@ bool Writer::wait_for_readers(std::chrono::milliseconds timeout) const {
   return true;
 }
 
+bool Writer::wait_for_settled_readers(std::chrono::milliseconds quiet, std::chrono::milliseconds timeout) const {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  if (!wait_for_readers(timeout)) return false;
+  int count = matched();
+  auto since = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - since < quiet) {
+    if (std::chrono::steady_clock::now() >= end) return true;
+    dds_sleepfor(DDS_MSECS(5));
+    if (const int now = matched(); now != count) {
+      count = now;
+      since = std::chrono::steady_clock::now();
+    }
+  }
+  return true;
+}
+
 bool Writer::wait_for_acks(std::chrono::milliseconds timeout) const {
   return dds_wait_for_acks(handle_, DDS_MSECS(timeout.count())) == DDS_RETCODE_OK;
 }

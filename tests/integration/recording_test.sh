@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Integration, separate processes over a real DDS domain: a scripted session (a press, a material
-# change, a grasp and lift, an annotation) recorded by viscera-record; the file judged by the
+# change, a grasp and lift, an annotation, the first client pressing again under the same id)
+# recorded by viscera-record; the file judged by the
 # official MCAP reader (@mcap/core under Node: channels, schemas, counts against the writers'
 # sequence numbers, no gaps, monotonic log times, attachments) and every payload by viscera's own
 # decoders; a second recorder (lz4) killed with SIGKILL mid-session, recovered, and the recovered
@@ -40,12 +41,14 @@ wait $press; rc_press=$?
 sleep 1.5
 kill -KILL "$victim"
 wait $grasp; rc_grasp=$?
+# The first client again, with the same id: its commands are numbered from 1 again.
+"$hc" --domain "$domain" --client-id 11 --instrument 1 --duration 1.5 --depth 0.01 --quiet > "$tmp/press2.log" 2>&1; rc_press2=$?
 sleep 0.3
 kill -INT "$recorder"; wait "$recorder"; rc_rec=$?
 kill -INT "$server"; wait "$server"; rc_server=$?
 cat "$tmp/control.log" "$tmp/press.log" "$tmp/grasp.log"; tail -3 "$tmp/rec.log"; [ $rc_server -eq 0 ] || cat "$tmp/server.log"
-check "the session ran (press $rc_press, annotation $rc_note, material $rc_material, grasp $rc_grasp, server $rc_server)" \
-  "[ $rc_press -eq 0 ] && [ $rc_note -eq 0 ] && [ $rc_material -eq 0 ] && [ $rc_grasp -eq 0 ] && [ $rc_server -eq 0 ]"
+check "the session ran (press $rc_press, annotation $rc_note, material $rc_material, grasp $rc_grasp, press again $rc_press2, server $rc_server)" \
+  "[ $rc_press -eq 0 ] && [ $rc_note -eq 0 ] && [ $rc_material -eq 0 ] && [ $rc_grasp -eq 0 ] && [ $rc_press2 -eq 0 ] && [ $rc_server -eq 0 ]"
 check "the recorder closed its file (rc $rc_rec)" "[ $rc_rec -eq 0 ]"
 
 # --- The official reader's verdict -----------------------------------------------------------

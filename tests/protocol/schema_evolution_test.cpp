@@ -24,7 +24,8 @@ TEST(SchemaEvolution, OldReaderReadsNewForceFeedback) {
   f.contact_normal = {0, 0, 1};
   f.stiffness[8] = 800;
   f.step_time_ns = 180000;
-  f.penetration_m = 0.0021;  // the field schema 1 does not know
+  f.penetration_m = 0.0021;  // fields schema 1 does not know: penetration (schema 2), tick (schema 7)
+  f.tick = 987654321;
   const auto bytes = encode(f);
   flatbuffers::Verifier verifier(bytes.data(), bytes.size());
   ASSERT_TRUE(v1::VerifyForceFeedbackBuffer(verifier));
@@ -53,6 +54,7 @@ TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
   EXPECT_EQ(f->force[2], 2.5);
   EXPECT_EQ(f->stiffness[8], 400);
   EXPECT_EQ(f->penetration_m, 0.0);  // absent: the schema's default
+  EXPECT_EQ(f->tick, 0u);  // an older server stamps no tick: a recording of it cannot be re-simulated
 
   flatbuffers::FlatBufferBuilder c;
   const v1::Vec3 tip(0.0, 0.01, 0.05);

@@ -77,6 +77,7 @@ struct SyntheticSession {
       c.client_id = kClient;
       c.seq = seq;
       c.tip_position = {0.01 * static_cast<double>(seq), 0.02, -0.001 * static_cast<double>(seq)};
+      c.client_stamp_ns = 5'000'000 + static_cast<std::int64_t>(seq);
       commands.push_back(c);
     }
     const auto command_at = [](std::uint64_t tick) -> std::uint64_t { return tick < 104 ? 1 : tick < 108 ? 2 : 3; };
@@ -85,6 +86,7 @@ struct SyntheticSession {
       f.instrument_id = kInstrument;
       f.client_id = kClient;
       f.command_seq = command_at(tick);
+      f.command_client_stamp_ns = commands[f.command_seq - 1].client_stamp_ns;
       f.step_time_ns = 1000;
       f.tick = tick;
       f.in_contact = tick >= 103;
@@ -95,6 +97,7 @@ struct SyntheticSession {
     }
     proto::Force answered = forces[4];  // command 4, answered on the state after tick 105
     answered.command_seq = 4;
+    answered.command_client_stamp_ns = commands[3].client_stamp_ns;
     answered.step_time_ns = 0;
     answered.tick = 105;
     forces.push_back(answered);
@@ -167,6 +170,16 @@ struct SyntheticSession {
     }
     add(proto::Stream::event, 0, 11, 2, proto::encode(events[1]));
     for (std::size_t i = 0; i < frames.size(); ++i) add(proto::Stream::mesh_frame, 1, 15, i + 1, proto::encode(frames[i]));
+    // A later run of the same client, with the same id: its commands and its request 3 have
+    // the same numbers as this run's, and must not be taken for them.
+    for (auto c : commands) {
+      c.client_stamp_ns += 1'000'000;
+      c.tip_position[0] = -c.tip_position[0];
+      add(proto::Stream::instrument_command, kInstrument, 16, c.seq, proto::encode(c));
+    }
+    auto later_request = material_request;
+    later_request.material.youngs_modulus_pa = 9000.0;
+    add(proto::Stream::session_request, kClient, 17, 1, proto::encode(later_request));
     w.close();
   }
 
@@ -249,7 +262,7 @@ TEST(Recording, WhatIsWrittenReadsBackAndDecodesByTheSchemasItCarries) {
     Recording r(path.string());
     EXPECT_EQ(r.info().at("schema_version"), std::to_string(proto::kSchemaVersion));
     ASSERT_TRUE(r.summary().statistics);
-    const std::uint64_t expected = 4 + session.forces.size() + 2 + 1 + session.frames.size();  // all but the scene files
+    const std::uint64_t expected = 2 * 4 + session.forces.size() + 2 + 2 + session.frames.size();  // all but the scene files
     EXPECT_EQ(r.summary().statistics->message_count, expected);
     EXPECT_GT(r.summary().chunks.size(), 2u);
 
@@ -284,7 +297,7 @@ TEST(Recording, WhatIsWrittenReadsBackAndDecodesByTheSchemasItCarries) {
     EXPECT_EQ(seen[proto::Stream::force_feedback], static_cast<int>(session.forces.size()));
     EXPECT_EQ(seen[proto::Stream::event], 2);
     EXPECT_EQ(seen[proto::Stream::mesh_frame], 2);
-    EXPECT_EQ(seen[proto::Stream::instrument_command], 4);
+    EXPECT_EQ(seen[proto::Stream::instrument_command], 8);
 
     // The scene's files: attached once each, with their digests; the drops: none.
     ASSERT_EQ(r.scenes().size(), 1u);
@@ -391,6 +404,8 @@ TEST(LockstepPlan, PutsEachInputAtTheTickTheServerAppliedIt) {
     EXPECT_EQ(command_seqs(tick, false).size(), new_command ? 1u : 0u) << "tick " << tick;
   }
   EXPECT_EQ(command_seqs(104, false), std::vector<std::uint64_t>{2});
+  // This run's command 2, not the later run's of the same number (told apart by the client stamp).
+  EXPECT_EQ(proto::decode_command(plan.step(104).commands.at(0), &why)->tip_position, session.commands[1].tip_position);
   EXPECT_EQ(command_seqs(106, true), std::vector<std::uint64_t>{4});  // answered on the state after tick 105
   // The claim and the material change, where their events say they took effect.
   const auto actions = [&](std::uint64_t tick) {
@@ -400,7 +415,7 @@ TEST(LockstepPlan, PutsEachInputAtTheTickTheServerAppliedIt) {
   };
   EXPECT_EQ(actions(100), std::vector<proto::Action>{proto::Action::claim_instrument});
   EXPECT_EQ(actions(106), std::vector<proto::Action>{proto::Action::set_material});
-  EXPECT_EQ(*proto::decode_session_request(plan.step(106).requests[0], &why)->material.youngs_modulus_pa, 6000.0);
+  EXPECT_EQ(*proto::decode_session_request(plan.step(106).requests[0], &why)->material.youngs_modulus_pa, 6000.0);  // not the later run's 9000
   EXPECT_TRUE(plan.step(103).want_frame && plan.step(110).want_frame && !plan.step(104).want_frame);
   EXPECT_EQ(plan.recorded_forces, session.forces.size());
   EXPECT_TRUE(plan.notes.empty()) << plan.notes.front();

@@ -72,6 +72,13 @@ TEST(ParallelForces, EqualTheOneThreadForcesAndMemoryAndAreDeterministic) {
     parallel(x, f, {mem, mem, 1e-3});
     for (std::size_t i = 0; i < f.size(); ++i) ASSERT_EQ(f[i], f_parallel[i]) << "repetition " << rep << ", node " << i;
   }
+  // The same chunks on one thread: the same bits as on two (what lets a session be re-simulated
+  // bit for bit whatever the thread count).
+  ParallelForces one_thread(*model, 1, 4);
+  std::vector<double> mem_one(nm, 0.0);
+  std::vector<Vec3> f_one(x.size(), Vec3(0, 0, -0.01));
+  one_thread(x, f_one, {mem_one, mem_one, 1e-3});
+  for (std::size_t i = 0; i < f_one.size(); ++i) ASSERT_EQ(f_one[i], f_parallel[i]) << "node " << i;
 }
 
 TEST(ParallelForces, ReportInstabilityAndKeepModelsThatDoNotSplitWhole) {

@@ -28,8 +28,14 @@ proto::LockstepStep LockstepPlan::step(std::uint64_t tick) const {
 
 namespace {
 
-using CommandKey = std::tuple<std::uint32_t, std::uint32_t, std::uint64_t>;  // client, instrument, seq
+// A client that runs twice with the same id numbers its commands and requests from 1 again, so
+// a command is named by its client stamp too (a force echoes it), and a request by when it came.
+using CommandKey = std::tuple<std::uint32_t, std::uint32_t, std::uint64_t, std::int64_t>;  // client, instrument, seq, client stamp
 using RequestKey = std::pair<std::uint32_t, std::uint64_t>;  // client, request_seq
+struct TimedPayload {
+  std::uint64_t log_time;
+  std::vector<std::uint8_t> payload;
+};
 
 struct Stepped {
   std::uint32_t client;
@@ -58,7 +64,8 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
   plan.last_tick = plan.first_tick;
 
   std::map<CommandKey, std::vector<std::uint8_t>> commands;
-  std::map<RequestKey, std::vector<std::uint8_t>> requests;
+  std::map<RequestKey, std::vector<TimedPayload>> requests;  // in log-time order
+  std::vector<std::uint64_t> event_log_times;  // parallel to events
   std::vector<proto::Force> forces;  // in recorded order
   std::vector<proto::Event> events;  // server events, in recorded order
   std::vector<std::uint64_t> force_log_times;  // parallel to forces
@@ -68,13 +75,13 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
     switch (ch.stream) {
       case proto::Stream::instrument_command:
         if (const auto c = proto::decode_command(m.data, &why))
-          commands[{c->client_id, c->instrument_id, c->seq}] = m.data;
+          commands[{c->client_id, c->instrument_id, c->seq, c->client_stamp_ns}] = m.data;
         else
           ++undecodable;
         break;
       case proto::Stream::session_request:
         if (const auto r = proto::decode_session_request(m.data, &why))
-          requests[{r->client_id, r->request_seq}] = m.data;
+          requests[{r->client_id, r->request_seq}].push_back({m.log_time, m.data});
         else
           ++undecodable;
         break;
@@ -92,7 +99,10 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
         break;
       case proto::Stream::event:
         if (const auto e = proto::decode_event(m.data, &why)) {
-          if (e->source_client_id == 0 && e->tick >= plan.first_tick) events.push_back(*e);
+          if (e->source_client_id == 0 && e->tick >= plan.first_tick) {
+            events.push_back(*e);
+            event_log_times.push_back(m.log_time);
+          }
         } else {
           ++undecodable;
         }
@@ -149,7 +159,8 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
   // Events: the requests they show taking effect, and what each tick must raise.
   std::map<std::uint32_t, std::uint64_t> claimed_at;  // instrument -> tick of its last claim
   std::uint64_t missing_requests = 0;
-  for (const auto& e : events) {
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const proto::Event& e = events[i];
     plan.last_tick = std::max(plan.last_tick, e.tick);
     if (e.kind != proto::EventKind::request_refused) {
       plan.events[e.tick].push_back({e.kind, e.instrument_id, e.client_id, e.request_seq, e.sim_time_s});
@@ -174,7 +185,11 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
       case proto::EventKind::material_changed:
       case proto::EventKind::physics_rate_changed:
         if (const auto it = requests.find({e.client_id, e.request_seq}); it != requests.end()) {
-          s.requests.push_back(it->second);
+          // The newest request of that number that came before the event (the first if none did).
+          const auto& candidates = it->second;
+          auto chosen = candidates.begin();
+          for (auto c = candidates.begin(); c != candidates.end() && c->log_time <= event_log_times[i]; ++c) chosen = c;
+          s.requests.push_back(chosen->payload);
         } else {
           ++missing_requests;
           plan.notes.push_back(std::string("tick ") + std::to_string(e.tick) + ": " + proto::event_name(e.kind) + " by client " +
@@ -190,7 +205,7 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
   std::map<std::uint32_t, Stepped> last_stepped;  // per instrument
   std::uint64_t missing_commands = 0;
   const auto command = [&](const proto::Force& f) -> const std::vector<std::uint8_t>* {
-    const auto it = commands.find({f.client_id, f.instrument_id, f.command_seq});
+    const auto it = commands.find({f.client_id, f.instrument_id, f.command_seq, f.command_client_stamp_ns});
     if (it != commands.end()) return &it->second;
     if (++missing_commands <= 5)
       plan.notes.push_back("tick " + std::to_string(f.tick) + ": command " + std::to_string(f.command_seq) + " of client " +

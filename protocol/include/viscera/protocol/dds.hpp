@@ -88,6 +88,11 @@ class Writer {
   /// Waits until at least one reader is matched (a new writer's first samples reach only the
   /// readers discovered by then); false on timeout.
   bool wait_for_readers(std::chrono::milliseconds timeout) const;
+  /// Waits for a first reader, then until no reader has matched for `quiet` (or `timeout` in all
+  /// passed): the other readers of the domain (a recorder beside the server) learn of a new writer
+  /// within milliseconds of the first, and a best-effort sample written before they do is lost to
+  /// them. False if no reader matched at all.
+  bool wait_for_settled_readers(std::chrono::milliseconds quiet, std::chrono::milliseconds timeout) const;
   /// Waits until every matched reliable reader acknowledged what was written; false on timeout.
   bool wait_for_acks(std::chrono::milliseconds timeout) const;
 
