@@ -10,8 +10,9 @@
 // A file cut short (a recorder killed): only the stream pass, up to where the reader stops; prints
 // {"messages": N, "error": "..."}: the messages of its complete chunks.
 import { open } from "node:fs/promises";
-import { McapIndexedReader, McapStreamReader } from "@mcap/core";
+import { McapStreamReader } from "@mcap/core";
 import { loadDecompressHandlers } from "@mcap/support";
+import { openIndexed } from "./indexed_reader.mjs";
 
 const cut = process.argv[2] === "--cut";
 const path = process.argv[cut ? 3 : 2];
@@ -81,18 +82,7 @@ try {
   );
 
   // 2. Index: summary, chunk and message indexes.
-  const handle = await open(path, "r");
-  const size = BigInt((await handle.stat()).size);
-  const readable = {
-    size: async () => size,
-    read: async (offset, length) => {
-      const b = new Uint8Array(Number(length));
-      const { bytesRead } = await handle.read(b, 0, b.length, Number(offset));
-      if (bytesRead !== b.length) throw new Error(`short read at ${offset}`);
-      return b;
-    },
-  };
-  const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+  const { reader, close } = await openIndexed(path, decompressHandlers);
   const indexCounts = new Map();
   let indexed = 0;
   for await (const m of reader.readMessages({ validateCrcs: true })) {
@@ -130,7 +120,7 @@ try {
   for await (const a of reader.readAttachments({ validateCrcs: true })) out.attachments.push({ name: a.name, mediaType: a.mediaType, bytes: a.data.length });
   out.metadata = [];
   for await (const m of reader.readMetadata()) out.metadata.push({ name: m.name, metadata: Object.fromEntries(m.metadata) });
-  await handle.close();
+  await close();
   console.log(JSON.stringify(out, null, 1));
 } catch (e) {
   console.error(`check_mcap: ${path}: ${e.message ?? e}`);

@@ -5,10 +5,9 @@
 // the original's), and the pace: the original's log-time span of that run over the replay's. Prints
 // one JSON object per topic: {original, replayed, firstIndex, inOrder, firstMismatch, originalSpanS,
 // replaySpanS, pace}.
-import { open } from "node:fs/promises";
 import { createHash } from "node:crypto";
-import { McapIndexedReader } from "@mcap/core";
 import { loadDecompressHandlers } from "@mcap/support";
+import { openIndexed } from "./indexed_reader.mjs";
 
 const [original, replay, ...topics] = process.argv.slice(2);
 if (!replay || topics.length === 0) {
@@ -18,24 +17,14 @@ if (!replay || topics.length === 0) {
 const decompressHandlers = await loadDecompressHandlers();
 
 async function messages(path) {
-  const handle = await open(path, "r");
-  const size = BigInt((await handle.stat()).size);
-  const readable = {
-    size: async () => size,
-    read: async (offset, length) => {
-      const b = new Uint8Array(Number(length));
-      await handle.read(b, 0, b.length, Number(offset));
-      return b;
-    },
-  };
-  const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+  const { reader, close } = await openIndexed(path, decompressHandlers);
   const byTopic = new Map();
   for await (const m of reader.readMessages({ validateCrcs: true })) {
     const topic = reader.channelsById.get(m.channelId).topic;
     if (!byTopic.has(topic)) byTopic.set(topic, []);
     byTopic.get(topic).push({ t: m.logTime, digest: createHash("sha1").update(m.data).digest("hex") });
   }
-  await handle.close();
+  await close();
   return byTopic;
 }
 
