@@ -3,7 +3,7 @@
 #  1. the whole suite in Release with ctest (unit, lab, physics, tools, integration over a real DDS
 #     domain, the fuzz targets, the soak, and lint: clang-format on every file, clang-tidy on the
 #     sources changed by the last 3 commits);
-#  2. under AddressSanitizer + UndefinedBehaviorSanitizer, every test that can run under them: the
+#  2. under AddressSanitizer + UndefinedBehaviorSanitizer (built at -O1), every test that can run under them: the
 #     unit, lab and command-line tests. Left out, with the reason: the three "physics" tests (12k
 #     liver presses, ten minutes of sanitized tissue loop; the same code runs sanitized in the unit
 #     tests on smaller meshes) and the multi-process tests, which assert real-time rates (1 kHz) that

@@ -178,18 +178,17 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   return c;
 }
 
-SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration) {
-  SpecimenResult r;
-  r.supported = specimen_supports(m, d.mode, &r.note);
-  if (!r.supported) return r;
-  const Rig rig = make_rig(d);
-  const bool shear = rig.shear;
-  const Specimen& sp = d.specimen;
-  const auto& mesh = rig.mesh;
-  // The fitted law in GPS terms: unrelaxed modulus E_U = E + sum E_l, weights E_l / E_U on both
-  // shear and bulk parts (the whole D relaxes alike), Kelvin-Voigt time eta / E_U.
-  double relaxing = 0.0;
+namespace {
+
+/// The fitted law in GPS terms: unrelaxed modulus E_U = E + sum E_l, weights E_l / E_U on both
+/// shear and bulk parts (the whole D relaxes alike), Kelvin-Voigt time eta / E_U; softening per
+/// edge, as the law per specimen (under the mode's proportional loading the same factor); the
+/// elastic shape in the conservative (energy) form with its constants calibrated to the law's
+/// curve (`shape`, filled when the law has one).
+GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCalibration* calibration, double* unrelaxed_modulus_pa,
+                        ShapeCalibration* shape) {
   GpsViscoelasticity ve;
+  double relaxing = 0.0;
   if (m.has(Mechanism::broadband_relaxation))
     for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
       if (m.relaxation_modulus_pa[l] > 0) relaxing += m.relaxation_modulus_pa[l];
@@ -202,44 +201,85 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
       }
   ve.bulk_weight = ve.shear_weight;
   ve.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
-  // Per edge, as the law per specimen: under the mode's proportional loading the same factor.
   if (m.has(Mechanism::first_load_softening)) ve.first_load_softening = m.softening_d;
   if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
-    // Conservative (energy) form, with its constants calibrated to the law's elastic curve.
-    r.shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
-    ve.qlv_stiffening = r.shape.gps_b;
-    ve.compression_ratio = r.shape.gps_r;
+    *shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
+    ve.qlv_stiffening = shape->gps_b;
+    ve.compression_ratio = shape->gps_r;
     ve.qlv_form = GpsViscoelasticity::QlvForm::energy;
   }
   GpsOptions options;
   options.variant = GpsVariant::energy_consistent;
   options.viscoelasticity = ve;
-  const GpsModel model(mesh, {specimen_elasticity(E_u, shear)}, {}, options);
+  *unrelaxed_modulus_pa = E_u;
+  return options;
+}
 
+/// The test's loading on the rig's moving face: its strain history prescribed on the moving
+/// nodes' x, or its stress history as a traction on the moving face (per pascal, scaled by the
+/// history). The returned conditions refer to `t`, which must outlive them.
+BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const TestData& t) {
   BoundaryConditions bc = rig.bc;
-  const auto& moving = rig.moving;
-  const double eps = 1e-9 * sp.length_m;
-  const double gauge = rig.gauge, area = rig.area;
+  const bool shear = rig.shear;
   const double t0 = t.time_s.front();
   if (t.control == Control::strain) {
-    bc.prescribed_axes.push_back({moving, 0, [&, t0](const Vec3& X, double time) {
+    bc.prescribed_axes.push_back({rig.moving, 0, [&t, t0, shear](const Vec3& X, double time) {
                                     const double e = interpolate(t.time_s, t.strain, time + t0);
                                     return X.x() + e * (shear ? X.z() : X.x());
                                   }});
-  } else {
-    bc.nodal_forces.assign(mesh->node_count(), Vec3::Zero());
-    const int normal = shear ? 2 : 0;
-    const double face = shear ? sp.thickness_m : sp.length_m;
-    for (const auto& tri : extract_boundary(*mesh).triangles) {
-      bool on = true;
-      for (auto v : tri) on = on && mesh->nodes[v][normal] > face - eps;
-      if (!on) continue;
-      const Vec3 &a = mesh->nodes[tri[0]], &b = mesh->nodes[tri[1]], &c = mesh->nodes[tri[2]];
-      for (auto v : tri) bc.nodal_forces[v].x() += 0.5 * (b - a).cross(c - a).norm() / 3.0;  // per pascal
-    }
-    bc.force_amplitude = [&, t0](double time) { return interpolate(t.time_s, t.stress_pa, time + t0); };
+    return bc;
   }
-  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), sp.density_kg_m3), bc, {1e-3, 0.0, 1e-8, 25});
+  const auto& mesh = *rig.mesh;
+  const double eps = 1e-9 * d.specimen.length_m;
+  bc.nodal_forces.assign(mesh.node_count(), Vec3::Zero());
+  const int normal = shear ? 2 : 0;
+  const double face = shear ? d.specimen.thickness_m : d.specimen.length_m;
+  for (const auto& tri : extract_boundary(mesh).triangles) {
+    bool on = true;
+    for (auto v : tri) on = on && mesh.nodes[v][normal] > face - eps;
+    if (!on) continue;
+    const Vec3 &a = mesh.nodes[tri[0]], &b = mesh.nodes[tri[1]], &c = mesh.nodes[tri[2]];
+    for (auto v : tri) bc.nodal_forces[v].x() += 0.5 * (b - a).cross(c - a).norm() / 3.0;  // per pascal
+  }
+  bc.force_amplitude = [&t, t0](double time) { return interpolate(t.time_s, t.stress_pa, time + t0); };
+  return bc;
+}
+
+/// Advances to time `end` [s] in steps from 1/8 of the sampling interval `interval` (or 1 ms)
+/// growing by 1.6x: small where the history turns, long through holds (backward Euler is stable
+/// for any step). A step whose Newton iteration does not converge is retried at a quarter.
+void advance_to(ImplicitIntegrator& integrator, State& s, double end, double interval, double total_s, SpecimenResult& r) {
+  double dt = std::min(1e-3, interval / 8);
+  while (s.time_s < end - 1e-12) {
+    dt = std::min(dt, end - s.time_s);
+    integrator.set_dt(dt);
+    try {
+      r.newton_iterations += integrator.step(s).iterations;
+    } catch (const SimulationError&) {
+      // Newton did not converge: the state is unchanged; retry with a quarter of the step.
+      if (dt < 1e-9 * (total_s + 1)) throw;
+      dt /= 4;
+      ++r.step_cuts;
+      continue;
+    }
+    ++r.steps;
+    dt *= 1.6;
+  }
+}
+
+}  // namespace
+
+SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration) {
+  SpecimenResult r;
+  r.supported = specimen_supports(m, d.mode, &r.note);
+  if (!r.supported) return r;
+  const Rig rig = make_rig(d);
+  const auto& mesh = rig.mesh;
+  double E_u = 0.0;
+  const GpsOptions options = specimen_gps(m, d, calibration, &E_u, &r.shape);
+  const GpsModel model(mesh, {specimen_elasticity(E_u, rig.shear)}, {}, options);
+  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), d.specimen.density_kg_m3), specimen_loading(rig, d, t),
+                                {1e-3, 0.0, 1e-8, 25});
   State s = State::at_rest(*mesh);
   // The first sample is taken as an equilibrium state, as the material-point law does: grip (or
   // load) at its first value, solved statically, memory variables fully relaxed there.
@@ -249,6 +289,8 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
     std::vector<Vec3> f(mesh->node_count(), Vec3::Zero());
     model.add_forces(s.x, f, {s.memory, s.memory, 1e12});
   }
+  // The measured quantities: the moving face's reaction per area [Pa] and its mean displacement
+  // over the gauge (the strain).
   std::vector<Vec3> forces;
   const auto measure = [&](bool first) {
     if (first) {
@@ -259,35 +301,16 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
       forces = integrator.last_internal_forces();
     }
     double reaction = 0.0, u = 0.0;
-    for (auto i : moving) {
+    for (auto i : rig.moving) {
       reaction -= forces[i].x();
       u += s.x[i].x() - mesh->nodes[i].x();
     }
-    return std::pair{reaction / area, u / static_cast<double>(moving.size()) / gauge};
+    return std::pair{reaction / rig.area, u / static_cast<double>(rig.moving.size()) / rig.gauge};
   };
+  const double t0 = t.time_s.front();
   double sq = 0.0;
   for (std::size_t k = 0; k < t.time_s.size(); ++k) {
-    if (k > 0) {
-      // Steps from 1/8 of the interval (or 1 ms) growing by 1.6x: small where the history turns,
-      // long through holds; backward Euler is stable for any step.
-      const double end = t.time_s[k] - t0;
-      double dt = std::min(1e-3, (t.time_s[k] - t.time_s[k - 1]) / 8);
-      while (s.time_s < end - 1e-12) {
-        dt = std::min(dt, end - s.time_s);
-        integrator.set_dt(dt);
-        try {
-          r.newton_iterations += integrator.step(s).iterations;
-        } catch (const SimulationError&) {
-          // Newton did not converge: the state is unchanged; retry with a quarter of the step.
-          if (dt < 1e-9 * (t.time_s.back() - t0 + 1)) throw;
-          dt /= 4;
-          ++r.step_cuts;
-          continue;
-        }
-        ++r.steps;
-        dt *= 1.6;
-      }
-    }
+    if (k > 0) advance_to(integrator, s, t.time_s[k] - t0, t.time_s[k] - t.time_s[k - 1], t.time_s.back() - t0, r);
     const auto [stress, strain] = measure(k == 0);
     if (t.control == Control::strain) {
       r.stress_pa.push_back(stress);

@@ -148,6 +148,23 @@ for topic, r in c.items():
 sys.exit(1 if bad else 0)
 PY
 
+# --- A replay steered from a console: pause, seek while paused, resume ---------------------
+"$replay" play "$tmp/session.mcap" --partition replay-ctl --domain "$domain" --no-keys > "$tmp/play-ctl.log" 2>&1 & player=$!; pids+=($player)
+wait_for "playing" "$tmp/play-ctl.log"
+sleep 1
+"$ctl" pause --partition replay-ctl --domain "$domain" > "$tmp/steer.log" 2>&1; rc_pause=$?
+"$ctl" show --partition replay-ctl --domain "$domain" > "$tmp/show-paused.log" 2>&1
+"$ctl" seek 5 --partition replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1; rc_seek=$?
+"$ctl" resume --partition replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1; rc_resume=$?
+sleep 1.5  # a status line or two from where it was sought
+"$ctl" seek 99999 --partition replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1
+wait "$player"; rc_player=$?
+cat "$tmp/steer.log"; tail -4 "$tmp/play-ctl.log"
+check "the replay was paused (rc $rc_pause) and showed it" "[ $rc_pause -eq 0 ] && grep -q 'scene liver: paused' '$tmp/show-paused.log'"
+check "it sought while paused (rc $rc_seek) and resumed (rc $rc_resume) from there" \
+  "[ $rc_seek -eq 0 ] && [ $rc_resume -eq 0 ] && grep -q 'replay sought to 5.0 s' '$tmp/steer.log' && grep -qE '^viscera-replay: [5-9]\.[0-9] s of' '$tmp/play-ctl.log'"
+check "a seek past the end ends the replay (rc $rc_player)" "[ $rc_player -eq 0 ] && grep -q 'published' '$tmp/play-ctl.log'"
+
 # --- Re-simulation in lockstep ---------------------------------------------------------------
 "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --report "$tmp/resim.json" --quiet > "$tmp/resim.log" 2>&1; rc_resim=$?
 cat "$tmp/resim.log"
