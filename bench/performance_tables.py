@@ -28,7 +28,7 @@ def tick(path):
     data = json.load(open(path))
     ctx = data["context"]
     rows = ["| scene | tets | sub-steps per tick | tick on 1 thread [us] | tick on 2 threads [us] | budget [us] |", "|---|---|---|---|---|---|"]
-    med = {b["run_name"]: b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
+    med = {b["run_name"].removesuffix("/real_time"): b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
     scenes = sorted({n.split("/")[1] for n in med})
     for s in scenes:
         one, two = med.get(f"Tick/{s}/threads:1"), med.get(f"Tick/{s}/threads:2")

@@ -64,7 +64,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
       *organ.model, density, bc, ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
   check_tick_budget(organ.integrator->dt_s(), 0, rate_hz, budget, source, field);
   // The same chunks on any number of threads: the same bits (a session re-simulates on another).
-  organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, kForceChunks);
+  organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, std::max(kForceChunks, s.physics_threads));
   organ.integrator->set_force_evaluation(
       [p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return (*p)(x, f, m); });
   // The compliance predicts the simulated response, so it sees the same inertia.

@@ -23,7 +23,7 @@ struct Organ {
   tissue::Box bounds;
   tissue::BoundarySurface boundary;
   std::unique_ptr<tissue::ForceModel> model;
-  std::unique_ptr<ParallelForces> parallel_forces;  ///< on the scene's physics_threads, kForceChunks chunks; used by the integrator
+  std::unique_ptr<ParallelForces> parallel_forces;  ///< on the scene's physics_threads, max(kForceChunks, threads) chunks; used by the integrator
   std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
   std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
   /// One explicit sub-step of this organ on this machine [s] (the median of five, timed when built).

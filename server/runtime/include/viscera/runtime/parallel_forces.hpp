@@ -5,8 +5,10 @@
 // buffers are added after in chunk order, so the forces are the same bit for bit whichever thread
 // computed which chunk, and for any number of threads with the same chunks (deterministic; they
 // differ from ForceModel::add_forces in one piece only by rounding). One thread takes every chunk
-// itself: the server always evaluates in kForceChunks chunks, so that a session re-simulated on
-// another number of threads gives the same bits (docs/RECORDING.md).
+// itself: the server evaluates in kForceChunks chunks on one thread and on two, so that a session
+// re-simulated on the other number gives the same bits (docs/RECORDING.md); more threads than
+// that take a chunk each. Every chunk beyond the first costs a buffer to clear and to add (on the
+// 12k liver, 8 chunks made the tick 30-45% slower than 2: docs/PERFORMANCE-LOG.md).
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
 // calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
 // caller, waiting for a helper's chunk, spins briefly and then sleeps.
@@ -19,8 +21,8 @@
 
 namespace viscera::runtime {
 
-/// The chunks the server cuts the elements into, whatever its number of threads (at most this).
-inline constexpr int kForceChunks = 8;
+/// The chunks the server cuts the elements into on one or two threads (more threads: one each).
+inline constexpr int kForceChunks = 2;
 
 class ParallelForces {
  public:
