@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "viscera/client/stream_tap.hpp"
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
@@ -156,7 +158,21 @@ int info(const std::vector<std::string>& args, bool verify) {
                 c.metadata.count("source_id") ? c.metadata.at("source_id").c_str() : "?",
                 c.metadata.count("writer") ? c.metadata.at("writer").c_str() : "?", c.schema_id, static_cast<unsigned long long>(n));
   }
-  for (const auto& scene : r.scenes()) {
+  for (std::size_t k = 0; k < r.scenes().size(); ++k) {
+    const auto& scene = r.scenes()[k];
+    // The server publishes a scene's files again when its settings change at run time (a
+    // material, a physics rate): say so, rather than list it as another scene.
+    std::size_t changes = 0;
+    try {
+      changes = nlohmann::json::parse(scene.settings_json).value("changes", nlohmann::json::array()).size();
+    } catch (const nlohmann::json::exception&) {
+      // no readable settings: no changes to count
+    }
+    if (k > 0 && r.scenes()[k - 1].generation == scene.generation) {
+      std::printf("  scene (generation %u): its settings changed at run time (%zu change%s so far)\n", scene.generation, changes,
+                  changes == 1 ? "" : "s");
+      continue;
+    }
     std::printf("  scene (generation %u) from tick %llu, %s\n", scene.generation, static_cast<unsigned long long>(scene.first_tick),
                 scene.server_version.c_str());
     for (const auto& f : scene.files)
