@@ -62,9 +62,10 @@ std::shared_ptr<const Snapshot> CommandResponder::latest() const {
   return snapshot_;
 }
 
-ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c, std::uint64_t* tick) const {
+ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c, std::uint64_t* tick, double* max_edge_strain) const {
   const auto snap = latest();
   if (tick) *tick = snap->tick;
+  if (max_edge_strain) *max_edge_strain = snap->max_edge_strain;
   const Vec3 tip(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
   ContactResult result = queries_.at(instrument_id)->query(tip, snap->x);
   if (const auto g = snap->grasped.find(instrument_id); g != snap->grasped.end() && !g->second.empty()) {

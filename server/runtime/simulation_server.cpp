@@ -232,17 +232,20 @@ struct SimulationServer::Impl {
   void publish_snapshot(std::uint64_t tick) {
     auto snap = std::make_shared<Snapshot>();
     snap->tick = tick;
+    snap->max_edge_strain = organ->integrator->max_edge_strain();
     snap->x = state.x;
     for (const auto& [id, t] : tools)
       if (!t.tool.held().empty()) snap->grasped[id] = t.tool.held();
     responder.publish(std::move(snap));
   }
 
-  /// `tick`: the tick that stepped with the command, or whose state answered it.
+  /// `tick`: the tick that stepped with the command, or whose state answered it; `strain`: the
+  /// organ's largest edge strain that tick.
   void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns,
-                     std::uint64_t tick) {
+                     std::uint64_t tick, double strain) {
     proto::Force f = force_message(id, owner, command, r, local_stiffness(r, *organ->compliance, lockstep), proto::now_ns(), step_time_ns);
     f.tick = tick;
+    f.max_edge_strain = strain;
     auto payload = proto::encode(f);
     if (capture)
       capture->forces.push_back(std::move(payload));
@@ -254,7 +257,9 @@ struct SimulationServer::Impl {
   /// After a tick: every active tool's force, and its contact and grasp events.
   void publish_forces(std::int64_t step_time_ns) {
     for (auto& [id, t] : tools) {
-      if (t.tool.active()) publish_force(id, t.tool.owner(), t.tool.command(), t.result, std::max<std::int64_t>(step_time_ns, 1), current_tick());
+      if (t.tool.active())
+        publish_force(id, t.tool.owner(), t.tool.command(), t.result, std::max<std::int64_t>(step_time_ns, 1), current_tick(),
+                      organ->integrator->max_edge_strain());
       if (const ToolEvent e = t.tool.update_contact(t.result.in_contact, sim_time_s); e != ToolEvent::none)
         event(e == ToolEvent::contact_started ? proto::EventKind::contact_started : proto::EventKind::contact_ended, id, t.tool.owner());
     }
@@ -288,8 +293,9 @@ struct SimulationServer::Impl {
     });
     for (const auto& u : updated) {
       std::uint64_t tick = 0;
-      const ContactResult r = responder.answer(u.id, u.command, &tick);
-      publish_force(u.id, u.owner, u.command, r, 0, tick);
+      double strain = 0;
+      const ContactResult r = responder.answer(u.id, u.command, &tick, &strain);
+      publish_force(u.id, u.owner, u.command, r, 0, tick, strain);
     }
   }
 
@@ -311,8 +317,9 @@ struct SimulationServer::Impl {
         continue;
       }
       std::uint64_t tick = 0;
-      const ContactResult r = responder.answer(c->instrument_id, *c, &tick);
-      publish_force(c->instrument_id, c->client_id, *c, r, 0, tick);
+      double strain = 0;
+      const ContactResult r = responder.answer(c->instrument_id, *c, &tick, &strain);
+      publish_force(c->instrument_id, c->client_id, *c, r, 0, tick, strain);
     }
   }
 

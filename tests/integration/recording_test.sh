@@ -204,10 +204,14 @@ printf '\x55\xaa\x55\xaa\x55\xaa\x55\xaa' | dd of="$tmp/corrupt.mcap" bs=1 seek=
 printf 'time_s,strain,stress_pa\n0,0,0\n' > "$tmp/not-mcap.mcap"
 python3 - "$tmp/session.mcap" "$tmp/newer.mcap" <<'PY'
 import sys
-b = open(sys.argv[1], "rb").read()
-key = b"schema_version" + (1).to_bytes(4, "little") + b"7"
-assert key in b, "the recording's schema_version metadata"
-open(sys.argv[2], "wb").write(b.replace(key, key[:-1] + b"9"))
+b = bytearray(open(sys.argv[1], "rb").read())
+at = b.index(b"schema_version") + len(b"schema_version")  # then the value: u32 length, digits
+n = int.from_bytes(b[at:at + 4], "little")
+version = int(b[at + 4:at + 4 + n])
+newer = str(version + 1) if len(str(version + 1)) == n else "9" * n  # same length: the file's offsets stay
+assert int(newer) > version
+b[at + 4:at + 4 + n] = newer.encode()
+open(sys.argv[2], "wb").write(b)
 PY
 sed 's#liver2.msh#liver.msh#' "$scene" > "$tmp/other-organ.json"
 bad() {  # NAME WANT COMMAND...: exit 2, one line on stderr containing WANT

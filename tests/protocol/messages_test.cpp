@@ -34,11 +34,19 @@ TEST(Messages, RoundTripsEveryMessage) {
   f.force = {0.1, 0.2, 3.0};
   f.in_contact = true;
   f.stiffness[4] = 200;
+  f.max_edge_strain = 0.137;
   const auto fd = decode_force(encode(f), &why);
   ASSERT_TRUE(fd) << why;
   EXPECT_EQ(fd->force[2], 3.0);
   EXPECT_TRUE(fd->in_contact);
   EXPECT_EQ(fd->stiffness[4], 200);
+  EXPECT_EQ(fd->max_edge_strain, 0.137);
+  // An edge strain that cannot be: negative, not a number, beyond any organ that still runs.
+  for (const double bad : {-0.1, std::nan(""), 1e6}) {
+    Force g = f;
+    g.max_edge_strain = bad;
+    EXPECT_FALSE(decode_force(encode(g), &why)) << bad;
+  }
   const auto s = decode_session_request(encode(SessionRequest{7, Action::release_instrument, 2}), &why);
   ASSERT_TRUE(s) << why;
   EXPECT_EQ(s->action, Action::release_instrument);

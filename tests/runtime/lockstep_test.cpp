@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -218,4 +219,46 @@ TEST(Lockstep, AStepForAnotherTickIsRefusedWithItsReason) {
 }
 
 }  // namespace
+TEST(Lockstep, EveryForceCarriesTheOrgansLargestEdgeStrainOfItsTick) {
+  const LockstepRun a = run(1);
+  ASSERT_EQ(a.results.size(), static_cast<std::size_t>(kTicks + 1));
+  std::string why;
+  std::map<std::uint64_t, double> stepped;  // tick -> strain of the force stepped there
+  double before_contact = 0, deepest = 0;
+  std::vector<double> in_contact;  // the stepped forces' strain while pressing, in order
+  for (const auto& r : a.results)
+    for (const auto& payload : r.forces) {
+      const auto f = proto::decode_force(payload, &why);
+      ASSERT_TRUE(f) << why;
+      if (f->step_time_ns == 0) {
+        // Answered on the state after tick T (in step T + 1): the strain of tick T's evaluations.
+        if (stepped.count(f->tick)) {
+          EXPECT_EQ(f->max_edge_strain, stepped[f->tick]) << "tick " << f->tick;
+        }
+        continue;
+      }
+      stepped[f->tick] = f->max_edge_strain;
+      if (!f->in_contact && deepest == 0) before_contact = std::max(before_contact, f->max_edge_strain);
+      if (f->in_contact) {
+        in_contact.push_back(f->max_edge_strain);
+        deepest = std::max(deepest, f->max_edge_strain);
+      }
+    }
+  // At rest the edges have their rest lengths; pressed 18 mm in, the tissue under a 6 mm tip is
+  // strained by a few percent to a few tens, never near the 2 at which the integration stops.
+  EXPECT_LT(before_contact, 1e-12);
+  EXPECT_GT(deepest, 0.01);
+  EXPECT_LT(deepest, 1.0);
+  // The press goes steadily deeper: the strain grows with it. Not tick by tick (the surface rings,
+  // and the largest edge strain follows it), but the last fifth of the press is well above the first.
+  ASSERT_GT(in_contact.size(), 100u);
+  const std::size_t fifth = in_contact.size() / 5;
+  double first = 0, last = 0;
+  for (std::size_t k = 0; k < fifth; ++k) {
+    first += in_contact[k] / static_cast<double>(fifth);
+    last += in_contact[in_contact.size() - 1 - k] / static_cast<double>(fifth);
+  }
+  EXPECT_GT(last, 2 * first) << "first fifth of the press " << first << ", last " << last;
+}
+
 }  // namespace viscera::runtime

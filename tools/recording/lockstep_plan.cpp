@@ -62,6 +62,10 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
   plan.first_tick = plan.scene.first_tick;
   plan.sim_time_s = plan.scene.sim_time_s;
   plan.last_tick = plan.first_tick;
+  if (const auto it = recording.info().find("schema_version"); it != recording.info().end() && it->second.size() == 1 && it->second < "8") {
+    plan.strain_recorded = false;
+    plan.notes.push_back("recorded with protocol schema " + it->second + ": its forces carry no edge strain, which is not compared");
+  }
 
   std::map<CommandKey, std::vector<std::uint8_t>> commands;
   std::map<RequestKey, std::vector<TimedPayload>> requests;  // in log-time order
@@ -218,7 +222,7 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
     const bool stepped = f.step_time_ns > 0;
     const std::uint64_t result_tick = stepped ? f.tick : f.tick + 1;
     plan.forces[result_tick].push_back({f.instrument_id, f.client_id, f.command_seq, stepped, f.in_contact, f.force, f.torque, f.contact_point,
-                                        f.contact_normal, f.penetration_m, f.stiffness, force_log_times[i]});
+                                        f.contact_normal, f.penetration_m, f.max_edge_strain, f.stiffness, force_log_times[i]});
     ++plan.recorded_forces;
     plan.last_tick = std::max(plan.last_tick, result_tick);
     if (stepped) {

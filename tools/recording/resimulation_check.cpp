@@ -25,7 +25,8 @@ bool same_bits(const Range& a, const Range& b) {
 }
 
 /// The first field of two forces that differs, or nullopt: (name, recorded, recomputed).
-std::optional<std::tuple<std::string, std::string, std::string>> force_difference(const ExpectedForce& e, const proto::Force& f) {
+std::optional<std::tuple<std::string, std::string, std::string>> force_difference(const ExpectedForce& e, const proto::Force& f,
+                                                                                  bool compare_strain) {
   if (e.in_contact != f.in_contact) return std::make_tuple("in_contact", e.in_contact ? "true" : "false", f.in_contact ? "true" : "false");
   const char* axes = "xyz";
   const auto vec = [&](const char* name, const proto::Vector3& a,
@@ -40,6 +41,8 @@ std::optional<std::tuple<std::string, std::string, std::string>> force_differenc
   if (auto d = vec("contact_normal", e.contact_normal, f.contact_normal)) return d;
   if (!same_bits(e.penetration_m, f.penetration_m))
     return std::make_tuple("penetration_m", exact_number(e.penetration_m), exact_number(f.penetration_m));
+  if (compare_strain && !same_bits(e.max_edge_strain, f.max_edge_strain))
+    return std::make_tuple("max_edge_strain", exact_number(e.max_edge_strain), exact_number(f.max_edge_strain));
   return std::nullopt;
 }
 
@@ -78,7 +81,7 @@ void ResimulationCheck::check_forces(const proto::LockstepResult& r) {
         continue;
       }
       ++matched;
-      if (const auto d = force_difference(e, it->second)) {
+      if (const auto d = force_difference(e, it->second, plan_.strain_recorded)) {
         diverged({r.tick, "force_feedback", describe(e.instrument_id, e.command_seq, e.stepped), std::get<0>(*d), std::get<1>(*d), std::get<2>(*d)});
       } else {
         ++counts_.forces_identical;

@@ -74,6 +74,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
     }
     throw SimulationError(msg.str());
   }
+  max_edge_strain_ = std::max(max_edge_strain_, stats.max_edge_strain);
   x_prev_ = state.x;
   v_prev_ = state.v;
   t_prev_ = state.time_s;
@@ -117,6 +118,7 @@ long ExplicitIntegrator::advance(State& state, double duration_s) {
   const long steps = static_cast<long>(std::ceil(duration_s / dt_ * (1 - 1e-12)));
   const double dt = duration_s / static_cast<double>(steps);
   const double start = state.time_s;
+  max_edge_strain_ = 0.0;
   for (long k = 1; k <= steps; ++k) {
     step_with(state, dt);
     state.time_s = start + static_cast<double>(k) * dt;

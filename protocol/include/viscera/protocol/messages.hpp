@@ -35,6 +35,9 @@ struct Force {
   /// schema 7: the tick that stepped with the command (step_time_ns > 0), or whose state answered
   /// it at once (step_time_ns 0); 0 from older servers
   std::uint64_t tick = 0;
+  /// schema 8: the organ's largest edge strain |L - L0| / L0 over that tick's force evaluations
+  /// (a tissue-damage proxy); 0 from older servers
+  double max_edge_strain = 0;
 };
 
 enum class Action : std::int8_t {
@@ -205,7 +208,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 7;
+inline constexpr int kSchemaVersion = 8;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -22,6 +22,7 @@ namespace viscera::runtime {
 /// The organ after a tick and the tissue each grasper holds; never changed once published.
 struct Snapshot {
   std::uint64_t tick = 0;  ///< the tick after which it was taken
+  double max_edge_strain = 0;  ///< the organ's largest edge strain that tick's force evaluations saw
   std::vector<Vec3> x;
   std::map<std::uint32_t, GraspHold> grasped;
 };
@@ -49,8 +50,9 @@ class CommandResponder {
   void publish(std::shared_ptr<const Snapshot> snapshot);
   std::shared_ptr<const Snapshot> latest() const;
   /// Command thread: the reaction on `instrument_id` at the commanded pose on the newest snapshot
-  /// (`tick`, if given, gets the snapshot's tick).
-  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command, std::uint64_t* tick = nullptr) const;
+  /// (`tick` and `max_edge_strain`, if given, get the snapshot's).
+  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command, std::uint64_t* tick = nullptr,
+                       double* max_edge_strain = nullptr) const;
 
  private:
   std::map<std::uint32_t, std::unique_ptr<ProbeContact>> queries_;

@@ -34,6 +34,7 @@ struct ExpectedForce {
   bool in_contact = false;
   protocol::Vector3 force{}, torque{}, contact_point{}, contact_normal{};
   double penetration_m = 0;
+  double max_edge_strain = 0;
   std::array<double, 9> stiffness{};
   std::uint64_t log_time_ns = 0;
 };
@@ -64,6 +65,7 @@ struct LockstepPlan {
   std::map<std::uint64_t, ExpectedFrame> frames;
   std::uint64_t recorded_forces = 0, recorded_events = 0, recorded_frames = 0;
   std::vector<std::string> notes;  ///< what could not be reproduced, and why
+  bool strain_recorded = true;  ///< forces carry the organ's edge strain (recorded with schema 8 or later)
   /// The step of `tick` (an empty one where nothing happens).
   protocol::LockstepStep step(std::uint64_t tick) const;
 };

@@ -1,6 +1,6 @@
 #pragma once
 // A re-simulation compared with its recording, tick by tick: every recorded force (all its
-// physics: contact, force, torque, contact point and normal, penetration; not the wall-clock
+// physics: contact, force, torque, contact point and normal, penetration, the organ's largest edge strain; not the wall-clock
 // stamps), every server event (kind, instrument, client, request, simulated time), every surface
 // frame (positions to the bit) against what the lockstep server computed. The first divergence is
 // named: tick, topic, field, recorded and recomputed values. No network: the driver feeds it the

@@ -45,6 +45,9 @@ class ExplicitIntegrator {
   /// Returns the number of sub-steps. Between sub-steps it asks the interruption (if set) and
   /// returns early when it says so, with the state at the last sub-step taken.
   long advance(State& state, double duration_s);
+  /// The largest edge strain |L - L0| / L0 that the force evaluations of the last advance() saw
+  /// (at the start of each sub-step).
+  double max_edge_strain() const { return max_edge_strain_; }
   /// Asked between the sub-steps of advance(): true stops it (a program that must stop at once).
   void set_interruption(std::function<bool()> interrupted) { interrupted_ = std::move(interrupted); }
 
@@ -76,6 +79,7 @@ class ExplicitIntegrator {
   std::vector<Vec3> force_, x_prev_, v_prev_;
   std::vector<double> field_stiffness_, field_damping_;
   double t_prev_ = 0.0;
+  double max_edge_strain_ = 0.0;
 };
 
 }  // namespace viscera::tissue
