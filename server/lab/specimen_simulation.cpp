@@ -101,9 +101,8 @@ Mat6 specimen_elasticity(double modulus_pa, bool shear) {
 std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, double r, const std::vector<double>& strains) {
   GpsOptions options;
   options.variant = GpsVariant::energy_consistent;
-  options.viscoelasticity.qlv_stiffening = b;
-  options.viscoelasticity.compression_ratio = r;
-  options.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+  options.mechanisms.stiffening = {b, GpsStiffening::Form::energy};
+  options.mechanisms.asymmetry.compression_ratio = r;
   const GpsModel model(rig.mesh, {specimen_elasticity(modulus_pa, rig.shear)}, {}, options);
   double strain = 0.0;
   BoundaryConditions bc = rig.bc;
@@ -187,7 +186,7 @@ namespace {
 /// curve (`shape`, filled when the law has one).
 GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCalibration* calibration, double* unrelaxed_modulus_pa,
                         ShapeCalibration* shape) {
-  GpsViscoelasticity ve;
+  GpsMechanisms ve;
   double relaxing = 0.0;
   if (m.has(Mechanism::broadband_relaxation))
     for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
@@ -196,21 +195,19 @@ GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCal
   if (m.has(Mechanism::broadband_relaxation))
     for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
       if (m.relaxation_modulus_pa[l] > 0) {
-        ve.omega_rad_s.push_back(1.0 / m.relaxation_time_s[l]);
-        ve.shear_weight.push_back(m.relaxation_modulus_pa[l] / E_u);
+        ve.viscous.omega_rad_s.push_back(1.0 / m.relaxation_time_s[l]);
+        ve.viscous.shear_weight.push_back(m.relaxation_modulus_pa[l] / E_u);
       }
-  ve.bulk_weight = ve.shear_weight;
-  ve.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
-  if (m.has(Mechanism::first_load_softening)) ve.first_load_softening = m.softening_d;
+  ve.viscous.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
+  if (m.has(Mechanism::first_load_softening)) ve.softening.d = m.softening_d;
   if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
     *shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
-    ve.qlv_stiffening = shape->gps_b;
-    ve.compression_ratio = shape->gps_r;
-    ve.qlv_form = GpsViscoelasticity::QlvForm::energy;
+    ve.stiffening = {shape->gps_b, GpsStiffening::Form::energy};
+    ve.asymmetry.compression_ratio = shape->gps_r;
   }
   GpsOptions options;
   options.variant = GpsVariant::energy_consistent;
-  options.viscoelasticity = ve;
+  options.mechanisms = ve;
   *unrelaxed_modulus_pa = E_u;
   return options;
 }

@@ -41,7 +41,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   const SceneSpec& s = organ.scene;
   const Material& material = organ.material;
   Mat6 D = material.elasticity;
-  GpsViscoelasticity ve;
+  GpsMechanisms ve;
   if (material.viscoelasticity) {
     const ViscoelasticSetup setup = make_viscoelastic(material.elasticity, *material.viscoelasticity, s.material);
     D = setup.unrelaxed_elasticity;

@@ -267,6 +267,25 @@ struct SimulationServer::Impl {
 
   // --- Commands (command thread) ------------------------------------------------------------
 
+  /// A command's payload decoded, or counted as malformed.
+  std::optional<proto::Command> decode_counted(std::span<const std::uint8_t> payload) {
+    std::string why;
+    auto c = proto::decode_command(payload, &why);
+    if (!c) ++rejected_malformed;
+    return c;
+  }
+
+  /// A command offered to its instrument, a refusal counted; whether it became the newest.
+  bool offer_counted(const proto::Command& c, std::int64_t now_ns) {
+    switch (instruments.command(c, now_ns)) {
+      case CommandResult::accepted: return true;
+      case CommandResult::stale: return false;
+      case CommandResult::not_owner: ++rejected_not_owner; return false;
+      case CommandResult::unknown_instrument: ++rejected_unknown_instrument; return false;
+    }
+    return false;
+  }
+
   /// Each valid command from an instrument's owner becomes the instrument's newest command and is
   /// answered at once with the reaction at the commanded pose on the newest snapshot (contact
   /// query, no step). The next tick steps the tissue with it.
@@ -278,18 +297,8 @@ struct SimulationServer::Impl {
     std::vector<Update> updated;
     std::lock_guard world(organ_mutex);  // the organ and the responder's queries stay while we answer
     endpoints.take_commands([&](const proto::Received& r) {
-      std::string why;
-      const auto c = proto::decode_command(r.payload, &why);
-      if (!c) {
-        ++rejected_malformed;
-        return;
-      }
-      switch (instruments.command(*c, proto::now_ns())) {
-        case CommandResult::accepted: updated.push_back({c->instrument_id, c->client_id, *c}); break;
-        case CommandResult::stale: break;
-        case CommandResult::not_owner: ++rejected_not_owner; break;
-        case CommandResult::unknown_instrument: ++rejected_unknown_instrument; break;
-      }
+      const auto c = decode_counted(r.payload);
+      if (c && offer_counted(*c, proto::now_ns())) updated.push_back({c->instrument_id, c->client_id, *c});
     });
     for (const auto& u : updated) {
       std::uint64_t tick = 0;
@@ -306,12 +315,8 @@ struct SimulationServer::Impl {
   /// within one tick's interval is not recorded).
   void answer_in_lockstep(const std::vector<std::vector<std::uint8_t>>& answers) {
     for (const auto& payload : answers) {
-      std::string why;
-      const auto c = proto::decode_command(payload, &why);
-      if (!c) {
-        ++rejected_malformed;
-        continue;
-      }
+      const auto c = decode_counted(payload);
+      if (!c) continue;
       if (!instruments.owner(c->instrument_id)) {
         ++rejected_unknown_instrument;
         continue;
@@ -326,20 +331,8 @@ struct SimulationServer::Impl {
   /// Lockstep: the step's commands become their instruments' newest (the live command thread's
   /// other half).
   void command_in_lockstep(const std::vector<std::vector<std::uint8_t>>& commands) {
-    for (const auto& payload : commands) {
-      std::string why;
-      const auto c = proto::decode_command(payload, &why);
-      if (!c) {
-        ++rejected_malformed;
-        continue;
-      }
-      switch (instruments.command(*c, 0)) {
-        case CommandResult::accepted:
-        case CommandResult::stale: break;
-        case CommandResult::not_owner: ++rejected_not_owner; break;
-        case CommandResult::unknown_instrument: ++rejected_unknown_instrument; break;
-      }
-    }
+    for (const auto& payload : commands)
+      if (const auto c = decode_counted(payload)) offer_counted(*c, 0);
   }
 
   // --- Session requests (physics thread) -----------------------------------------------------

@@ -169,7 +169,7 @@ TEST(Specimen, FungStiffeningRunsInItsEnergyFormUniaxiallyAndIsRefusedInShear) {
 
 TEST(Specimen, FirstLoadSofteningRunsPerEdgeInBothModes) {
   // Seeds 9 (uniaxial) and 4 (simple shear) hide first-load softening. On the specimen each edge
-  // keeps its own extremes (GpsViscoelasticity::first_load_softening); under the mode's
+  // keeps its own extremes (GpsSoftening); under the mode's
   // proportional loading every edge's |e| / m is the specimen's, so what the softening changes in
   // the specimen's stress history (the fitted model against the same model with d = 0) must be
   // what it changes in the law's, on every strain-controlled test with reloading. Uniaxially the

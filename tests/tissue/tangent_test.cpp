@@ -39,14 +39,14 @@ TEST(Tangent, MatchesFiniteDifferencesAtLargeDeformation) {
     const GpsModel volume(mesh, {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.6});
     const FiniteElementModel linear(mesh, FeKind::linear, {test::soft_tissue()});
     GpsOptions qlv_options;
-    qlv_options.viscoelasticity.qlv_stiffening = 8.0;
+    qlv_options.mechanisms.stiffening.b = 8.0;
     const GpsModel qlv(mesh, {test::soft_tissue()}, {}, qlv_options);
     GpsOptions fung_energy{GpsVariant::energy_consistent, 0.4};
-    fung_energy.viscoelasticity.qlv_stiffening = 8.0;
-    fung_energy.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+    fung_energy.mechanisms.stiffening.b = 8.0;
+    fung_energy.mechanisms.stiffening.form = GpsStiffening::Form::energy;
     const GpsModel qlv_energy(mesh, {test::soft_tissue()}, {}, fung_energy);
     GpsOptions asymmetric = fung_energy;
-    asymmetric.viscoelasticity.compression_ratio = 0.4;
+    asymmetric.mechanisms.asymmetry.compression_ratio = 0.4;
     const GpsModel qlv_asymmetric(mesh, {test::soft_tissue()}, {}, asymmetric);
     for (const ForceModel* m :
          {static_cast<const ForceModel*>(&paper), static_cast<const ForceModel*>(&energy), static_cast<const ForceModel*>(&volume),
@@ -69,11 +69,11 @@ TEST(Tangent, EnergyConsistentForcesAreTheEnergyGradient) {
   std::mt19937_64 rng(22);
   const auto rest = test::random_tet(rng);
   GpsOptions fung{GpsVariant::energy_consistent, 0.5};
-  fung.viscoelasticity.qlv_stiffening = 10.0;
-  fung.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+  fung.mechanisms.stiffening.b = 10.0;
+  fung.mechanisms.stiffening.form = GpsStiffening::Form::energy;
   const GpsModel linear(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, {GpsVariant::energy_consistent, 0.5});
   const GpsModel stiffening(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, fung);
-  fung.viscoelasticity.compression_ratio = 2.5;
+  fung.mechanisms.asymmetry.compression_ratio = 2.5;
   const GpsModel asymmetric(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, fung);
   std::vector<Vec3> x(rest.begin(), rest.end());
   for (auto& p : x) p = 1.1 * p + 0.001 * Vec3::Random();

@@ -39,7 +39,7 @@ struct Element {
     spec.bulk_q = bulk_q;
     ve = make_viscoelastic(elasticity_matrix(IsotropicElasticity{3e3, 0.3}), spec);
     GpsOptions o;
-    o.viscoelasticity = ve.gps;
+    o.mechanisms = ve.gps;
     model = std::make_unique<GpsModel>(test::single_tet_mesh(rest), std::vector<Mat6>{ve.unrelaxed_elasticity}, std::vector<std::uint16_t>{}, o);
   }
   // Positions under the homogeneous displacement gradient a * G.
@@ -184,7 +184,7 @@ TEST(FirstLoadSoftening, AnElementUnderProportionalLoadingSoftensAsTheLaw) {
   const double d = 0.4, A = 1e-4;
   const std::array<Vec3, 4> rest{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0), Vec3(0.005, 0.00289, 0.00816)};
   GpsOptions soft;
-  soft.viscoelasticity.first_load_softening = d;
+  soft.mechanisms.softening.d = d;
   const GpsModel softened(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, soft);
   const GpsModel virgin(test::single_tet_mesh(rest), {test::soft_tissue()});
   Mat3 G = Mat3::Zero();
@@ -236,9 +236,9 @@ TEST(FirstLoadSoftening, TangentIsTheDerivativeOfTheForcesAtTheExtremesTheStepSt
   const auto rest = test::random_tet(rng);
   for (const bool energy : {false, true}) {
     GpsOptions o{GpsVariant::energy_consistent, 0.0};
-    o.viscoelasticity.first_load_softening = 0.5;
-    o.viscoelasticity.qlv_stiffening = 6.0;
-    if (energy) o.viscoelasticity.qlv_form = GpsViscoelasticity::QlvForm::energy;
+    o.mechanisms.softening.d = 0.5;
+    o.mechanisms.stiffening.b = 6.0;
+    if (energy) o.mechanisms.stiffening.form = GpsStiffening::Form::energy;
     const GpsModel model(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, o);
     std::vector<double> before(model.memory_size(), 0.0);
     std::vector<Vec3> x(rest.begin(), rest.end()), f(4);
@@ -322,7 +322,7 @@ TEST(Stability, ExplicitLiverWithMemoryVariablesStaysWithinItsEnergyBound) {
   spec.bulk_q = 10.0;
   const ViscoelasticSetup ve = make_viscoelastic(test::soft_tissue(), spec);
   GpsOptions o;
-  o.viscoelasticity = ve.gps;
+  o.mechanisms = ve.gps;
   const GpsModel model(mesh, {ve.unrelaxed_elasticity}, {}, o);
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -9.81);
@@ -354,8 +354,8 @@ TEST(Stability, ExplicitLiverWithMemoryVariablesStaysWithinItsEnergyBound) {
   ASSERT_EQ(llt.info(), Eigen::Success);
   const double static_energy2 = f.dot(llt.solve(f));  // u_s^T K_u u_s
   double r = 1.0, shear = 1.0, bulk = 1.0;
-  for (double y : ve.gps.shear_weight) shear -= y;
-  for (double y : ve.gps.bulk_weight) bulk -= y;
+  for (double y : ve.gps.viscous.shear_weight) shear -= y;
+  for (double y : ve.gps.viscous.bulk_weight) bulk -= y;
   r = std::min(shear, bulk);
   ASSERT_GT(r, 0.0);
   State s = State::at_rest(*mesh);
@@ -382,7 +382,7 @@ TEST(Stability, KelvinVoigtShortensTheComputedStepAndStaysStableThere) {
   spec.model = ViscoelasticSpec::Model::kelvin_voigt;
   const ViscoelasticSetup ve = make_viscoelastic(test::soft_tissue(), spec);
   GpsOptions o;
-  o.viscoelasticity = ve.gps;
+  o.mechanisms = ve.gps;
   const GpsModel kv(mesh, {ve.unrelaxed_elasticity}, {}, o);
   const GpsModel elastic(mesh, {ve.unrelaxed_elasticity});
   const std::vector<double> rho(mesh->tet_count(), 1060.0);
@@ -494,10 +494,10 @@ TEST(Qlv, UniformDilatationStiffensExactlyAsFungsExponential) {
   const std::array<Vec3, 4> rest{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.004, 0.009, 0), Vec3(0.003, 0.002, 0.008)};
   const double B = 12.0;
   const GpsModel linear(test::single_tet_mesh(rest), {test::soft_tissue()});
-  for (const auto form : {GpsViscoelasticity::QlvForm::edge_map, GpsViscoelasticity::QlvForm::energy}) {
+  for (const auto form : {GpsStiffening::Form::edge_map, GpsStiffening::Form::energy}) {
     GpsOptions q;
-    q.viscoelasticity.qlv_stiffening = B;
-    q.viscoelasticity.qlv_form = form;
+    q.mechanisms.stiffening.b = B;
+    q.mechanisms.stiffening.form = form;
     const GpsModel qlv(test::single_tet_mesh(rest), {test::soft_tissue()}, {}, q);
     for (double e : {-0.1, -0.0004, 0.0007, 0.05, 0.2}) {  // both sides of the series/closed-form switch at |B e| = 0.01
       std::vector<Vec3> x;
@@ -543,4 +543,75 @@ TEST(Qlv, EnergyMapSatisfiesItsDefinition) {
     EXPECT_NEAR(m.d2h, (edge_energy_map(6.0, 0.3, e + d).dh - edge_energy_map(6.0, 0.3, e - d).dh) / (2 * d), 1e-4 * (1 + std::abs(m.d2h))) << e;
     EXPECT_GT(m.dh, 0.0);
   }
+}
+
+// Each part of the composition refuses what it cannot run, naming itself; the rules between parts
+// are checked where the parts meet; a valid composition reaches the model unchanged.
+TEST(GpsMechanisms, EachPartAndEachRuleBetweenPartsRefusesWhatItCannotRun) {
+  const auto refusal = [](const GpsMechanisms& m) {
+    try {
+      m.validate();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  GpsMechanisms ok;
+  ok.viscous = {{1.0, 10.0}, {0.2, 0.1}, {}, 0.01};
+  ok.stiffening = {8.0, GpsStiffening::Form::energy};
+  ok.asymmetry.compression_ratio = 2.0;
+  ok.softening.d = 0.3;
+  EXPECT_EQ(refusal(ok), "");
+  EXPECT_TRUE(ok.energy_map());
+  EXPECT_TRUE(ok.has_memory());
+  EXPECT_FALSE(GpsMechanisms{}.has_memory());
+
+  GpsMechanisms m = ok;
+  m.viscous.shear_weight.pop_back();
+  EXPECT_NE(refusal(m).find("viscous part"), std::string::npos);
+  m = ok;
+  m.viscous.omega_rad_s.assign(9, 1.0);
+  m.viscous.shear_weight.assign(9, 0.01);
+  EXPECT_NE(refusal(m).find("at most 8"), std::string::npos);
+  m = ok;
+  m.viscous.omega_rad_s[0] = 0.0;
+  EXPECT_NE(refusal(m).find("viscous part"), std::string::npos);
+  m = ok;
+  m.viscous.kelvin_voigt_time_s = -1e-3;
+  EXPECT_NE(refusal(m).find("Kelvin-Voigt"), std::string::npos);
+  m = ok;
+  m.stiffening.b = std::nan("");
+  EXPECT_NE(refusal(m).find("stiffening"), std::string::npos);
+  m = ok;
+  m.asymmetry.compression_ratio = 0.0;
+  EXPECT_NE(refusal(m).find("asymmetry"), std::string::npos);
+  m = ok;
+  m.softening.d = 1.0;
+  EXPECT_NE(refusal(m).find("softening"), std::string::npos);
+  // Between parts: asymmetry lives in the energy form only ...
+  m = ok;
+  m.stiffening.form = GpsStiffening::Form::edge_map;
+  EXPECT_NE(refusal(m).find("energy form"), std::string::npos);
+  // ... and the energy form relaxes the whole tension, so bulk and shear must relax alike.
+  m = ok;
+  m.viscous.bulk_weight = {0.0, 0.0};
+  EXPECT_NE(refusal(m).find("bulk and shear"), std::string::npos);
+  m.stiffening.b = 0.0;
+  m.asymmetry.compression_ratio = 1.0;  // no energy map left: the bulk may relax on its own
+  EXPECT_EQ(refusal(m), "");
+
+  const auto mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(0.01, 0.01, 0.01), 1, 1, 1));
+  const Mat6 D = elasticity_matrix(IsotropicElasticity{3e3, 0.3});
+  GpsOptions bad_options;
+  bad_options.mechanisms.softening.d = 1.5;
+  EXPECT_THROW(GpsModel(mesh, {D}, {}, bad_options), std::invalid_argument);
+  EXPECT_THROW(GpsModel(mesh, {D}, std::vector<std::uint16_t>(mesh->tet_count(), 1)), std::invalid_argument);
+  GpsOptions options;
+  options.variant = GpsVariant::energy_consistent;
+  options.mechanisms = ok;
+  const GpsModel model(mesh, {D}, {}, options);
+  EXPECT_EQ(model.options().mechanisms.viscous.omega_rad_s, ok.viscous.omega_rad_s);
+  EXPECT_EQ(model.stiffness_damping_time_s(), 0.01);
+  // Memory per block: elongations, 2 mechanisms, 2 softening extremes (6 x 8 doubles each).
+  EXPECT_EQ(model.memory_size(), (mesh->tet_count() + 7) / 8 * (1 + 2 + 2) * 6 * 8);
 }

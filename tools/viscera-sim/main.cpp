@@ -140,14 +140,14 @@ Organ build(const viscera::common::CommandLine& cl) {
   o.material = material_of(cl);
   const double volume = cl.number_in("volume-term", 0.0, 0.999);
   Mat6 elasticity = o.material.elasticity;
-  GpsViscoelasticity viscoelasticity;
+  GpsMechanisms mechanisms;
   if (o.material.viscoelasticity) {
     const ViscoelasticSetup ve = make_viscoelastic(o.material.elasticity, *o.material.viscoelasticity, cl.text("material"));
     std::printf("viscoelasticity\n%s", ve.table.c_str());
     elasticity = ve.unrelaxed_elasticity;
-    viscoelasticity = ve.gps;
+    mechanisms = ve.gps;
   }
-  o.model = make_force_model(cl.text("model"), o.mesh, {elasticity}, volume, viscoelasticity);
+  o.model = make_force_model(cl.text("model"), o.mesh, {elasticity}, volume, mechanisms);
   BoundaryConditions bc;
   const auto g = cl.numbers("gravity", 3);
   bc.gravity_m_s2 = Vec3(g[0], g[1], g[2]);

@@ -24,23 +24,15 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   if (materials.empty()) throw std::invalid_argument("GpsModel: no material");
   if (!material_of_tet.empty() && material_of_tet.size() != element_count())
     throw std::invalid_argument("GpsModel: material_of_tet size differs from tet count");
+  for (const std::uint16_t m : material_of_tet)
+    if (m >= materials.size()) throw std::invalid_argument("GpsModel: material_of_tet names a material that was not given");
   if (!(options_.volume_stiffness_fraction >= 0.0 && options_.volume_stiffness_fraction < 1.0))
     throw std::invalid_argument("GpsModel: volume_stiffness_fraction must lie in [0, 1)");
   with_volume_ = options_.volume_stiffness_fraction > 0.0;
-  const GpsViscoelasticity& ve = options_.viscoelasticity;
-  mechanisms_ = ve.omega_rad_s.size();
-  if (mechanisms_ > 8) throw std::invalid_argument("GpsModel: at most 8 relaxation mechanisms");
-  if (ve.shear_weight.size() != mechanisms_ || (!ve.bulk_weight.empty() && ve.bulk_weight.size() != mechanisms_))
-    throw std::invalid_argument("GpsModel: one shear (and bulk) weight per relaxation frequency expected");
-  if (!(ve.kelvin_voigt_time_s >= 0) || !(ve.qlv_stiffening >= 0))
-    throw std::invalid_argument("GpsModel: Kelvin-Voigt time and QLV stiffening must be >= 0");
-  const bool bulk_differs = !ve.bulk_weight.empty() && ve.bulk_weight != ve.shear_weight;
-  if (!(ve.compression_ratio > 0) || (ve.compression_ratio != 1.0 && ve.qlv_form != GpsViscoelasticity::QlvForm::energy))
-    throw std::invalid_argument("GpsModel: compression_ratio must be positive, and needs the energy form");
-  if (!(ve.first_load_softening >= 0 && ve.first_load_softening < 1))
-    throw std::invalid_argument("GpsModel: first-load softening must lie in [0, 1)");
-  if (bulk_differs && ve.energy_map())
-    throw std::invalid_argument("GpsModel: Fung stiffening in energy form relaxes the whole tension: bulk and shear weights must agree");
+  options_.mechanisms.validate();
+  const GpsViscous& viscous = options_.mechanisms.viscous;
+  mechanisms_ = viscous.mechanisms();
+  const bool bulk_differs = viscous.bulk_differs();
   std::vector<double> kappa(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m) kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
 
@@ -119,28 +111,28 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
   double max_strain[L] = {}, nan_probe[L] = {};
   // Memory: per block (1 + mechanisms) x 6 x L doubles: previous elongations, then zeta_l; with
   // first-load softening 2 x 6 x L more: each edge's largest strain in tension, then in compression.
-  const GpsViscoelasticity& ve = options_.viscoelasticity;
+  const GpsMechanisms& mech = options_.mechanisms;
   const std::size_t nm = mechanisms_;
   const std::size_t stride = memory_stride();
-  const double softening = ve.first_load_softening;
+  const double softening = mech.softening.d;
   const std::size_t soft_at = softening_offset();
   double me[8], ma[8], mc[8], ys[8], yb[8];
   double rate_scale = 0.0;
   const double dt = memory ? memory->dt_s : 0.0;
   if constexpr (kMemory) {
     for (std::size_t l = 0; l < nm; ++l) {
-      const MemoryStep st = MemoryStep::make(ve.omega_rad_s[l], dt);
+      const MemoryStep st = MemoryStep::make(mech.viscous.omega_rad_s[l], dt);
       me[l] = st.e;
       ma[l] = st.a;
       mc[l] = st.c;
-      ys[l] = ve.shear_weight[l];
-      yb[l] = ve.bulk_weight.empty() ? ve.shear_weight[l] : ve.bulk_weight[l];
+      ys[l] = mech.viscous.shear_weight[l];
+      yb[l] = mech.viscous.bulk(l);
     }
-    rate_scale = dt > 0 ? ve.kelvin_voigt_time_s / dt : 0.0;
+    rate_scale = dt > 0 ? mech.viscous.kelvin_voigt_time_s / dt : 0.0;
   }
-  const double qlv = ve.qlv_stiffening;
-  const bool qlv_energy = ve.energy_map();
-  const double ratio = ve.compression_ratio;
+  const double qlv = mech.stiffening.b;
+  const bool qlv_energy = mech.energy_map();
+  const double ratio = mech.asymmetry.compression_ratio;
   // When the two streams (elements, memory) come from DRAM, the hardware prefetcher does not keep
   // them ahead: at 96k tets asking for them two blocks early makes a step 25% faster (AMD EPYC).
   // While they fit in the caches it costs: 9% on a 12k step (Intel Xeon). Into all cache levels
@@ -367,7 +359,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f) const { return add_forces(x, f, MemoryUpdate{}, ElementPart{}); }
 
-std::size_t GpsModel::memory_size() const { return options_.viscoelasticity.has_memory() ? blocks_.size() * memory_stride() : 0; }
+std::size_t GpsModel::memory_size() const { return options_.mechanisms.has_memory() ? blocks_.size() * memory_stride() : 0; }
 
 ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const {
   return add_forces(x, f, memory, ElementPart{});
@@ -391,9 +383,10 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, cons
 
 double GpsModel::energy(std::span<const Vec3> x) const {
   // The elastic energy; with the edge-map stiffening there is none (linear energy returned).
-  const double qlv = options_.viscoelasticity.qlv_stiffening;
-  const bool qlv_energy = options_.viscoelasticity.energy_map();
-  const double ratio = options_.viscoelasticity.compression_ratio;
+  const GpsMechanisms& mech = options_.mechanisms;
+  const double qlv = mech.stiffening.b;
+  const bool qlv_energy = mech.energy_map();
+  const double ratio = mech.asymmetry.compression_ratio;
   double sum = 0.0;
   for (std::size_t e = 0; e < element_count(); ++e) {
     const auto p = gather(x, e);
@@ -423,16 +416,17 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double d
 
 Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, std::span<const double> memory) const {
   // d(relaxed elongation)/d(dL) over a step of dt: 1 - sum Y_l c_l (+ tau / dt for Kelvin-Voigt).
-  const GpsViscoelasticity& ve = options_.viscoelasticity;
-  if (!ve.has_memory()) return tangent(x, e, 1.0, 0.0);
+  const GpsMechanisms& mech = options_.mechanisms;
+  if (!mech.has_memory()) return tangent(x, e, 1.0, 0.0);
+  const GpsViscous& viscous = mech.viscous;
   double shear = 1.0, bulk = 1.0;
   for (std::size_t l = 0; l < mechanisms_; ++l) {
-    const double c = dt_s > 0 ? MemoryStep::make(ve.omega_rad_s[l], dt_s).c : 0.0;
-    shear -= ve.shear_weight[l] * c;
-    bulk -= (ve.bulk_weight.empty() ? ve.shear_weight[l] : ve.bulk_weight[l]) * c;
+    const double c = dt_s > 0 ? MemoryStep::make(viscous.omega_rad_s[l], dt_s).c : 0.0;
+    shear -= viscous.shear_weight[l] * c;
+    bulk -= viscous.bulk(l) * c;
   }
-  const double kv = dt_s > 0 ? ve.kelvin_voigt_time_s / dt_s : 0.0;
-  const double d = ve.first_load_softening;
+  const double kv = dt_s > 0 ? viscous.kelvin_voigt_time_s / dt_s : 0.0;
+  const double d = mech.softening.d;
   if (!(d > 0) || memory.size() != memory_size()) return tangent(x, e, shear + kv, bulk - shear);
   // First-load softening: the factors at x for the extremes the step started with.
   const auto p = gather(x, e);
@@ -462,7 +456,7 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     for (int k = 0; k < 6; ++k) hv(k) = bb.hv[k][e % L];
     H += bulk_extra * bb.scale[e % L] * hv * hv.transpose();
   }
-  const double qlv = options_.viscoelasticity.qlv_stiffening;
+  const double qlv = options_.mechanisms.stiffening.b;
   Mat6x12 G = Mat6x12::Zero();
   Vec6 len, dL;
   Eigen::Matrix<double, 3, 6> Y;
@@ -475,13 +469,13 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     G.block<1, 3>(k, 3 * b) = Y.col(k).transpose() / len(k);
   }
   Mat6x12 Gm = G;  // derivative of the (possibly QLV-mapped) elongation measure
-  const bool qlv_energy = options_.viscoelasticity.energy_map();
+  const bool qlv_energy = options_.mechanisms.energy_map();
   Vec6 dh = Vec6::Ones(), d2h = Vec6::Zero();  // energy form: t_k = h'_k (H h)_k
   if (qlv > 0 || qlv_energy)
     for (int k = 0; k < 6; ++k) {
       const double strain = dL(k) / edge_length(e, k);
       if (qlv_energy) {
-        const FungEnergyMap m = edge_energy_map(qlv, options_.viscoelasticity.compression_ratio, strain);
+        const FungEnergyMap m = edge_energy_map(qlv, options_.mechanisms.asymmetry.compression_ratio, strain);
         dh(k) = m.dh;
         d2h(k) = m.d2h / edge_length(e, k);  // d h'/d dL
         Gm.row(k) *= m.dh;

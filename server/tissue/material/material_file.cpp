@@ -60,9 +60,9 @@ Material parse_material(const std::string& text, const std::string& source) {
     spec.mechanisms = static_cast<int>(v.integer("mechanisms", 1, 8, spec.mechanisms));
     spec.reference_frequency_hz = v.number("reference_frequency_hz", 1e-9, 1e9, spec.reference_frequency_hz);
     spec.qlv_stiffening = v.number("qlv_stiffening", 0, 1e3, spec.qlv_stiffening);
-    if (v.choice("qlv_form", {"edge_map", "energy"}, "edge_map") == "energy") spec.qlv_form = GpsViscoelasticity::QlvForm::energy;
+    if (v.choice("qlv_form", {"edge_map", "energy"}, "edge_map") == "energy") spec.qlv_form = GpsStiffening::Form::energy;
     spec.compression_ratio = v.number("compression_ratio", 1e-3, 1e3, spec.compression_ratio);
-    if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsViscoelasticity::QlvForm::energy)
+    if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsStiffening::Form::energy)
       v.fail("compression_ratio", short_number(spec.compression_ratio) + " needs \"qlv_form\": \"energy\"");
     m.viscoelasticity = spec;
   }

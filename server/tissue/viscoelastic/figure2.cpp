@@ -51,7 +51,7 @@ ShearBlock make_shear_block(const Figure2Options& o, const std::function<double(
   spec.reference_frequency_hz = o.reference_frequency_hz;
   const ViscoelasticSetup ve = make_viscoelastic(elasticity_matrix(IsotropicElasticity{2 * o.modulus_pa * (1 + nu), nu}), spec, "figure 2");
   GpsOptions gps_options;
-  gps_options.viscoelasticity = ve.gps;
+  gps_options.mechanisms = ve.gps;
   b.model = std::make_unique<GpsModel>(b.mesh, std::vector<Mat6>{ve.unrelaxed_elasticity}, std::vector<std::uint16_t>{}, gps_options);
   b.bc.nodal_forces.assign(b.mesh->node_count(), Vec3::Zero());
   for (std::size_t i = 0; i < b.mesh->node_count(); ++i) {

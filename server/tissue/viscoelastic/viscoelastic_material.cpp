@@ -29,26 +29,25 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
     throw InputError(source, 0, "reference_frequency_hz", std::to_string(spec.reference_frequency_hz) + " must be positive");
   if (!(spec.compression_ratio > 0) || !std::isfinite(spec.compression_ratio))
     throw InputError(source, 0, "compression_ratio", std::to_string(spec.compression_ratio) + " must be a positive number");
-  if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsViscoelasticity::QlvForm::energy)
+  if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsStiffening::Form::energy)
     throw InputError(source, 0, "compression_ratio", std::to_string(spec.compression_ratio) + " needs \"qlv_form\": \"energy\"");
-  if (spec.qlv_form == GpsViscoelasticity::QlvForm::energy && spec.model == ViscoelasticSpec::Model::constant_q &&
+  if (spec.qlv_form == GpsStiffening::Form::energy && spec.model == ViscoelasticSpec::Model::constant_q &&
       (spec.qlv_stiffening > 0 || spec.compression_ratio != 1.0) && spec.bulk_q != spec.shear_q)
     throw InputError(source, 0, "qlv_form",
                      "\"energy\" relaxes the whole elastic tension, so it needs bulk_q equal to shear_q (" +
                          (spec.bulk_q ? std::to_string(*spec.bulk_q) : std::string("absent")) + " against " + std::to_string(spec.shear_q) + ")");
   ViscoelasticSetup out;
-  out.gps.qlv_stiffening = spec.qlv_stiffening;
-  out.gps.qlv_form = spec.qlv_form;
-  out.gps.compression_ratio = spec.compression_ratio;
+  out.gps.stiffening = {spec.qlv_stiffening, spec.qlv_form};
+  out.gps.asymmetry.compression_ratio = spec.compression_ratio;
   const Mat6 D_vol = volumetric_part(D), D_dev = D - D_vol;
   const double w_ref = 2 * M_PI * spec.reference_frequency_hz;
   if (spec.model == ViscoelasticSpec::Model::kelvin_voigt) {
     // One relaxation time tau with Q(w_ref) = 1 / (w_ref tau), and |M(w_ref)| kept: E_kv = |M| / sqrt(1 + 1/Q^2).
-    out.gps.kelvin_voigt_time_s = 1.0 / (spec.shear_q * w_ref);
+    out.gps.viscous.kelvin_voigt_time_s = 1.0 / (spec.shear_q * w_ref);
     out.unrelaxed_elasticity = D / std::sqrt(1.0 + 1.0 / (spec.shear_q * spec.shear_q));
     std::ostringstream s;
-    s << "Kelvin-Voigt: relaxation time " << out.gps.kelvin_voigt_time_s << " s (Q = " << spec.shear_q << " at " << spec.reference_frequency_hz
-      << " Hz only; Q(f) = Q f_ref / f)\n";
+    s << "Kelvin-Voigt: relaxation time " << out.gps.viscous.kelvin_voigt_time_s << " s (Q = " << spec.shear_q << " at "
+      << spec.reference_frequency_hz << " Hz only; Q(f) = Q f_ref / f)\n";
     out.table = s.str();
     return out;
   }
@@ -57,23 +56,23 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
   ConstantQTarget shear{spec.shear_q, spec.band_low_hz, spec.band_high_hz, spec.mechanisms, D(5, 5), spec.reference_frequency_hz};
   out.shear_fit = fit_constant_q(shear, source);
   const double shear_factor = out.shear_fit.solids.unrelaxed_modulus_pa / D(5, 5);
-  out.gps.omega_rad_s = out.shear_fit.solids.omega_rad_s;
-  out.gps.shear_weight = out.shear_fit.solids.weight;
+  out.gps.viscous.omega_rad_s = out.shear_fit.solids.omega_rad_s;
+  out.gps.viscous.shear_weight = out.shear_fit.solids.weight;
   double bulk_factor = 1.0;
   const bool bulk_as_shear = spec.bulk_q && *spec.bulk_q == spec.shear_q;
   if (bulk_as_shear) {  // the same dimensionless fit: the weights are the shear's exactly
-    out.gps.bulk_weight = out.gps.shear_weight;
+    out.gps.viscous.bulk_weight = out.gps.viscous.shear_weight;
     bulk_factor = shear_factor;
   } else if (spec.bulk_q) {
     ConstantQTarget bulk = shear;
     bulk.q = *spec.bulk_q;
     bulk.modulus_pa = reuss_bulk_modulus(D);
-    bulk.fixed_frequencies_rad_s = out.gps.omega_rad_s;
+    bulk.fixed_frequencies_rad_s = out.gps.viscous.omega_rad_s;
     out.bulk_fit = fit_constant_q(bulk, source);
-    out.gps.bulk_weight = out.bulk_fit->solids.weight;
+    out.gps.viscous.bulk_weight = out.bulk_fit->solids.weight;
     bulk_factor = out.bulk_fit->solids.unrelaxed_modulus_pa / bulk.modulus_pa;
   } else {
-    out.gps.bulk_weight.assign(out.gps.omega_rad_s.size(), 0.0);
+    out.gps.viscous.bulk_weight.assign(out.gps.viscous.omega_rad_s.size(), 0.0);
   }
   out.unrelaxed_elasticity = shear_factor * D_dev + bulk_factor * D_vol;
   out.table = "shear: " + describe(out.shear_fit, shear);

@@ -10,10 +10,10 @@
 namespace viscera::tissue {
 
 /// "gps" (paper form), "gps_energy" (energy-consistent), "corotational", "linear".
-/// volume_fraction > 0 adds the signed-volume term to the GPS variants; viscoelasticity (memory
-/// variables, Kelvin-Voigt, QLV) is available for the GPS variants only (InputError otherwise).
+/// volume_fraction > 0 adds the signed-volume term to the GPS variants; the mechanisms (memory
+/// variables, Kelvin-Voigt, stiffening, asymmetry, softening) need a GPS variant (InputError otherwise).
 std::unique_ptr<ForceModel> make_force_model(const std::string& name, std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materials,
-                                             double volume_fraction = 0.0, const GpsViscoelasticity& viscoelasticity = {});
+                                             double volume_fraction = 0.0, const GpsMechanisms& mechanisms = {});
 
 /// The accepted names, for --help texts and error messages.
 const std::vector<std::string>& force_model_names();

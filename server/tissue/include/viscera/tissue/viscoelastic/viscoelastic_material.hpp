@@ -19,15 +19,15 @@ struct ViscoelasticSpec {
   int mechanisms = 3;
   double reference_frequency_hz = 2.0;
   double qlv_stiffening = 0.0;  ///< Fung's B (0: linear elastic response)
-  /// How the stiffening enters the GPS (GpsViscoelasticity::QlvForm): the published edge map or the
+  /// How the stiffening enters the GPS (GpsStiffening::Form): the published edge map or the
   /// conservative energy form.
-  GpsViscoelasticity::QlvForm qlv_form = GpsViscoelasticity::QlvForm::edge_map;
+  GpsStiffening::Form qlv_form = GpsStiffening::Form::edge_map;
   double compression_ratio = 1.0;  ///< tension/compression asymmetry r (energy form only; 1: none)
 };
 
 struct ViscoelasticSetup {
   Mat6 unrelaxed_elasticity;  ///< what the GPS is built with
-  GpsViscoelasticity gps;
+  GpsMechanisms gps;
   ConstantQFit shear_fit;
   std::optional<ConstantQFit> bulk_fit;  ///< none when the bulk is elastic or relaxes as the shear (bulk_q = shear_q)
   std::string table;  ///< the fitted mechanisms, for the user
