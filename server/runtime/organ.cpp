@@ -34,6 +34,18 @@ double time_substep(Organ& organ) {
   return t[2];
 }
 
+/// The slab of the organ's bounding box whose surface nodes are fixed.
+Box fixed_slab(const SceneSpec& s, const Box& bounds) {
+  const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
+  Box slab = bounds;
+  const double extent = bounds.hi[a] - bounds.lo[a];
+  if (s.fix_side == "min")
+    slab.hi[a] = bounds.lo[a] + s.fix_fraction * extent;
+  else
+    slab.lo[a] = bounds.hi[a] - s.fix_fraction * extent;
+  return slab;
+}
+
 /// Model, integrator and compliance of `organ` from its scene, material and mesh, once a tick at
 /// `rate_hz` is known to fit the budget (a step that cannot run is refused before any is taken).
 /// `field` names what the user chose (the material file, or the parameter changed).
@@ -47,18 +59,26 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
     D = setup.unrelaxed_elasticity;
     ve = setup.gps;
   }
-  organ.model = make_force_model(s.model, organ.mesh, {D}, s.volume_term, ve);
+  // Each region's material, calibrated per element like the organ's. The relaxation is the
+  // model's (one set of memory-variable weights), so a region relaxes as its organ: its own
+  // material file may repeat the organ's viscoelasticity, not give another.
+  std::vector<Mat6> materials{D};
+  std::vector<double> density(organ.mesh->tet_count(), material.density_kg_m3);
+  for (std::size_t k = 0; k < organ.region_materials.size(); ++k) {
+    const Material& rm = organ.region_materials[k];
+    const std::string& file = s.regions[k].material;
+    if (rm.viscoelasticity && rm.viscoelasticity != material.viscoelasticity)
+      throw InputError(file, 0, "viscoelasticity",
+                       "differs from the organ's (" + s.material + "): a region relaxes as its organ; leave it out or give the organ's");
+    materials.push_back(material.viscoelasticity ? make_viscoelastic(rm.elasticity, *material.viscoelasticity, file).unrelaxed_elasticity
+                                                 : rm.elasticity);
+  }
+  for (std::size_t e = 0; e < organ.regions.material_of_tet.size(); ++e)
+    if (const std::uint16_t m = organ.regions.material_of_tet[e]) density[e] = organ.region_materials[m - 1].density_kg_m3;
+  organ.model = make_force_model(s.model, organ.mesh, materials, s.volume_term, ve, organ.regions.material_of_tet);
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
-  const int a = s.fix_axis == "x" ? 0 : s.fix_axis == "y" ? 1 : 2;
-  Box slab = organ.bounds;
-  const double extent = organ.bounds.hi[a] - organ.bounds.lo[a];
-  if (s.fix_side == "min")
-    slab.hi[a] = organ.bounds.lo[a] + s.fix_fraction * extent;
-  else
-    slab.lo[a] = organ.bounds.hi[a] - s.fix_fraction * extent;
-  bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, slab);
-  const std::vector<double> density(organ.mesh->tet_count(), material.density_kg_m3);
+  bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, fixed_slab(s, organ.bounds));
   // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
   organ.integrator = std::make_unique<ExplicitIntegrator>(
       *organ.model, density, bc, ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
@@ -104,10 +124,30 @@ std::string Organ::describe_step(double rate_hz) const {
   return out;
 }
 
+std::string Organ::describe_regions() const {
+  std::string out;
+  char b[400];
+  for (std::size_t k = 0; k < regions.regions.size(); ++k) {
+    const PlacedRegion& r = regions.regions[k];
+    if (r.shape == RegionSpec::Shape::sphere)
+      std::snprintf(b, sizeof b, "\nregion %s: sphere of radius %.4g m at (%.4g, %.4g, %.4g) m, its top %.3g m deep", r.name.c_str(), r.radius_m,
+                    r.center_m.x(), r.center_m.y(), r.center_m.z(), r.depth_m);
+    else
+      std::snprintf(b, sizeof b, "\nregion %s: box (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", r.name.c_str(), r.box.lo.x(), r.box.lo.y(), r.box.lo.z(),
+                    r.box.hi.x(), r.box.hi.y(), r.box.hi.z());
+    out += b;
+    std::snprintf(b, sizeof b, ", %zu elements (%.3g cm^3), material %s", r.elements, 1e6 * r.volume_m3, region_materials[k].name.c_str());
+    out += b;
+  }
+  return out;
+}
+
 std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& budget) {
   auto organ = std::make_unique<Organ>();
   organ->scene = scene;
-  for (const auto& [role, path] : {std::pair{"scene", scene.source}, {"mesh", scene.mesh}, {"material", scene.material}}) {
+  std::vector<std::pair<std::string, std::string>> files{{"scene", scene.source}, {"mesh", scene.mesh}, {"material", scene.material}};
+  for (std::size_t k = 0; k < scene.regions.size(); ++k) files.emplace_back(protocol::region_material_role(k), scene.regions[k].material);
+  for (const auto& [role, path] : files) {
     try {
       auto bytes = common::read_file_bytes(path);
       organ->sources.push_back({role, path, protocol::sha256_hex(bytes), std::move(bytes)});
@@ -121,6 +161,8 @@ std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& bud
   organ->material = read_material_file(scene.material);
   organ->bounds = bounding_box(*organ->mesh);
   organ->boundary = extract_boundary(*organ->mesh);
+  organ->regions = lay_out_regions(scene.regions, *organ->mesh, organ->boundary, fixed_slab(scene, organ->bounds), scene.source);
+  for (const RegionSpec& r : scene.regions) organ->region_materials.push_back(read_material_file(r.material));
   build_physics(*organ, scene.physics_rate_hz, budget, scene.source, "organ.material");
   return organ;
 }
@@ -133,6 +175,8 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   next->bounds = organ.bounds;
   next->boundary = organ.boundary;
   next->sources = organ.sources;
+  next->regions = organ.regions;
+  next->region_materials = organ.region_materials;
   Material& m = next->material;
   const std::string source = "set_material (material " + m.name + ")";
   if (change.youngs_modulus_pa || change.poisson_ratio) {

@@ -17,6 +17,52 @@ using common::InputError;
 using common::JsonObject;
 using nlohmann::json;
 
+namespace {
+
+std::array<double, 3> point(const JsonObject& o, const char* key) {
+  const auto v = o.numbers(key, 3, -1e3, 1e3);
+  return {v[0], v[1], v[2]};
+}
+
+RegionSpec read_region(const JsonObject& r, const std::filesystem::path& dir, std::set<std::string>& names) {
+  r.require_known({"name", "material", "sphere", "box"});
+  RegionSpec region;
+  region.name = r.text("name");
+  if (region.name.empty() || region.name.size() > 64) r.fail("name", "must have 1 to 64 characters");
+  if (!names.insert(region.name).second) r.fail("name", "'" + common::printable(region.name) + "' is used twice");
+  region.material = (dir / r.text("material")).string();
+  if (r.has("sphere") == r.has("box")) r.fail("sphere", "a region is either a \"sphere\" or a \"box\"");
+  if (r.has("box")) {
+    const JsonObject b = r.object("box");
+    b.require_known({"lo_m", "hi_m"});
+    region.shape = RegionSpec::Shape::box;
+    region.lo_m = point(b, "lo_m");
+    region.hi_m = point(b, "hi_m");
+    for (int a = 0; a < 3; ++a)
+      if (!(region.lo_m[a] < region.hi_m[a])) b.fail("hi_m", "must exceed lo_m on every axis");
+    return region;
+  }
+  const JsonObject sphere = r.object("sphere");
+  sphere.require_known({"center_m", "radius_m", "random_center"});
+  region.radius_m = sphere.number("radius_m", 1e-4, 10);
+  if (sphere.has("center_m") == sphere.has("random_center")) sphere.fail("center_m", "a sphere has either a \"center_m\" or a \"random_center\"");
+  if (sphere.has("center_m")) {
+    region.center_m = point(sphere, "center_m");
+    return region;
+  }
+  const JsonObject random = sphere.object("random_center");
+  random.require_known({"seed", "depth_m"});
+  region.random_center = true;
+  region.seed = static_cast<std::uint64_t>(random.integer("seed", 0, 9'007'199'254'740'991LL));  // JSON's exact integers
+  const auto depth = random.numbers("depth_m", 2, 0, 1);
+  if (!(depth[0] <= depth[1])) random.fail("depth_m", "must be [least, most] with least <= most");
+  region.min_depth_m = depth[0];
+  region.max_depth_m = depth[1];
+  return region;
+}
+
+}  // namespace
+
 SceneSpec read_scene_file(const std::string& path) {
   const json j = common::read_json_file(path);
   const JsonObject top(j, path);
@@ -33,7 +79,8 @@ SceneSpec read_scene_file(const std::string& path) {
   s.max_tool_speed_m_s = top.number("max_tool_speed_m_s", 1e-3, 100, 0.5);
   const JsonObject o = top.object("organ");
   o.require_known({"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction", "physics_threads", "volume_term",
-                   "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab"});
+                   "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab",
+                   "regions"});
   s.mesh = (dir / o.text("mesh")).string();
   s.material = (dir / o.text("material")).string();
   s.model = o.choice("model", {"gps", "gps_energy", "corotational", "linear"}, "gps_energy");
@@ -59,6 +106,12 @@ SceneSpec read_scene_file(const std::string& path) {
       o.fail("fix_slab", "axis '" + common::printable(s.fix_axis) + "' is not x, y or z");
     if (s.fix_side != "min" && s.fix_side != "max") o.fail("fix_slab", "side '" + common::printable(s.fix_side) + "' is not min or max");
     if (!(s.fix_fraction > 0 && s.fix_fraction <= 1)) o.fail("fix_slab", "fraction must lie in (0, 1]");
+  }
+  if (o.has("regions")) {
+    const json& regions = o.array("regions");
+    std::set<std::string> names;
+    for (std::size_t k = 0; k < regions.size(); ++k)
+      s.regions.push_back(read_region(JsonObject(regions[k], path, "organ.regions[" + std::to_string(k) + "]"), dir, names));
   }
   const json& instruments = top.array("instruments", 1);
   std::set<std::uint32_t> ids;

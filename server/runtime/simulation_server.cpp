@@ -599,7 +599,7 @@ std::string SimulationServer::describe() const {
   std::snprintf(b, sizeof b, "scene %s: %zu nodes, %zu tets, model %s, %zu instruments, %.0f Hz, DDS domain %u, ", impl_->scene.name.c_str(),
                 impl_->organ->mesh->node_count(), impl_->organ->mesh->tet_count(), std::string(impl_->organ->model->name()).c_str(),
                 impl_->tools.size(), impl_->scene.physics_rate_hz, impl_->scene.domain_id);
-  return b + impl_->organ->describe_step(impl_->scene.physics_rate_hz);
+  return b + impl_->organ->describe_step(impl_->scene.physics_rate_hz) + impl_->organ->describe_regions();
 }
 
 ServerStats SimulationServer::run_lockstep(const std::atomic<bool>& stop, LockstepLink& link, const Status& status) {

@@ -56,7 +56,10 @@ Recording::Recording(const std::string& path) : reader_(path) {
       }
       scene.server_version = m.values.count("server_version") ? m.values.at("server_version") : "";
       scene.settings_json = m.values.count("settings_json") ? m.values.at("settings_json") : "";
-      for (const std::string role : {"scene", "mesh", "material"})
+      std::vector<std::string> roles{"scene", "mesh", "material"};
+      for (std::size_t k = 0; m.values.count(protocol::region_material_role(k) + ".attachment"); ++k)
+        roles.push_back(protocol::region_material_role(k));
+      for (const std::string& role : roles)
         if (m.values.count(role + ".attachment"))
           scene.files.push_back({role, m.values.count(role + ".path") ? m.values.at(role + ".path") : "", m.values.at(role + ".attachment"),
                                  m.values.count(role + ".sha256") ? m.values.at(role + ".sha256") : ""});

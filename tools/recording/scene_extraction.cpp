@@ -73,6 +73,14 @@ ExtractedScenes extract_scenes(Recording& recording, const std::string& dir, con
     json j = parse(content(recording, *scene), recording.path() + " (attachment " + scene->attachment + ")");
     j["organ"]["mesh"] = write(*mesh);
     j["organ"]["material"] = write(*material);
+    if (j["organ"].contains("regions") && j["organ"]["regions"].is_array())
+      for (std::size_t k = 0; k < j["organ"]["regions"].size(); ++k) {
+        const RecordedFile* region = s->file(protocol::region_material_role(k));
+        if (!region)
+          throw InputError(recording.path(), 0, "viscera.scene",
+                           "generation " + std::to_string(s->generation) + " lacks the material file of its region " + std::to_string(k));
+        j["organ"]["regions"][k]["material"] = write(*region);
+      }
     const std::string stem = fs::path(scene->path).stem().string();
     const fs::path path = fs::path(out.scene_dir) / (stem + ".json");
     const std::string text = j.dump(2);
@@ -107,6 +115,10 @@ ExtractedScenes extract_scenes(Recording& recording, const std::string& dir, con
   const fs::path base = fs::path(*replacement).parent_path();
   changed["organ"]["mesh"] = fs::absolute(base / organ_here.value("mesh", std::string())).string();
   changed["organ"]["material"] = fs::absolute(base / organ_here.value("material", std::string())).string();
+  if (changed["organ"].contains("regions") && changed["organ"]["regions"].is_array())
+    for (auto& region : changed["organ"]["regions"])
+      if (region.is_object() && region.contains("material") && region["material"].is_string())
+        region["material"] = fs::absolute(base / region["material"].get<std::string>()).string();
   const auto material_bytes = common::read_file_bytes(changed["organ"]["material"].get<std::string>());
   if (protocol::sha256_hex(material_bytes) != first.file("material")->sha256)
     out.differences.push_back("organ.material: " + changed["organ"]["material"].get<std::string>() + " (another material file than the recording's " +

@@ -176,10 +176,13 @@ struct Event {
 
 /// A file the server built its organ from (schema 7).
 struct LoadedFile {
-  std::string role;  ///< scene | mesh | material
+  std::string role;  ///< scene | mesh | material | region_material_role(k)
   std::string path, sha256;
   std::vector<std::uint8_t> content;
 };
+
+/// The role of the material file of the scene's k-th material region.
+inline std::string region_material_role(std::size_t k) { return "region." + std::to_string(k) + ".material"; }
 
 /// What it takes to run the current scene again (schema 7).
 struct SceneFiles {

@@ -7,6 +7,7 @@
 
 #include "viscera/protocol/messages.hpp"
 #include "viscera/runtime/contact_compliance.hpp"
+#include "viscera/runtime/material_regions.hpp"
 #include "viscera/runtime/parallel_forces.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/runtime/tick_budget.hpp"
@@ -19,6 +20,10 @@ namespace viscera::runtime {
 struct Organ {
   SceneSpec scene;
   tissue::Material material;
+  /// The scene's material regions on this mesh, and each region's material (region_materials[k]
+  /// for regions.regions[k]); kept as they are when the organ's own material changes.
+  RegionLayout regions;
+  std::vector<tissue::Material> region_materials;
   std::shared_ptr<tissue::TetMesh> mesh;
   tissue::Box bounds;
   tissue::BoundarySurface boundary;
@@ -37,6 +42,9 @@ struct Organ {
   /// One line: the explicit step, what a tick at `rate_hz` costs, and, if any, the mass scaling that
   /// lengthened the step.
   std::string describe_step(double rate_hz) const;
+  /// Its material regions, one line each (empty when there is none): where each lies, how many
+  /// elements it holds, its material.
+  std::string describe_regions() const;
 };
 
 /// Reads the scene's mesh and material and builds the organ. Throws InputError naming the file

@@ -3,6 +3,7 @@
 // the instruments, rates and the DDS domain. Paths are relative to the scene file. Errors name
 // the file and the field.
 #include <array>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,20 @@ struct InstrumentSpec {
   InstrumentKind kind = InstrumentKind::probe;
   double tip_radius_m = 0.005;
   double grasp_radius_m = 0.01;  ///< grasper: surface nodes this close to the tip are grasped
+};
+
+/// Part of the organ made of its own material (docs/SCENE.md, "Material regions"): the elements
+/// whose centroid lies inside a sphere or a box, in metres in the organ's frame (the mesh as
+/// scaled). A sphere's centre may be drawn from a seed, at a depth below the surface.
+struct RegionSpec {
+  std::string name;
+  std::string material;  ///< material file (resolved against the scene's folder)
+  enum class Shape { sphere, box } shape = Shape::sphere;
+  std::array<double, 3> center_m{}, lo_m{}, hi_m{};
+  double radius_m = 0;
+  bool random_center = false;  ///< sphere: centre drawn from `seed`
+  std::uint64_t seed = 0;
+  double min_depth_m = 0, max_depth_m = 0;  ///< random centre: the sphere's top this far below the surface
 };
 
 struct SceneSpec {
@@ -40,6 +55,7 @@ struct SceneSpec {
   std::string fix_axis = "z", fix_side = "max";
   double fix_fraction = 0.2;
   std::vector<InstrumentSpec> instruments;
+  std::vector<RegionSpec> regions;  ///< later regions take the elements they share with earlier ones
 };
 
 SceneSpec read_scene_file(const std::string& path);

@@ -23,6 +23,8 @@ struct ViscoelasticSpec {
   /// conservative energy form.
   GpsStiffening::Form qlv_form = GpsStiffening::Form::edge_map;
   double compression_ratio = 1.0;  ///< tension/compression asymmetry r (energy form only; 1: none)
+
+  bool operator==(const ViscoelasticSpec&) const = default;
 };
 
 struct ViscoelasticSetup {
