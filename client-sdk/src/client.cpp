@@ -155,10 +155,12 @@ std::optional<proto::RequestOutcome> Client::request(proto::SessionRequest r, st
   return std::nullopt;
 }
 
-std::optional<proto::RequestOutcome> Client::load_scene(const std::string& name, std::chrono::milliseconds timeout) {
+std::optional<proto::RequestOutcome> Client::load_scene(const std::string& name, std::chrono::milliseconds timeout,
+                                                        std::optional<std::uint64_t> seed) {
   proto::SessionRequest r;
   r.action = proto::Action::load_scene;
   r.scene_name = name;
+  r.scene_seed = seed;
   return request(std::move(r), timeout);
 }
 

@@ -11,6 +11,7 @@ nlohmann::json to_json(const SessionRequest& r) {
   nlohmann::json j = {{"action", action_name(r.action)}, {"client_id", r.client_id}, {"request_seq", r.request_seq}};
   if (r.action == Action::claim_instrument || r.action == Action::release_instrument) j["instrument_id"] = r.instrument_id;
   if (r.action == Action::load_scene) j["scene_name"] = r.scene_name;
+  if (r.action == Action::load_scene && r.scene_seed) j["scene_seed"] = *r.scene_seed;
   if (r.action == Action::set_physics_rate) j["physics_rate_hz"] = r.physics_rate_hz;
   if (r.action == Action::seek) j["seek_s"] = r.seek_s;
   if (r.action == Action::set_material) {
@@ -48,6 +49,7 @@ std::optional<SessionRequest> session_request_from_json(const nlohmann::json& j,
     r.scene_name = j.value("scene_name", std::string());
     r.physics_rate_hz = j.value("physics_rate_hz", 0.0);
     r.seek_s = j.value("seek_s", 0.0);
+    if (j.contains("scene_seed")) r.scene_seed = j.at("scene_seed").get<std::uint64_t>();
     if (const auto m = j.find("material"); m != j.end()) {
       const auto get = [&](const char* name, std::optional<double>& out) {
         if (m->contains(name)) out = m->at(name).get<double>();

@@ -70,7 +70,8 @@ std::vector<std::uint8_t> encode(const SessionRequest& r) {
     material = m.Finish();
   }
   return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id, r.request_seq, name, material,
-                                            r.physics_rate_hz, r.seek_s));
+                                            r.physics_rate_hz, r.seek_s,
+                                            r.scene_seed ? flatbuffers::Optional<std::uint64_t>(*r.scene_seed) : flatbuffers::nullopt));
 }
 
 std::vector<std::uint8_t> encode(const Scene& s) {
@@ -93,8 +94,16 @@ std::vector<std::uint8_t> encode(const Scene& s) {
         fb::CreateRequestOutcome(b, o.client_id, o.request_seq, static_cast<fb::SessionAction>(o.action), o.accepted, b.CreateString(o.message)));
   const auto recent = b.CreateVector(outcomes);
   const auto unreadable = b.CreateVectorOfStrings(s.unreadable_scenes);
-  return finish(
-      b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent, unreadable));
+  std::vector<flatbuffers::Offset<fb::RegionState>> region_list;
+  for (const auto& r : s.regions) {
+    const fb::Vec3 c = to_fb(r.center), bmin = to_fb(r.box_min), bmax = to_fb(r.box_max);
+    region_list.push_back(fb::CreateRegionState(b, b.CreateString(r.name), r.box ? fb::RegionShape::box : fb::RegionShape::sphere, &c, r.radius_m,
+                                                &bmin, &bmax, r.depth_m, r.elements, r.volume_m3, b.CreateString(r.material_name),
+                                                r.youngs_modulus_pa));
+  }
+  const auto regions = b.CreateVector(region_list);
+  return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent,
+                                        unreadable, regions));
 }
 
 std::vector<std::uint8_t> encode(const TelemetryReport& t) {
@@ -248,7 +257,8 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
     *why = "client_id 0 is reserved";
     return std::nullopt;
   }
-  SessionRequest r{m->client_id(), static_cast<Action>(a), m->instrument_id(), m->request_seq(), {}, {}, m->physics_rate_hz(), m->seek_s()};
+  SessionRequest r{m->client_id(), static_cast<Action>(a), m->instrument_id(), m->request_seq(), {}, {}, m->physics_rate_hz(), m->seek_s(), {}};
+  if (r.action == Action::load_scene && m->scene_seed().has_value()) r.scene_seed = *m->scene_seed();
   if (r.action == Action::load_scene) {
     r.scene_name = m->scene_name() ? m->scene_name()->str() : "";
     const bool plain = std::all_of(r.scene_name.begin(), r.scene_name.end(),
@@ -328,6 +338,26 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
   s.preparing = m->preparing() ? m->preparing()->str() : "";
   if (m->unreadable_scenes())
     for (const auto* n : *m->unreadable_scenes()) s.unreadable_scenes.push_back(n->str());
+  if (m->regions())
+    for (const auto* r : *m->regions()) {
+      RegionInfo i{r->name() ? r->name()->str() : "",
+                   r->shape() == fb::RegionShape::box,
+                   from_fb(r->center()),
+                   r->radius_m(),
+                   from_fb(r->box_min()),
+                   from_fb(r->box_max()),
+                   r->depth_m(),
+                   r->elements(),
+                   r->volume_m3(),
+                   r->material_name() ? r->material_name()->str() : "",
+                   r->youngs_modulus_pa()};
+      if (!finite(i.center) || !finite(i.box_min) || !finite(i.box_max) ||
+          !std::isfinite(i.radius_m + i.depth_m + i.volume_m3 + i.youngs_modulus_pa) || i.radius_m < 0) {
+        *why = "region '" + i.name.substr(0, 64) + "': numbers not finite";
+        return std::nullopt;
+      }
+      s.regions.push_back(std::move(i));
+    }
   if (m->recent_requests())
     for (const auto* o : *m->recent_requests())
       s.recent_requests.push_back(

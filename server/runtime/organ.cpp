@@ -124,6 +124,27 @@ std::string Organ::describe_step(double rate_hz) const {
   return out;
 }
 
+std::vector<protocol::RegionInfo> Organ::region_info() const {
+  std::vector<protocol::RegionInfo> out;
+  for (std::size_t k = 0; k < regions.regions.size(); ++k) {
+    const PlacedRegion& r = regions.regions[k];
+    protocol::RegionInfo i;
+    i.name = r.name;
+    i.box = r.shape == RegionSpec::Shape::box;
+    i.center = {r.center_m.x(), r.center_m.y(), r.center_m.z()};
+    i.radius_m = r.radius_m;
+    i.box_min = {r.box.lo.x(), r.box.lo.y(), r.box.lo.z()};
+    i.box_max = {r.box.hi.x(), r.box.hi.y(), r.box.hi.z()};
+    i.depth_m = r.depth_m;
+    i.elements = static_cast<std::uint32_t>(r.elements);
+    i.volume_m3 = r.volume_m3;
+    i.material_name = region_materials[k].name;
+    if (region_materials[k].isotropic) i.youngs_modulus_pa = region_materials[k].isotropic->youngs_modulus_pa;
+    out.push_back(std::move(i));
+  }
+  return out;
+}
+
 std::string Organ::describe_regions() const {
   std::string out;
   char b[400];

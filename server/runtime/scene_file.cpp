@@ -129,6 +129,11 @@ SceneSpec read_scene_file(const std::string& path) {
   return s;
 }
 
+void reseed_regions(SceneSpec& scene, std::uint64_t seed) {
+  for (std::size_t k = 0; k < scene.regions.size(); ++k)
+    if (scene.regions[k].random_center) scene.regions[k].seed = seed + k;
+}
+
 SceneListing list_scenes(const std::string& directory) {
   SceneListing listing;
   std::error_code ec;

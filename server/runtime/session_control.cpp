@@ -54,6 +54,7 @@ std::optional<std::string> SessionControl::start_scene(const protocol::SessionRe
     return std::string(e.what());
   }
   spec.domain_id = domain_id;  // the server stays on its domain
+  if (request.scene_seed) reseed_regions(spec, *request.scene_seed);
   preparing_ =
       Preparing{std::async(std::launch::async, [spec, build = build_scene_] { return build(spec); }), request, "scene " + request.scene_name};
   return std::nullopt;

@@ -193,6 +193,7 @@ struct SimulationServer::Impl {
     sc.bounds_max = {bounds.hi.x(), bounds.hi.y(), bounds.hi.z()};
     sc.generation = generation;
     sc.material = organ->material_info();
+    sc.regions = organ->region_info();
     sc.available_scenes = session.scenes().loadable;
     for (const auto& [name, error] : session.scenes().unreadable) sc.unreadable_scenes.push_back(name + ": " + error.substr(0, 300));
     sc.preparing = session.preparing();

@@ -208,9 +208,20 @@ b = bytearray(open(sys.argv[1], "rb").read())
 at = b.index(b"schema_version") + len(b"schema_version")  # then the value: u32 length, digits
 n = int.from_bytes(b[at:at + 4], "little")
 version = int(b[at + 4:at + 4 + n])
-newer = str(version + 1) if len(str(version + 1)) == n else "9" * n  # same length: the file's offsets stay
-assert int(newer) > version
-b[at + 4:at + 4 + n] = newer.encode()
+newer = str(version + 1).encode()
+if len(newer) > n:
+    # One digit more (9 -> 10): the byte comes from the "recorder" value, which precedes it in the
+    # same metadata record (keys sorted), so the record and every offset in the file stay.
+    r = b.index(b"recorder") + len(b"recorder")
+    m = int.from_bytes(b[r:r + 4], "little")
+    assert r < at and m > 1
+    b[r:r + 4] = (m - 1).to_bytes(4, "little")
+    del b[r + 4 + m - 1]
+    at -= 1
+    b[at:at + 4] = len(newer).to_bytes(4, "little")
+    b[at + 4:at + 4 + n] = newer
+else:
+    b[at + 4:at + 4 + n] = newer.rjust(n, b"0")
 open(sys.argv[2], "wb").write(b)
 PY
 sed 's#liver2.msh#liver.msh#' "$scene" > "$tmp/other-organ.json"

@@ -190,6 +190,12 @@ TEST(Messages, RunTimeControlRequestsRoundTripAndBadOnesAreRejected) {
   ASSERT_TRUE(l) << why;
   EXPECT_EQ(l->scene_name, "liver-12k");
   EXPECT_EQ(l->request_seq, 1'000'000'000'001u);
+  EXPECT_FALSE(l->scene_seed);  // absent: the scene file's seed (schema 9)
+  load.scene_seed = 0;  // a seed of 0 is a seed, not "absent"
+  ASSERT_TRUE(decode_session_request(encode(load), &why));
+  EXPECT_EQ(decode_session_request(encode(load), &why)->scene_seed, std::optional<std::uint64_t>(0));
+  load.scene_seed = 18'446'744'073'709'551'615u;
+  EXPECT_EQ(decode_session_request(encode(load), &why)->scene_seed, load.scene_seed);
   // A scene name is a name in the server's scene directory, never a path.
   for (const std::string& bad : std::vector<std::string>{"", "../etc/passwd", "/etc/passwd", ".hidden", "a b", std::string(65, 'a')}) {
     load.scene_name = bad;
@@ -254,6 +260,36 @@ TEST(Messages, SceneStateCarriesMaterialScenesAndOutcomes) {
   EXPECT_FALSE(d->recent_requests[0].accepted);
   EXPECT_EQ(d->recent_requests[1].action, Action::set_physics_rate);
   EXPECT_EQ(d->recent_requests[1].message, "physics rate 500 Hz");
+  // Material regions (schema 9).
+  RegionInfo nodule;
+  nodule.name = "nodule";
+  nodule.center = {0.01, -0.02, 0.03};
+  nodule.radius_m = 0.012;
+  nodule.depth_m = 0.005;
+  nodule.elements = 9;
+  nodule.volume_m3 = 1e-5;
+  nodule.material_name = "nodule";
+  nodule.youngs_modulus_pa = 20000;
+  RegionInfo lobe;
+  lobe.name = "lobe";
+  lobe.box = true;
+  lobe.box_min = {-1, -2, -3};
+  lobe.box_max = {1, 2, 3};
+  sc.regions = {nodule, lobe};
+  const auto r = decode_scene(encode(sc), &why);
+  ASSERT_TRUE(r) << why;
+  ASSERT_EQ(r->regions.size(), 2u);
+  EXPECT_EQ(r->regions[0].name, "nodule");
+  EXPECT_FALSE(r->regions[0].box);
+  EXPECT_EQ(r->regions[0].center[1], -0.02);
+  EXPECT_EQ(r->regions[0].radius_m, 0.012);
+  EXPECT_EQ(r->regions[0].elements, 9u);
+  EXPECT_EQ(r->regions[0].youngs_modulus_pa, 20000);
+  EXPECT_TRUE(r->regions[1].box);
+  EXPECT_EQ(r->regions[1].box_max[2], 3);
+  sc.regions[0].center[0] = std::nan("");
+  EXPECT_FALSE(decode_scene(encode(sc), &why));
+  sc.regions.clear();
   sc.material.added_mass_fraction = INFINITY;
   EXPECT_FALSE(decode_scene(encode(sc), &why));
   sc.material.added_mass_fraction = 0;

@@ -73,6 +73,7 @@ struct Request {
   viscera::protocol::MaterialChange change;
   double rate_hz = 0, duration_s = 10, seek_s = 0;
   std::chrono::milliseconds timeout{60'000};
+  std::optional<std::uint64_t> seed;  ///< load: the drawn regions' seed
 };
 
 Request parse(const viscera::common::CommandLine& cl) {
@@ -108,6 +109,9 @@ Request parse(const viscera::common::CommandLine& cl) {
       return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
     });
     if (!plain) throw UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
+    if (cl.has("seed")) r.seed = static_cast<std::uint64_t>(cl.number_in("seed", 0, 9007199254740991.0));
+  } else if (cl.has("seed")) {
+    throw UsageError("--seed is for the load action");
   }
   if (r.action == "rate") {
     char* end = nullptr;
@@ -147,7 +151,7 @@ int follow_events(viscera::client::Client& client, const viscera::protocol::Scen
 int control(viscera::client::Client& client, const Request& r) {
   using viscera::protocol::Action;
   if (r.action == "load" || r.action == "material" || r.action == "rate" || r.action == "seek") {
-    const auto outcome = r.action == "load"       ? client.load_scene(r.argument, r.timeout)
+    const auto outcome = r.action == "load"       ? client.load_scene(r.argument, r.timeout, r.seed)
                          : r.action == "material" ? client.set_material(r.change, r.timeout)
                          : r.action == "seek"     ? client.seek(r.seek_s, r.timeout)
                                                   : client.set_physics_rate(r.rate_hz, r.timeout);
@@ -186,6 +190,15 @@ void print_scene(const viscera::protocol::Scene& scene) {
   std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene.preparing.empty() ? "" : "; preparing ",
               scene.preparing.c_str());
   for (const auto& u : scene.unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
+  for (const auto& g : scene.regions) {
+    if (g.box)
+      std::printf("  region %s: box (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", g.name.c_str(), g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0],
+                  g.box_max[1], g.box_max[2]);
+    else
+      std::printf("  region %s: sphere of radius %.4g m at (%.4g, %.4g, %.4g) m, its top %.3g m deep", g.name.c_str(), g.radius_m, g.center[0],
+                  g.center[1], g.center[2], g.depth_m);
+    std::printf(", %u elements, material %s (E %.0f Pa)\n", g.elements, g.material_name.c_str(), g.youngs_modulus_pa);
+  }
 }
 
 }  // namespace
@@ -212,6 +225,7 @@ int main(int argc, char** argv) {
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
   cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
   cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
+  cl.flag("seed", "N", "load: the seed of the scene's drawn material regions (a hidden nodule elsewhere; default: the scene file's)");
   cl.flag("youngs-modulus-pa", "E", "material: Young's modulus [Pa] (isotropic materials)");
   cl.flag("poisson-ratio", "NU", "material: Poisson's ratio (isotropic materials)");
   cl.flag("density-kg-m3", "RHO", "material: density [kg/m^3]");

@@ -63,7 +63,9 @@ class Client {
   /// Sends the request once (reliably) and waits up to `timeout` for the server's outcome, which
   /// says what was done or why not; nothing if no outcome came in time. Loading a scene releases
   /// every instrument: their owners claim again (Scene::generation tells them it happened).
-  std::optional<protocol::RequestOutcome> load_scene(const std::string& name, std::chrono::milliseconds timeout);
+  /// `seed`: the seed of the scene's drawn material regions (none: the scene file's).
+  std::optional<protocol::RequestOutcome> load_scene(const std::string& name, std::chrono::milliseconds timeout,
+                                                     std::optional<std::uint64_t> seed = std::nullopt);
   std::optional<protocol::RequestOutcome> set_material(const protocol::MaterialChange& change, std::chrono::milliseconds timeout);
   std::optional<protocol::RequestOutcome> set_physics_rate(double rate_hz, std::chrono::milliseconds timeout);
   /// A replay (viscera-replay play, in its partition): jump to `seconds` from the recording's start.

@@ -69,6 +69,7 @@ struct SessionRequest {
   MaterialChange material;  ///< set_material: at least one parameter
   double physics_rate_hz = 0;  ///< set_physics_rate: [10, 10000]
   double seek_s = 0;  ///< seek (schema 7): [s] from the recording's start, >= 0
+  std::optional<std::uint64_t> scene_seed;  ///< load_scene (schema 9): seed of the drawn regions; none: the scene file's
 };
 
 struct InstrumentInfo {
@@ -97,6 +98,20 @@ struct RequestOutcome {
   std::string message;
 };
 
+/// A material region as laid out (schema 9); positions in the organ's frame [m].
+struct RegionInfo {
+  std::string name;
+  bool box = false;  ///< else a sphere
+  Vector3 center{};
+  double radius_m = 0;
+  Vector3 box_min{}, box_max{};
+  double depth_m = 0;  ///< sphere: its top's depth below the surface
+  std::uint32_t elements = 0;
+  double volume_m3 = 0;
+  std::string material_name;
+  double youngs_modulus_pa = 0;  ///< 0: not isotropic
+};
+
 struct Scene {
   std::string name;
   double physics_rate_hz = 0;
@@ -110,6 +125,7 @@ struct Scene {
   std::string preparing;  ///< scene or material being built in the background
   std::vector<RequestOutcome> recent_requests;  ///< the last few, oldest first
   std::vector<std::string> unreadable_scenes;  ///< schema 6: "name: error" for scene files that do not read
+  std::vector<RegionInfo> regions;  ///< schema 9: the organ's material regions
 };
 
 struct TelemetryReport {
@@ -211,7 +227,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 8;
+inline constexpr int kSchemaVersion = 9;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -18,7 +18,7 @@ struct PlacedRegion {
   RegionSpec::Shape shape = RegionSpec::Shape::sphere;
   tissue::Vec3 center_m = tissue::Vec3::Zero();  ///< sphere
   double radius_m = 0;
-  tissue::Box box;  ///< box
+  tissue::Box box{tissue::Vec3::Zero(), tissue::Vec3::Zero()};  ///< box
   double depth_m = 0;  ///< sphere: its top's depth below the organ's surface (distance to the surface minus radius)
   std::size_t elements = 0;
   double volume_m3 = 0;  ///< of its elements

@@ -39,6 +39,8 @@ struct Organ {
 
   /// The material as the scene state shows it.
   protocol::MaterialInfo material_info() const;
+  /// The material regions as the scene state shows them.
+  std::vector<protocol::RegionInfo> region_info() const;
   /// One line: the explicit step, what a tick at `rate_hz` costs, and, if any, the mass scaling that
   /// lengthened the step.
   std::string describe_step(double rate_hz) const;

@@ -60,6 +60,10 @@ struct SceneSpec {
 
 SceneSpec read_scene_file(const std::string& path);
 
+/// Every region whose centre is drawn gets its seed from `seed` (region k: seed + k), e.g. from a
+/// load_scene request: a trainer hides the nodule somewhere else on every run.
+void reseed_regions(SceneSpec& scene, std::uint64_t seed);
+
 /// The scenes of a directory: the stems of its *.json files that read as scene files (what
 /// load_scene may name), and those that do not, each with its error; both sorted.
 struct SceneListing {
