@@ -185,7 +185,7 @@ std::optional<proto::RequestOutcome> Client::seek(double seconds, std::chrono::m
   return request(std::move(r), timeout);
 }
 
-void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad) {
+void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad, std::uint32_t buttons) {
   proto::Command c;
   c.instrument_id = instrument_id;
   c.client_id = client_id_;
@@ -193,6 +193,7 @@ void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, do
   c.client_stamp_ns = proto::now_ns();
   c.tip_position = tip;
   c.jaw_opening = jaw_opening_rad;
+  c.buttons = buttons;
   impl_->commands.write(instrument_id, proto::encode(c));
 }
 

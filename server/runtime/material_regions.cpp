@@ -18,6 +18,7 @@ using tissue::Vec3;
 namespace {
 
 constexpr int kDraws = 20000;  // candidate centres tried per drawn sphere before giving up
+constexpr double kFacingCos = 0.5;  // the nearest surface faces within 60 degrees of `facing`
 
 Vec3 centroid(const tissue::TetMesh& mesh, std::size_t e) {
   const auto& t = mesh.tets[e];
@@ -30,16 +31,35 @@ Vec3 vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
 std::string field(std::size_t k, const std::string& rest) { return "organ.regions[" + std::to_string(k) + "]" + rest; }
 
-/// A sphere's centre drawn from its seed: an element's centroid, taken in the order a 64-bit
-/// Mersenne twister picks them (index = draw mod element count), the first that qualifies.
+/// Whether p lies in an element of the mesh.
+bool inside(const tissue::TetMesh& mesh, const Vec3& p) {
+  for (const auto& t : mesh.tets) {
+    const Vec3& a = mesh.nodes[t[0]];
+    Eigen::Matrix3d M;
+    M << mesh.nodes[t[1]] - a, mesh.nodes[t[2]] - a, mesh.nodes[t[3]] - a;
+    const Vec3 w = M.partialPivLu().solve(p - a);
+    if (w.minCoeff() >= 0 && w.sum() <= 1) return true;
+  }
+  return false;
+}
+
+/// A uniform number in [0, 1) from 53 bits of a draw.
+double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+/// A sphere's centre drawn from its seed: points uniform in the organ's bounding box from a 64-bit
+/// Mersenne twister (x, y, z from three draws), the first inside the organ that qualifies.
 PlacedRegion draw_sphere(const RegionSpec& spec, std::size_t k, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary,
                          const Box& keep_out, const std::string& source) {
   std::mt19937_64 rng(spec.seed);
+  const Box bounds = tissue::bounding_box(mesh);
   for (int draw = 0; draw < kDraws; ++draw) {
-    const Vec3 c = centroid(mesh, rng() % mesh.tet_count());
-    if (distance_to_box(c, keep_out) <= spec.radius_m) continue;
-    const double depth = distance_to_surface(c, mesh, boundary) - spec.radius_m;
+    Vec3 c;
+    for (int a = 0; a < 3; ++a) c[a] = bounds.lo[a] + unit(rng) * (bounds.hi[a] - bounds.lo[a]);
+    if (distance_to_box(c, keep_out) <= spec.radius_m || !inside(mesh, c)) continue;
+    Vec3 normal;
+    const double depth = distance_to_surface(c, mesh, boundary, &normal) - spec.radius_m;
     if (depth < spec.min_depth_m || depth > spec.max_depth_m) continue;
+    if (vec(spec.facing).squaredNorm() > 0 && normal.dot(vec(spec.facing)) < kFacingCos) continue;
     PlacedRegion r;
     r.center_m = c;
     r.depth_m = depth;
@@ -47,17 +67,23 @@ PlacedRegion draw_sphere(const RegionSpec& spec, std::size_t k, const tissue::Te
   }
   throw InputError(source, 0, field(k, ".sphere.random_center.depth_m"),
                    "no place in the organ takes a sphere of radius " + std::to_string(spec.radius_m) + " m with its top " +
-                       std::to_string(spec.min_depth_m) + "-" + std::to_string(spec.max_depth_m) + " m deep, clear of the fixed slab (" +
+                       std::to_string(spec.min_depth_m) + "-" + std::to_string(spec.max_depth_m) + " m deep" +
+                       (vec(spec.facing).squaredNorm() > 0 ? " under a surface facing the stated way" : "") + ", clear of the fixed slab (" +
                        std::to_string(kDraws) + " centres tried)");
 }
 
 }  // namespace
 
-double distance_to_surface(const Vec3& p, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary) {
+double distance_to_surface(const Vec3& p, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary, Vec3* normal) {
   double best2 = std::numeric_limits<double>::infinity();
   for (const auto& t : boundary.triangles) {
     Vec3 w;
-    best2 = std::min(best2, (closest_point_on_triangle(p, mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], &w) - p).squaredNorm());
+    const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+    const double d2 = (closest_point_on_triangle(p, a, b, c, &w) - p).squaredNorm();
+    if (d2 < best2) {
+      best2 = d2;
+      if (normal) *normal = (b - a).cross(c - a).normalized();
+    }
   }
   return std::sqrt(best2);
 }

@@ -1,6 +1,7 @@
 #include "viscera/runtime/scene_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <set>
 
@@ -51,13 +52,19 @@ RegionSpec read_region(const JsonObject& r, const std::filesystem::path& dir, st
     return region;
   }
   const JsonObject random = sphere.object("random_center");
-  random.require_known({"seed", "depth_m"});
+  random.require_known({"seed", "depth_m", "facing"});
   region.random_center = true;
   region.seed = static_cast<std::uint64_t>(random.integer("seed", 0, 9'007'199'254'740'991LL));  // JSON's exact integers
   const auto depth = random.numbers("depth_m", 2, 0, 1);
   if (!(depth[0] <= depth[1])) random.fail("depth_m", "must be [least, most] with least <= most");
   region.min_depth_m = depth[0];
   region.max_depth_m = depth[1];
+  if (random.has("facing")) {
+    region.facing = point(random, "facing");
+    const double n = std::sqrt(region.facing[0] * region.facing[0] + region.facing[1] * region.facing[1] + region.facing[2] * region.facing[2]);
+    if (!(n > 0)) random.fail("facing", "must be a direction (not zero)");
+    for (double& c : region.facing) c /= n;
+  }
   return region;
 }
 

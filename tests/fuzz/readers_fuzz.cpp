@@ -1,8 +1,8 @@
 // libFuzzer target for every reader of a file a user edits or hands over: scene, material,
 // data set (its dataset.json and its CSV), fitted model, the Gmsh, legacy VTK and VTU mesh
-// readers, and the MCAP reader of session recordings. Whatever the bytes, a reader returns or throws InputError (one line naming the file);
-// any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan +
-// UBSan by tests/fuzz/run_fuzz.sh).
+// readers, the MCAP reader of session recordings and the trainer's exercise files. Whatever the bytes, a reader returns or throws InputError (one
+// line naming the file); any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan + UBSan by
+// tests/fuzz/run_fuzz.sh).
 //
 // The first byte picks the reader; the rest is the file. Files are written to a folder of this
 // process on tmpfs, since the readers take paths (as users give them).
@@ -21,6 +21,7 @@
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
+#include "viscera/training/exercise.hpp"
 
 #include "model_file.hpp"
 
@@ -67,7 +68,7 @@ void read_mcap(const std::string& path) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  const std::uint8_t pick = data[0] % 10;
+  const std::uint8_t pick = data[0] % 11;
   ++data;
   --size;
   using namespace viscera;
@@ -93,6 +94,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case 8: (void)common::parse_json(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"); break;
       case 9: read_mcap(write("session.mcap", data, size)); break;
+      case 10: (void)training::read_exercise_file(write("exercise.json", data, size)); break;
     }
   } catch (const common::InputError&) {
     // the one error a reader may give

@@ -22,6 +22,7 @@ seed() {  # selector file
 }
 for f in "$src"/data/scenes/*.json; do seed 0 "$f"; seed 8 "$f"; done
 for f in "$src"/data/materials/*.json; do seed 1 "$f"; done
+for f in "$src"/data/exercises/*.json; do seed 10 "$f"; done
 seed 3 "$src/data/meshes/liver.msh"
 seed 4 "$src/data/meshes/heart_imstk-unity.vtk"
 seed 5 "$src/data/meshes/volumetricTongue0.vtu"

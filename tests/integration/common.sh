@@ -11,3 +11,8 @@ failures=0; passed=0
 check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
 # A check written in Python, read from standard input (a here-document): counts one pass or one failure.
 pycheck() { if python3 - "$@"; then passed=$((passed+1)); else echo "FAIL the Python check above"; failures=$((failures+1)); fi; }
+# Waits until PATTERN appears in FILE (at most TENTHS tenths of a second, default 100); says so if it never does.
+wait_for() {  # PATTERN FILE [TENTHS]
+  for _ in $(seq "${3:-100}"); do grep -q "$1" "$2" && return 0; sleep 0.1; done
+  echo "FAIL '$1' never appeared in $2:"; cat "$2"; return 1
+}

@@ -21,10 +21,6 @@ hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"
 node_dir="$src/tests/node"
 [ -d "$node_dir/node_modules/@mcap/core" ] || { echo "FAIL @mcap/core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }
-wait_for() {  # PATTERN FILE [TENTHS]
-  for _ in $(seq "${3:-100}"); do grep -q "$1" "$2" && return 0; sleep 0.1; done
-  echo "FAIL '$1' never appeared in $2:"; cat "$2"; return 1
-}
 
 # --- The live session, recorded twice --------------------------------------------------------
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 & server=$!; pids+=($server)

@@ -193,6 +193,7 @@ TEST(MaterialRegions, ADrawnSphereLiesInsideTheOrganAtTheStatedDepthAndIsTheSame
   r.random_center = true;
   r.min_depth_m = 0.004;
   r.max_depth_m = 0.012;
+  r.facing = {0, 0, 1};  // under the upper surface, where a probe palpates from
   std::set<std::array<double, 3>> centres;
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     r.seed = seed;
@@ -211,6 +212,9 @@ TEST(MaterialRegions, ADrawnSphereLiesInsideTheOrganAtTheStatedDepthAndIsTheSame
       d.normalize();
       EXPECT_TRUE(inside(*mesh, p.center_m + 0.999 * (r.radius_m + r.min_depth_m) * d)) << "seed " << seed << ": tissue above the sphere";
     }
+    // Under a surface facing up (within 60 degrees): straight up, the organ ends within
+    // (radius + most depth) / cos 60 degrees.
+    EXPECT_FALSE(inside(*mesh, p.center_m + Vec3(0, 0, 2 * (r.radius_m + r.max_depth_m) + 1e-3))) << "seed " << seed;
     for (std::size_t e = 0; e < mesh->tet_count(); ++e) {
       const auto& t = mesh->tets[e];
       const Vec3 c = 0.25 * (mesh->nodes[t[0]] + mesh->nodes[t[1]] + mesh->nodes[t[2]] + mesh->nodes[t[3]]);

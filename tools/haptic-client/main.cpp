@@ -23,6 +23,7 @@
 #include "viscera/client/tick_phase.hpp"
 #include "viscera/common/command_line.hpp"
 
+#include "palpating_device.hpp"
 #include "scripted_device.hpp"
 #include "trajectory_device.hpp"
 
@@ -104,7 +105,8 @@ nlohmann::json to_json(const std::vector<ForceSample>& samples) {
 
 struct Options {
   std::uint32_t domain = 0, client_id = 1, instrument = 1;
-  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100, duration_s = 4;
+  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, hold_s = -1, force_n = 1.0, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100,
+         duration_s = 4;
   viscera::client::FadePolicy fade;
   std::string script, frame, report;
   std::vector<viscera::haptic::TrajectoryPoint> trajectory;
@@ -121,12 +123,15 @@ Options parse(viscera::common::CommandLine& cl) {
   o.depth_m = cl.number_in("depth", 0, 0.2);
   o.max_force_n = cl.number_in("max-force", 0.1, 1000);
   o.pull_m = cl.number_in("pull", 0, 0.2);
+  if (cl.has("hold")) o.hold_s = cl.number_in("hold", 0, 3600);
+  o.force_n = cl.number_in("force", 0.01, 50);
   o.blend_s = cl.number_in("blend", 0, 0.1);
   o.fade.fade_s = cl.number_in("fade", 0.001, 5);
   o.fade.stale_after_s = cl.number_in("stale-after", 0.001, 5);
   o.script = cl.text("script");
   o.frame = cl.text("frame");
-  if (o.script != "press" && o.script != "grasp") throw viscera::common::UsageError("--script: '" + o.script + "' is not press or grasp");
+  if (o.script != "press" && o.script != "grasp" && o.script != "hold" && o.script != "palpate")
+    throw viscera::common::UsageError("--script: '" + o.script + "' is not press, grasp, hold or palpate");
   if (o.frame != "scene" && o.frame != "organ-top") throw viscera::common::UsageError("--frame: '" + o.frame + "' is not scene or organ-top");
   if (cl.has("trajectory")) {  // before connecting: a bad file fails at once
     o.trajectory_file = cl.text("trajectory");
@@ -146,7 +151,9 @@ Options parse(viscera::common::CommandLine& cl) {
 }
 
 std::unique_ptr<viscera::client::Device> make_device(const Options& o, const viscera::protocol::Scene& scene) {
-  if (o.trajectory.empty()) return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m);
+  if (o.trajectory.empty() && o.script == "palpate") return std::make_unique<viscera::haptic::PalpatingDevice>(scene, o.depth_m, !o.quiet);
+  if (o.trajectory.empty())
+    return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m, o.hold_s, o.force_n);
   const Vector3 origin = o.frame == "scene" ? Vector3{0, 0, 0}
                                             : Vector3{0.5 * (scene.bounds_min[0] + scene.bounds_max[0]),
                                                       0.5 * (scene.bounds_min[1] + scene.bounds_max[1]), scene.bounds_max[2]};
@@ -244,7 +251,7 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
     }
     const auto in = device.read(t);
     if (in.finished) break;
-    client.send_tip(o.instrument, in.tip_m, in.jaw_rad);
+    client.send_tip(o.instrument, in.tip_m, in.jaw_rad, in.buttons);
     ++seq;
     sent[seq % sent.size()] = {seq, in.tip_m};
     // Wait for the answer to this command until shortly before the next device period.
@@ -313,7 +320,11 @@ int main(int argc, char** argv) {
       "A haptic device client: claims an instrument of a running viscera-server and drives it from a virtual device.\n"
       "Script 'press': the probe starts 1 cm above the organ at the centre of its top and moves down until the\n"
       "server reports contact, presses DEPTH further by mid-run and comes back to the contact height by the end.\n"
-      "Script 'grasp': the grasper moves down to contact (plus DEPTH), closes its jaws, pulls up PULL, opens.\n"
+      "Script 'grasp': the grasper moves down to contact (plus DEPTH), closes its jaws, pulls up PULL, opens\n"
+      "(with --hold: pulls up at 1 cm/s, holds HOLD seconds, then opens).\n"
+      "Script 'hold': the probe presses until the force it feels is FORCE and holds it there (a force drill).\n"
+      "Script 'palpate': the probe palpates the organ's top on a grid, by the force DEPTH beyond contact, and marks\n"
+      "the stiffest place with button 1 (a palpation exercise; it never reads where the nodule is).\n"
       "--trajectory FILE.csv plays a recorded or designed trajectory instead (docs/PROTOCOL.md).\n"
       "Prints force and command-to-force round trip live; --report writes every sample as JSON.\n"
       "If the server goes away the rendered force fades to zero (--fade) and the client exits with status 4\n"
@@ -325,8 +336,10 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "length of the run [s] (default: 4 for scripts, the trajectory's length for --trajectory)");
   cl.flag("rate", "HZ", "device rate [Hz]", "1000");
   cl.flag("depth", "M", "how far to press beyond the first contact [m]", "0.03");
-  cl.flag("script", "NAME", "press (probe) | grasp (grasper: touch the top, close the jaws, pull up PULL, open)", "press");
+  cl.flag("script", "NAME", "press | grasp | hold | palpate (above)", "press");
   cl.flag("pull", "M", "grasp script: how far to pull up after grasping [m]", "0.02");
+  cl.flag("hold", "S", "grasp script: hold the pull this long, then open [s] (default: open at 75% of the run)");
+  cl.flag("force", "N", "hold script: the force to hold [N]", "1.0");
   cl.flag("trajectory", "FILE.csv", "play this trajectory file (time_s,x_m,y_m,z_m[,jaw_rad][,buttons]) instead of a script");
   cl.flag("frame", "NAME", "trajectory positions: scene (absolute) | organ-top (relative to the organ's top centre)", "scene");
   cl.flag("max-force", "N", "device force limit [N]; rendered forces are clamped to it", "15");

@@ -4,7 +4,10 @@
 // organ's top centre until the force says "contact", then
 //   press: presses DEPTH further by mid-run, comes back to the contact height by the end;
 //   grasp: goes DEPTH beyond contact within 5% of the run with the jaws closed, pulls up PULL by
-//          75% of the run, then opens the jaws and holds.
+//          75% of the run, then opens the jaws and holds; with a HOLD time it pulls up at 1 cm/s,
+//          holds for HOLD seconds, then opens;
+//   hold:  presses until the force is FORCE and keeps it there (an integral controller on the
+//          force it feels, as a hand holding a steady pressure), until the end of the run.
 #include <limits>
 #include <string>
 
@@ -14,15 +17,17 @@ namespace viscera::haptic {
 
 class ScriptedDevice : public client::Device {
  public:
-  ScriptedDevice(std::string script, const protocol::Scene& scene, double duration_s, double depth_m, double pull_m);
+  /// hold_s < 0: the grasp's timing by the run's length; force_n: the hold script's target.
+  ScriptedDevice(std::string script, const protocol::Scene& scene, double duration_s, double depth_m, double pull_m, double hold_s = -1,
+                 double force_n = 1.0);
   std::string name() const override { return "scripted " + script_; }
   client::DeviceSample read(double t_s) override;
   void render(const protocol::Vector3& force_n, bool in_contact) override;
 
  private:
   std::string script_;
-  double cx_, cy_, top_, bottom_, duration_, depth_, pull_, search_speed_;
-  double t_ = 0, z_ = 0;
+  double cx_, cy_, top_, bottom_, duration_, depth_, pull_, hold_, target_force_, search_speed_;
+  double t_ = 0, z_ = 0, force_ = 0, hold_z_ = 0, hold_t_ = 0;
   double contact_z_ = std::numeric_limits<double>::quiet_NaN(), contact_t_ = 0;
 };
 

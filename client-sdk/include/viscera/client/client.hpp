@@ -73,7 +73,8 @@ class Client {
   std::optional<protocol::RequestOutcome> seek(double seconds, std::chrono::milliseconds timeout);
   /// Sends the instrument's tip position [m] and jaw opening [rad] (next sequence number,
   /// current stamp).
-  void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip, double jaw_opening_rad = 0.5);
+  /// `buttons`: the device's buttons as a bit mask (bit 0, button 1: a mark, docs/TRAINING.md).
+  void send_tip(std::uint32_t instrument_id, const protocol::Vector3& tip, double jaw_opening_rad = 0.5, std::uint32_t buttons = 0);
   /// Takes the forces that arrived; returns the newest for the instrument, if any. Each one
   /// whose echoed stamp is this client's adds a round-trip sample.
   std::optional<protocol::Force> poll_force(std::uint32_t instrument_id);

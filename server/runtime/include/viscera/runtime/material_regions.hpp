@@ -2,8 +2,9 @@
 // Material regions laid out on an organ's mesh (docs/SCENE.md, "Material regions"): each element
 // whose centroid lies inside a region's sphere or box takes the region's material (a later region
 // over an earlier one). A sphere whose centre is drawn from a seed lands where it lies wholly
-// inside the organ, its top between the stated depths below the surface, and clear of the fixed
-// slab; the draw is a fixed function of the seed, the mesh and the scene (the same on any machine).
+// inside the organ, its top between the stated depths below the surface (a surface facing the
+// stated way, if one is stated), and clear of the fixed slab; the draw is a fixed function of the seed, the mesh and the scene (the same on any
+// machine).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,7 +37,9 @@ struct RegionLayout {
 RegionLayout lay_out_regions(const std::vector<RegionSpec>& specs, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary,
                              const tissue::Box& keep_out, const std::string& source);
 
-/// Distance from `p` to the nearest boundary triangle [m].
-double distance_to_surface(const tissue::Vec3& p, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary);
+/// Distance from `p` to the nearest boundary triangle [m]; `normal`, if given, gets that
+/// triangle's outward unit normal.
+double distance_to_surface(const tissue::Vec3& p, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary,
+                           tissue::Vec3* normal = nullptr);
 
 }  // namespace viscera::runtime

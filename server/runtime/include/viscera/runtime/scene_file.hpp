@@ -31,6 +31,9 @@ struct RegionSpec {
   bool random_center = false;  ///< sphere: centre drawn from `seed`
   std::uint64_t seed = 0;
   double min_depth_m = 0, max_depth_m = 0;  ///< random centre: the sphere's top this far below the surface
+  /// random centre: the nearest surface faces within 60 degrees of this direction (e.g. up, where a
+  /// probe palpates from); zero: any surface
+  std::array<double, 3> facing{};
 };
 
 struct SceneSpec {

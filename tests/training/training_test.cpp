@@ -1,0 +1,240 @@
+// The trainer's scoring without a network: synthetic sessions whose metrics are known in closed
+// form (hold times, time above a limit, path length, the mark's distance to a sphere), fed as the
+// payloads a session's streams carry; the same numbers whatever the arrival order; exercise files
+// whose errors name the file and the field.
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "viscera/common/input_error.hpp"
+#include "viscera/training/exercise_scorer.hpp"
+
+using namespace viscera::training;
+namespace proto = viscera::protocol;
+
+namespace {
+
+struct Payload {
+  proto::Stream stream;
+  std::vector<std::uint8_t> bytes;
+};
+
+constexpr double kTipRadius = 0.005;
+
+/// A session at 1 kHz: the scene loaded at tick 100, then one command and its force per tick.
+struct Session {
+  std::vector<Payload> payloads;
+  std::uint64_t seq = 0;
+  std::uint32_t instrument = 1;
+
+  explicit Session(const std::string& scene, std::vector<proto::RegionInfo> regions = {}) {
+    proto::Scene s;
+    s.name = scene;
+    s.physics_rate_hz = 1000;
+    s.regions = std::move(regions);
+    payloads.push_back({proto::Stream::scene_state, proto::encode(s)});
+    event(proto::EventKind::scene_loaded, 100, "loaded scene " + scene + " (explicit step 0.0004 s)");
+  }
+  void event(proto::EventKind kind, std::uint64_t tick, std::string text = {}) {
+    proto::Event e;
+    e.kind = kind;
+    e.tick = tick;
+    e.instrument_id = instrument;
+    e.text = std::move(text);
+    payloads.push_back({proto::Stream::event, proto::encode(e)});
+  }
+  void step(std::uint64_t tick, const proto::Vector3& tip, double force_n, double strain = 0.1, std::uint32_t buttons = 0) {
+    proto::Command c;
+    c.instrument_id = instrument;
+    c.client_id = 7;
+    c.seq = ++seq;
+    c.tip_position = tip;
+    c.buttons = buttons;
+    payloads.push_back({proto::Stream::instrument_command, proto::encode(c)});
+    proto::Force f;
+    f.instrument_id = instrument;
+    f.client_id = 7;
+    f.command_seq = c.seq;
+    f.force = {0, 0, force_n};
+    f.in_contact = force_n > 0;
+    f.contact_point = {tip[0], tip[1], tip[2] - kTipRadius};  // the tool's sphere touches the tissue below its centre
+    f.tick = tick;
+    f.max_edge_strain = strain;
+    payloads.push_back({proto::Stream::force_feedback, proto::encode(f)});
+  }
+  ScoreReport score(const Exercise& e, const std::vector<Payload>& order) const {
+    ExerciseScorer s(e);
+    for (const auto& p : order) s.take(p.stream, p.bytes);
+    s.finish();
+    return s.report();
+  }
+  ScoreReport score(const Exercise& e) const { return score(e, payloads); }
+};
+
+Exercise drill() {
+  return parse_exercise(R"({"name": "drill", "kind": "force_drill", "scene": "liver", "time_limit_s": 60,
+    "limits": {"peak_force_n": 2.0, "edge_strain": 0.5}, "force_drill": {"force_n": 1.0, "tolerance_n": 0.1, "hold_s": 10}})",
+                        "drill.json");
+}
+
+bool has_failure(const ScoreReport& r, const std::string& words) {
+  return std::any_of(r.failures.begin(), r.failures.end(), [&](const std::string& f) { return f.find(words) != std::string::npos; });
+}
+
+}  // namespace
+
+// A ramp to 1 N over 2 s, then 1 N held: the hold starts at the first tick inside the band
+// (0.9 N, 1.8 s after the start) and completes 10 s later; the tip moved 3 mm down during the
+// ramp and 1 mm sideways in 1 um steps later: path 4 mm. A 40-tick spike above the limit in a
+// second performance: 0.040 s above it, failed for too much force, and the hold restarts after it.
+TEST(ExerciseScorer, ForceDrillHoldTimeAboveLimitAndPathAsTheirDefinitions) {
+  Session good("liver");
+  for (std::uint64_t k = 0; k <= 20000; ++k) {
+    const double t = 1e-3 * static_cast<double>(k);
+    const double F = t < 2.0 ? 0.5 * t : 1.0;
+    const double z = t < 2.0 ? -0.0015 * t : -0.003;
+    const double y = k >= 5000 && k < 6000 ? 1e-6 * static_cast<double>(k - 5000 + 1) : k >= 6000 ? 1e-3 : 0.0;
+    good.step(100 + k, {0, y, z}, F);
+  }
+  const ScoreReport r = good.score(drill());
+  EXPECT_TRUE(r.started);
+  EXPECT_TRUE(r.completed);
+  EXPECT_TRUE(r.passed) << (r.failures.empty() ? "" : r.failures[0]);
+  EXPECT_EQ(r.start_tick, 100u);
+  EXPECT_EQ(r.end_tick, 100u + 1800u + 10000u);  // the first tick at 0.9 N is 1.8 s in
+  EXPECT_NEAR(r.time_s, 11.8, 1e-9);
+  EXPECT_NEAR(r.longest_hold_s, 10.0, 1e-9);
+  EXPECT_NEAR(r.path_length_m, 0.003 + 0.001, 1e-9);
+  EXPECT_DOUBLE_EQ(r.peak_force_n, 1.0);
+  EXPECT_EQ(r.time_above_force_limit_s, 0.0);
+  EXPECT_NEAR(r.max_edge_strain, 0.1, 1e-12);
+
+  Session spiky("liver");
+  for (std::uint64_t k = 0; k <= 30000; ++k) {
+    const double t = 1e-3 * static_cast<double>(k);
+    const bool spike = k >= 5000 && k < 5040;
+    spiky.step(100 + k, {0, 0, 0}, spike ? 2.5 : t < 2.0 ? 0.5 * t : 1.0);
+  }
+  const ScoreReport s = spiky.score(drill());
+  EXPECT_FALSE(s.passed);
+  EXPECT_NEAR(s.time_above_force_limit_s, 0.040, 1e-12);
+  EXPECT_DOUBLE_EQ(s.peak_force_n, 2.5);
+  EXPECT_TRUE(has_failure(s, "too much force: 2.50 N"));
+  EXPECT_EQ(s.end_tick, 100u + 5040u + 10000u);  // the hold restarted after the spike
+  EXPECT_TRUE(s.completed);
+
+  // Never inside the band: not completed, out of time after the limit, failed for it.
+  Session weak("liver");
+  for (std::uint64_t k = 0; k <= 70000; ++k) weak.step(100 + k, {0, 0, 0}, 0.5);
+  const ScoreReport w = weak.score(drill());
+  EXPECT_FALSE(w.completed);
+  EXPECT_EQ(w.ending, "out of time");
+  EXPECT_EQ(w.end_tick, 100u + 60000u);
+  EXPECT_TRUE(has_failure(w, "not completed: out of time"));
+}
+
+// The same numbers whatever order the payloads arrive in (a tap or a recorder may take forces
+// before the commands they answer, and streams in any interleaving).
+TEST(ExerciseScorer, TheScoreDoesNotDependOnTheArrivalOrder) {
+  Session session("liver");
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0, 1e-4);
+  for (std::uint64_t k = 0; k <= 15000; ++k) session.step(100 + k, {n(rng), n(rng), n(rng)}, 1.0 + 0.2 * std::sin(1e-3 * static_cast<double>(k)));
+  const ScoreReport in_order = session.score(drill());
+  std::vector<Payload> shuffled = session.payloads;
+  // Forces before commands within blocks of 50 payloads, and the blocks' streams swapped.
+  for (std::size_t b = 2; b + 50 < shuffled.size(); b += 50)
+    std::shuffle(shuffled.begin() + static_cast<long>(b), shuffled.begin() + static_cast<long>(b + 50), rng);
+  const ScoreReport mixed = session.score(drill(), shuffled);
+  EXPECT_EQ(to_json(in_order), to_json(mixed));
+  EXPECT_GT(in_order.path_length_m, 0.1);
+}
+
+// Retraction: the lift is the tip's height above where it grasped; a let-go before the hold is
+// complete is a drop, named as such.
+TEST(ExerciseScorer, RetractionHoldsTheLiftAndNamesADrop) {
+  const Exercise e = parse_exercise(R"({"name": "retraction", "kind": "retraction", "scene": "liver", "instrument": 3, "time_limit_s": 60,
+    "retraction": {"lift_m": 0.02, "tolerance_m": 0.005, "hold_s": 5}})",
+                                    "retraction.json");
+  const auto performance = [](double release_after_s) {
+    Session s("liver");
+    s.instrument = 3;
+    for (std::uint64_t k = 0; k <= 12000; ++k) {
+      const double t = 1e-3 * static_cast<double>(k);
+      if (k == 500) s.event(proto::EventKind::grasped, 100 + k);
+      if (k == static_cast<std::uint64_t>(1000 * (2.5 + release_after_s))) s.event(proto::EventKind::let_go, 100 + k);
+      const double lift = t < 0.5 ? 0.0 : std::min(0.02, 0.011 * (t - 0.5));  // 11 mm/s from the grasp, 2 cm up at 2.32 s
+      s.step(100 + k, {0, 0, 0.05 + lift}, 0.5);
+    }
+    return s;
+  };
+  const ScoreReport good = performance(8.0).score(e);
+  EXPECT_TRUE(good.passed) << (good.failures.empty() ? "" : good.failures[0]);
+  EXPECT_EQ(good.drops, 0u);
+  // Inside the band from a lift of 15 mm, 0.015 / 0.011 = 1.3636 s after the grasp: the first tick
+  // at or beyond it is 1.864 s in; held for 5 s from there.
+  EXPECT_EQ(good.end_tick, 100u + 1864u + 5000u);
+  const ScoreReport dropped = performance(1.0).score(e);
+  EXPECT_FALSE(dropped.passed);
+  EXPECT_EQ(dropped.drops, 1u);
+  EXPECT_TRUE(has_failure(dropped, "the lobe was dropped"));
+  EXPECT_NEAR(dropped.longest_hold_s, 3.499 - 1.864, 1e-9);  // from 1.864 s to the last tick before the let-go at 3.5 s
+}
+
+// Palpation: the mark is where the tool touched the tissue when button 1 went down (the contact
+// point, a tip radius below the tip's centre); its distance to the nodule's surface is
+// |mark - centre| - radius (0 inside), scored against the tolerance.
+TEST(ExerciseScorer, PalpationScoresTheMarksDistanceToTheNodulesSurface) {
+  const Exercise e = parse_exercise(R"({"name": "palpation", "kind": "palpation", "scene": "liver-nodule", "palpation": {"mark_tolerance_m": 0.01}})",
+                                    "palpation.json");
+  proto::RegionInfo nodule;
+  nodule.name = "nodule";
+  nodule.center = {0.01, 0.02, 0.0};
+  nodule.radius_m = 0.012;
+  for (const double dx : {0.0, 0.015, 0.03}) {
+    Session s("liver-nodule", {nodule});
+    for (std::uint64_t k = 0; k <= 3000; ++k) s.step(100 + k, {0.01 + dx, 0.02, 0.02}, 0.3, 0.1, k >= 2000 && k < 2030 ? kMarkButton : 0);
+    const ScoreReport r = s.score(e);
+    ASSERT_TRUE(r.mark_distance_m);
+    const double expected = std::max(0.0, std::hypot(dx, 0.02 - kTipRadius) - 0.012);
+    EXPECT_NEAR(*r.mark_distance_m, expected, 1e-12);
+    EXPECT_EQ(r.end_tick, 2100u);
+    EXPECT_EQ(r.passed, expected <= 0.01) << "dx " << dx;
+    if (!r.passed) EXPECT_TRUE(has_failure(r, "the wrong place was marked"));
+  }
+  // No mark at all, and a session whose scene never loads.
+  Session none("liver-nodule", {nodule});
+  for (std::uint64_t k = 0; k <= 3000; ++k) none.step(100 + k, {0, 0, 0}, 0.3);
+  EXPECT_TRUE(has_failure(none.score(e), "no place was marked"));
+  Session other("liver");
+  EXPECT_TRUE(has_failure(other.score(e), "never started: no loading of scene liver-nodule"));
+}
+
+TEST(ExerciseFile, ErrorsNameTheFileAndTheField) {
+  const auto message = [](const std::string& text) {
+    try {
+      parse_exercise(text, "ex.json");
+    } catch (const viscera::common::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string head = R"({"name": "x", "scene": "liver", )";
+  EXPECT_NE(message(head + R"("kind": "force_drill", "colour": 1})").find("ex.json: colour: unknown field"), std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "suturing"})").find("ex.json: kind"), std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "time_limit_s": -3})").find("ex.json: time_limit_s"), std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "limits": {"peak_force_n": 1e9}})").find("ex.json: limits.peak_force_n"), std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "palpation": {}})").find("ex.json: palpation: belongs to a palpation exercise"),
+            std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "force_drill": {"force_n": 1, "tolerance_n": 2}})").find("ex.json: force_drill.tolerance_n"),
+            std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "limits": {"peak_force_n": 1.0}, "force_drill": {"force_n": 1.0, "tolerance_n": 0.1}})")
+                .find("force_drill.force_n"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"name": "x", "kind": "palpation", "scene": "../etc"})").find("no error"),
+            std::string::npos);  // a name; the server refuses paths
+  for (const char* f : {"palpation.json", "retraction.json", "force-drill.json"})
+    EXPECT_NO_THROW(read_exercise_file(std::string(VISCERA_DATA_DIR) + "/exercises/" + f)) << f;
+}

@@ -1,0 +1,140 @@
+#include "palpating_device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace viscera::haptic {
+
+namespace {
+constexpr double kTravelSpeed = 0.2, kDescendSpeed = 0.1, kPressSpeed = 0.05, kLiftSpeed = 0.2;  // [m/s]
+constexpr double kDwellS = 0.05;  // at DEPTH before the force is noted [s]
+constexpr double kCoarse = 0.02, kFine = 0.01;  // grid spacings [m]
+constexpr double kMargin = 0.15;  // of the organ's extent kept clear at its sides
+constexpr double kSafeForceN = 2.0;  // a press stops here
+constexpr double kMinVerticalShare = 0.8;  // F_z / |F| of a press that counts
+
+double magnitude(const protocol::Vector3& f) { return std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]); }
+}  // namespace
+
+PalpatingDevice::PalpatingDevice(const protocol::Scene& scene, double depth_m, bool verbose)
+    : safe_z_(scene.bounds_max[2] + 0.01), bottom_(scene.bounds_min[2]), depth_(depth_m), verbose_(verbose) {
+  const double x0 = scene.bounds_min[0], x1 = scene.bounds_max[0], y0 = scene.bounds_min[1], y1 = scene.bounds_max[1];
+  const double mx = kMargin * (x1 - x0), my = kMargin * (y1 - y0);
+  for (double x = x0 + mx; x <= x1 - mx + 1e-9; x += kCoarse)
+    for (double y = y0 + my; y <= y1 - my + 1e-9; y += kCoarse) probes_.push_back({x, y});
+  x_ = probes_.empty() ? 0.5 * (x0 + x1) : probes_[0].x;
+  y_ = probes_.empty() ? 0.5 * (y0 + y1) : probes_[0].y;
+  z_ = safe_z_;
+  if (probes_.empty()) phase_ = Phase::done;
+}
+
+void PalpatingDevice::add_neighbours(double x, double y, double spacing) {
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      if (i != 0 || j != 0) probes_.push_back({x + i * spacing, y + j * spacing});
+}
+
+void PalpatingDevice::next_point() {
+  phase_ = Phase::travel;
+  if (++current_ < probes_.size()) return;
+  const auto best = std::max_element(probes_.begin(), probes_.end(), [](const Probe& a, const Probe& b) { return a.force_n < b.force_n; });
+  if (best->force_n < 0) {  // no tissue anywhere
+    phase_ = Phase::done;
+    return;
+  }
+  if (!refined_) {
+    refined_ = true;
+    std::printf("palpate: %zu points 2 cm apart, stiffest at (%.3f, %.3f) m with %.3f N; 1 cm around it next\n", probes_.size(), best->x, best->y,
+                best->force_n);
+    std::fflush(stdout);
+    const double bx = best->x, by = best->y;
+    add_neighbours(bx, by, kFine);
+    return;
+  }
+  if (!marking_) {
+    marking_ = true;
+    std::printf("palpate: stiffest of %zu points at (%.3f, %.3f) m with %.3f N: marking it\n", probes_.size(), best->x, best->y, best->force_n);
+    std::fflush(stdout);
+    probes_.push_back({best->x, best->y});
+    return;
+  }
+  phase_ = Phase::done;
+}
+
+client::DeviceSample PalpatingDevice::read(double t) {
+  const double dt = std::clamp(t - t_, 0.0, 0.01);
+  t_ = t;
+  if (phase_ == Phase::done) {
+    z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
+    return {{x_, y_, z_}, 0.5, 0, z_ >= safe_z_};
+  }
+  Probe& p = probes_[current_];
+  switch (phase_) {
+    case Phase::travel: {
+      if (z_ < safe_z_) {  // straight up first, the way it came down
+        z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
+        break;
+      }
+      const double dx = p.x - x_, dy = p.y - y_, d = std::hypot(dx, dy), step = kTravelSpeed * dt;
+      if (d <= step) {
+        x_ = p.x;
+        y_ = p.y;
+        if (z_ >= safe_z_) phase_ = Phase::descend;
+      } else {
+        x_ += dx / d * step;
+        y_ += dy / d * step;
+      }
+      break;
+    }
+    case Phase::descend:
+      if (contact_) {
+        contact_z_ = z_;
+        phase_ = Phase::press;
+      } else if (z_ <= bottom_) {
+        next_point();  // no tissue under this point
+      } else {
+        z_ -= kDescendSpeed * dt;
+      }
+      break;
+    case Phase::press:
+      if (magnitude(force_) > kSafeForceN && !marking_) {
+        phase_ = Phase::lift;  // too stiff or too steep to press further: left out
+        break;
+      }
+      if (z_ > contact_z_ - 0.5 * depth_) p.half_force_n = magnitude(force_);
+      z_ = std::max(contact_z_ - depth_, z_ - kPressSpeed * dt);
+      if (z_ <= contact_z_ - depth_) {
+        phase_ = Phase::dwell;
+        phase_t_ = t;
+      }
+      break;
+    case Phase::dwell:
+      if (marking_ && current_ + 1 == probes_.size()) buttons_ = t - phase_t_ < 0.5 * kDwellS ? 0u : 1u;  // the mark: button 1 pressed
+      if (t - phase_t_ >= kDwellS) {
+        const double F = magnitude(force_);
+        p.force_n = F > 0 && force_[2] >= kMinVerticalShare * F ? F : -1.0;
+        if (verbose_) {
+          std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s\n", p.x, p.y, contact_z_, p.half_force_n,
+                      500 * depth_, F, 1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
+          std::fflush(stdout);
+        }
+        buttons_ = 0;
+        phase_ = Phase::lift;
+      }
+      break;
+    case Phase::lift:
+      z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
+      if (z_ >= safe_z_) next_point();
+      break;
+    case Phase::done: break;
+  }
+  return {{x_, y_, z_}, 0.5, buttons_, false};
+}
+
+void PalpatingDevice::render(const protocol::Vector3& f, bool in_contact) {
+  force_ = f;
+  contact_ = in_contact;
+}
+
+}  // namespace viscera::haptic

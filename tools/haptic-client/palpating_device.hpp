@@ -1,0 +1,46 @@
+#pragma once
+// A virtual device that palpates the organ from above to find what is stiffer inside it, as a
+// trainee's hand would: at each point of a grid over the organ's top (2 cm apart, then 1 cm apart
+// around the stiffest), it comes down until it touches, presses DEPTH further, notes the force it
+// feels there and lifts off; then it presses at the stiffest point and marks it (button 1). It
+// never reads the scene's regions: only the forces tell it where the nodule is. Where the surface
+// slopes steeply (the force it feels leans more than about 37 degrees from the vertical) or the
+// force passes a safe 2 N before DEPTH, the point is left out: a hand presses along the surface's
+// normal, and a vertical press into a slope measures the slope, not the tissue.
+#include <string>
+#include <vector>
+
+#include "viscera/client/device.hpp"
+
+namespace viscera::haptic {
+
+class PalpatingDevice : public client::Device {
+ public:
+  /// verbose: a line per point pressed (its place and the forces felt).
+  PalpatingDevice(const protocol::Scene& scene, double depth_m, bool verbose);
+  std::string name() const override { return "scripted palpate"; }
+  client::DeviceSample read(double t_s) override;
+  void render(const protocol::Vector3& force_n, bool in_contact) override;
+
+ private:
+  enum class Phase { travel, descend, press, dwell, lift, done };
+  struct Probe {
+    double x = 0, y = 0;
+    double force_n = -1;  ///< felt at DEPTH beyond contact; -1: not yet, or no tissue there
+    double half_force_n = 0;  ///< felt at DEPTH / 2
+  };
+  void next_point();
+  void add_neighbours(double x, double y, double spacing);
+
+  std::vector<Probe> probes_;
+  std::size_t current_ = 0;
+  bool refined_ = false, marking_ = false;
+  Phase phase_ = Phase::travel;
+  double safe_z_, bottom_, depth_;
+  double x_, y_, z_, t_ = 0, phase_t_ = 0, contact_z_ = 0;
+  protocol::Vector3 force_{};
+  bool contact_ = false, verbose_ = false;
+  std::uint32_t buttons_ = 0;
+};
+
+}  // namespace viscera::haptic
