@@ -11,6 +11,7 @@
 #include "viscera/lab/decimation.hpp"
 #include "viscera/lab/fit.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
+#include "viscera/lab/stress_controlled.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 
 namespace viscera::lab {
@@ -95,14 +96,24 @@ double rms_over_tests(const std::vector<TestFigures>& t, double TestFigures::*f)
 
 }  // namespace
 
-double noise_level_pa(const TestData& t) {
-  if (!t.stress_sd_pa.empty()) return rms(t.stress_sd_pa);
+namespace {
+// Noise of a sampled quantity from its second differences (robust: the median absolute value).
+double noise_from_second_differences(const std::vector<double>& v) {
   std::vector<double> d2;
-  for (std::size_t k = 2; k < t.stress_pa.size(); ++k) d2.push_back(std::abs(t.stress_pa[k] - 2 * t.stress_pa[k - 1] + t.stress_pa[k - 2]));
+  for (std::size_t k = 2; k < v.size(); ++k) d2.push_back(std::abs(v[k] - 2 * v[k - 1] + v[k - 2]));
   if (d2.empty()) return 0.0;
   std::nth_element(d2.begin(), d2.begin() + static_cast<long>(d2.size() / 2), d2.end());
   return d2[d2.size() / 2] / 0.6745 / std::sqrt(6.0);
 }
+}  // namespace
+
+double noise_level_measured(const TestData& t) {
+  if (t.control == Control::stress) return noise_from_second_differences(t.strain);
+  if (!t.stress_sd_pa.empty()) return rms(t.stress_sd_pa);
+  return noise_from_second_differences(t.stress_pa);
+}
+
+double noise_level_pa(const TestData& t) { return noise_level_measured(t) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t)); }
 
 ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d) {
   if (d.tests.size() < 2) throw common::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
@@ -119,8 +130,17 @@ ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d) {
     heldout[k] = rms_error_pa(fit_model(structure, others), d.tests[k]);
   }
   ev.model = full.get();
-  for (std::size_t k = 0; k < d.tests.size(); ++k)
-    ev.tests.push_back({d.tests[k].file, rms_error_pa(ev.model, d.tests[k]), heldout[k], noise_level_pa(d.tests[k])});
+  for (std::size_t k = 0; k < d.tests.size(); ++k) {
+    const TestData& t = d.tests[k];
+    TestFigures f{t.file, rms_error_pa(ev.model, t), heldout[k], noise_level_pa(t)};
+    if (t.control == Control::stress) {
+      const double modulus = apparent_modulus_pa(t);
+      f.fit_rms_strain = f.fit_rms_pa / modulus;
+      f.heldout_rms_strain = f.heldout_rms_pa / modulus;
+      f.noise_strain = f.noise_pa / modulus;
+    }
+    ev.tests.push_back(f);
+  }
   ev.fit_rms_pa = rms_over_tests(ev.tests, &TestFigures::fit_rms_pa);
   ev.heldout_rms_pa = rms_over_tests(ev.tests, &TestFigures::heldout_rms_pa);
   return ev;
@@ -150,16 +170,7 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
       const SpecimenResult r = simulate_specimen(m, d, t, &calibration);
       c.files.push_back(t.file);
       c.specimen_rms_pa.push_back(r.rms_pa);
-      if (t.control == Control::strain) {
-        c.law_rms_pa.push_back(rms_error_pa(m, t));
-      } else {  // same measure as the specimen: strain error x unrelaxed modulus
-        double E_u = m.modulus_pa, sq = 0.0;
-        if (m.has(Mechanism::broadband_relaxation))
-          for (double e : m.relaxation_modulus_pa) E_u += e;
-        const auto strain = predict_strain(m, t);
-        for (std::size_t k = 0; k < strain.size(); ++k) sq += (strain[k] - t.strain[k]) * (strain[k] - t.strain[k]) * E_u * E_u;
-        c.law_rms_pa.push_back(std::sqrt(sq / static_cast<double>(strain.size())));
-      }
+      c.law_rms_pa.push_back(rms_error_pa(m, t));
       c.steps += r.steps;
       c.newton_iterations += r.newton_iterations;
     }

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include "viscera/lab/golden_section.hpp"
+#include "viscera/lab/stress_controlled.hpp"
 
 namespace viscera::lab {
 
@@ -56,30 +57,115 @@ Eigen::VectorXd nonnegative_least_squares(const Eigen::MatrixXd& A, const Eigen:
 
 namespace {
 
+// The rows of the fit. Strain-controlled tests enter as stress errors, linear in the moduli and
+// viscosities for given nonlinear parameters. Stress-controlled tests are fitted on the strain they
+// measured (output error; stress_controlled.hpp), in equivalent stress: nonlinear in every
+// parameter, so they join in a last Gauss-Newton refinement. The nonlinear search uses the
+// strain-controlled tests, or, when a data set has only stress-controlled ones, their equation
+// error (the stress the model needs for the measured strain) as a start.
 struct Problem {
-  const std::vector<const TestData*>& tests;
+  std::vector<const TestData*> linear;  // rows linear in the parameters
+  std::vector<double> linear_weight;
+  std::vector<const TestData*> creep;  // stress-controlled, output error
+  std::vector<double> creep_weight;  // 1/sqrt(rows) x apparent modulus
   Eigen::VectorXd b;
-  std::vector<double> weight;  // per test
 };
 
-// Solves the linear part for the given nonlinear parameters; returns the weighted SSE.
-double solve_linear(MaterialModel& m, const Problem& p) {
-  Eigen::Index rows = 0;
-  for (const TestData* t : p.tests) rows += static_cast<Eigen::Index>(t->time_s.size());
+void assign(MaterialModel& m, const Eigen::VectorXd& x) {
   const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
-  Eigen::MatrixXd A(rows, static_cast<Eigen::Index>(2 + L));
-  Eigen::Index r = 0;
-  for (std::size_t k = 0; k < p.tests.size(); ++k) {
-    const Eigen::MatrixXd Bk = basis(m, *p.tests[k]);
-    A.block(r, 0, Bk.rows(), Bk.cols()) = p.weight[k] * Bk;
-    r += Bk.rows();
-  }
-  const Eigen::VectorXd x = nonnegative_least_squares(A, p.b);
   m.modulus_pa = x(0);
   m.viscosity_pa_s = x(1);
   m.relaxation_modulus_pa.assign(L, 0.0);
   for (std::size_t l = 0; l < L; ++l) m.relaxation_modulus_pa[l] = x(static_cast<Eigen::Index>(2 + l));
+}
+
+Eigen::VectorXd coefficients_of(const MaterialModel& m) {
+  const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
+  Eigen::VectorXd x(static_cast<Eigen::Index>(2 + L));
+  x(0) = m.modulus_pa;
+  x(1) = m.viscosity_pa_s;
+  for (std::size_t l = 0; l < L; ++l) x(static_cast<Eigen::Index>(2 + l)) = m.relaxation_modulus_pa[l];
+  return x;
+}
+
+Eigen::MatrixXd linear_rows(const MaterialModel& m, const Problem& p) {
+  Eigen::Index rows = 0;
+  for (const TestData* t : p.linear) rows += static_cast<Eigen::Index>(t->time_s.size());
+  const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
+  Eigen::MatrixXd A(rows, static_cast<Eigen::Index>(2 + L));
+  Eigen::Index r = 0;
+  for (std::size_t k = 0; k < p.linear.size(); ++k) {
+    const Eigen::MatrixXd Bk = basis(m, *p.linear[k]);
+    A.block(r, 0, Bk.rows(), Bk.cols()) = p.linear_weight[k] * Bk;
+    r += Bk.rows();
+  }
+  return A;
+}
+
+// Solves the linear part for the given nonlinear parameters; returns the weighted SSE.
+double solve_linear(MaterialModel& m, const Problem& p) {
+  const Eigen::MatrixXd A = linear_rows(m, p);
+  const Eigen::VectorXd x = nonnegative_least_squares(A, p.b);
+  assign(m, x);
   return (A * x - p.b).squaredNorm();
+}
+
+// Weighted strain errors of the stress-controlled tests, in equivalent stress.
+Eigen::VectorXd creep_residual(const MaterialModel& m, const Problem& p) {
+  Eigen::Index rows = 0;
+  for (const TestData* t : p.creep) rows += static_cast<Eigen::Index>(t->time_s.size());
+  Eigen::VectorXd r(rows);
+  Eigen::Index i = 0;
+  for (std::size_t k = 0; k < p.creep.size(); ++k) {
+    const std::vector<double> e = predict_strain(m, *p.creep[k]);
+    for (std::size_t j = 0; j < e.size(); ++j) r(i++) = p.creep_weight[k] * (e[j] - p.creep[k]->strain[j]);
+  }
+  return r;
+}
+
+// Gauss-Newton on every test, the linear parameters kept non-negative: each step solves the
+// strain-controlled rows and the stress-controlled rows linearised (Jacobian by forward
+// differences) as one non-negative least-squares problem, then halves the step until the
+// residual falls.
+void refine_on_measured(MaterialModel& m, const Problem& p) {
+  const Eigen::MatrixXd A = linear_rows(m, p);
+  const auto cost = [&](const MaterialModel& x) {
+    const Eigen::VectorXd c = creep_residual(x, p);
+    return (A.rows() ? (A * coefficients_of(x) - p.b).squaredNorm() : 0.0) + c.squaredNorm();
+  };
+  double scale = 0.0;  // a modulus typical of the tests, for the difference steps
+  for (const TestData* t : p.creep) scale = std::max(scale, apparent_modulus_pa(*t));
+  double current = cost(m);
+  for (int it = 0; it < 20; ++it) {
+    const Eigen::VectorXd x = coefficients_of(m), r = creep_residual(m, p);
+    Eigen::MatrixXd J(r.size(), x.size());
+    for (Eigen::Index j = 0; j < x.size(); ++j) {
+      Eigen::VectorXd xs = x;
+      const double h = 1e-6 * std::max(std::abs(x(j)), j == 1 ? 1e-2 * scale : scale);
+      xs(j) += h;
+      MaterialModel ms = m;
+      assign(ms, xs);
+      J.col(j) = (creep_residual(ms, p) - r) / h;
+    }
+    Eigen::MatrixXd M(A.rows() + J.rows(), x.size());
+    Eigen::VectorXd rhs(M.rows());
+    M << A, J;
+    rhs << p.b, J * x - r;
+    const Eigen::VectorXd step = nonnegative_least_squares(M, rhs) - x;
+    bool improved = false;
+    for (double f = 1.0; f > 1e-3; f *= 0.5) {
+      MaterialModel trial = m;
+      assign(trial, (x + f * step).cwiseMax(0.0));
+      const double c = cost(trial);
+      if (c < current) {
+        improved = current - c > 1e-10 * current;
+        m = trial;
+        current = c;
+        break;
+      }
+    }
+    if (!improved) break;
+  }
 }
 
 struct Nonlinear {
@@ -117,14 +203,17 @@ void search(MaterialModel& m, const Problem& p, const Nonlinear& q) {
 }  // namespace
 
 MaterialModel fit_model(const MaterialModel& structure, const std::vector<const TestData*>& tests) {
-  Problem p{tests, {}, {}};
+  Problem p;
+  for (const TestData* t : tests) (t->control == Control::strain ? p.linear : p.creep).push_back(t);
+  const bool output_error = !p.creep.empty();
+  if (p.linear.empty()) std::swap(p.linear, p.creep);  // only stress control: equation error to start
   Eigen::Index rows = 0;
-  for (const TestData* t : tests) rows += static_cast<Eigen::Index>(t->time_s.size());
+  for (const TestData* t : p.linear) rows += static_cast<Eigen::Index>(t->time_s.size());
   p.b.resize(rows);
   Eigen::Index r = 0;
-  for (const TestData* t : tests) {
+  for (const TestData* t : p.linear) {
     const double w = 1.0 / std::sqrt(static_cast<double>(t->time_s.size()));
-    p.weight.push_back(w);
+    p.linear_weight.push_back(w);
     for (double s : t->stress_pa) p.b(r++) = w * s;
   }
   MaterialModel m = structure;
@@ -137,18 +226,32 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
   if (m.has(Mechanism::first_load_softening)) params.push_back({&m.softening_d, 0.0, 0.95, false});
   if (params.empty()) {
     solve_linear(m, p);
-    return m;
+  } else {
+    for (int round = 0; round < (params.size() > 1 ? 3 : 1); ++round)
+      for (const auto& q : params) search(m, p, q);
   }
-  for (int round = 0; round < (params.size() > 1 ? 3 : 1); ++round)
-    for (const auto& q : params) search(m, p, q);
+  if (output_error) {
+    if (p.creep.empty()) {  // the start came from the equation error: now fit what was measured
+      std::swap(p.linear, p.creep);
+      p.linear_weight.clear();
+      p.b.resize(0);
+    }
+    for (const TestData* t : p.creep) p.creep_weight.push_back(apparent_modulus_pa(*t) / std::sqrt(static_cast<double>(t->time_s.size())));
+    refine_on_measured(m, p);
+  }
   return m;
 }
 
-double rms_error_pa(const MaterialModel& m, const TestData& t) {
-  const auto y = predict_stress(m, t);
+double rms_error_measured(const MaterialModel& m, const TestData& t) {
+  const auto y = predict_measured(m, t);
+  const std::vector<double>& measured = t.control == Control::strain ? t.stress_pa : t.strain;
   double s = 0.0;
-  for (std::size_t k = 0; k < y.size(); ++k) s += (y[k] - t.stress_pa[k]) * (y[k] - t.stress_pa[k]);
+  for (std::size_t k = 0; k < y.size(); ++k) s += (y[k] - measured[k]) * (y[k] - measured[k]);
   return std::sqrt(s / static_cast<double>(y.size()));
+}
+
+double rms_error_pa(const MaterialModel& m, const TestData& t) {
+  return rms_error_measured(m, t) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t));
 }
 
 }  // namespace viscera::lab

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "viscera/lab/command_path.hpp"
 #include "viscera/tissue/viscoelastic/standard_linear_solids.hpp"
 
 namespace viscera::lab {
@@ -40,24 +41,42 @@ int MaterialModel::parameter_count() const {
   return n;
 }
 
+double ElasticShape::value(double e) const {
+  double v = e;
+  if (m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0) v = std::expm1(m.stiffening_b * e) / m.stiffening_b;
+  if (m.has(Mechanism::tension_compression_asymmetry) && e < 0) v *= m.compression_ratio;
+  if (m.has(Mechanism::first_load_softening)) {
+    const double peak = e >= 0 ? max_tension : max_compression, a = std::abs(e);
+    if (a < peak) v *= 1.0 - m.softening_d * (1.0 - a / peak);
+  }
+  return v;
+}
+
+void ElasticShape::advance(double e) {
+  if (e >= 0)
+    max_tension = std::max(max_tension, e);
+  else
+    max_compression = std::max(max_compression, -e);
+}
+
+double ElasticShape::strain_for(double s) const {
+  // value() is increasing in e for every mechanism (softening's factor keeps d < 1).
+  double lo = -1.0, hi = 1.0;
+  while (value(lo) > s && lo > -1e6) lo *= 2;
+  while (value(hi) < s && hi < 1e6) hi *= 2;
+  for (int it = 0; it < 80 && hi - lo > 1e-15 * (std::abs(lo) + std::abs(hi)); ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (value(mid) < s ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<double>& strain) {
   std::vector<double> s(strain.size());
-  double max_t = 0.0, max_c = 0.0;  // previous extremes in tension and compression
+  ElasticShape shape{m};
   for (std::size_t k = 0; k < strain.size(); ++k) {
-    const double e = strain[k];
-    double v = e;
-    if (m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0) v = std::expm1(m.stiffening_b * e) / m.stiffening_b;
-    if (m.has(Mechanism::tension_compression_asymmetry) && e < 0) v *= m.compression_ratio;
-    if (m.has(Mechanism::first_load_softening)) {
-      const double peak = e >= 0 ? max_t : max_c;
-      const double a = std::abs(e);
-      if (a < peak) v *= 1.0 - m.softening_d * (1.0 - a / peak);
-      if (e >= 0)
-        max_t = std::max(max_t, a);
-      else
-        max_c = std::max(max_c, a);
-    }
-    s[k] = v;
+    s[k] = shape.value(strain[k]);
+    shape.advance(strain[k]);
   }
   return s;
 }
@@ -66,21 +85,23 @@ Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t) {
   const auto n = static_cast<Eigen::Index>(t.time_s.size());
   const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
   Eigen::MatrixXd A(n, static_cast<Eigen::Index>(2 + L));
-  const std::vector<double> s = elastic_shape(m, t.strain);
+  const CommandPath path = command_path(t.time_s, t.strain);
+  const std::vector<double> s = elastic_shape(m, path.value);
   std::vector<double> h(L, 0.0);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const auto uk = static_cast<std::size_t>(k);
-    A(k, 0) = s[uk];
-    A(k, 1) = k == 0 ? 0.0 : (s[uk] - s[uk - 1]) / (t.time_s[uk] - t.time_s[uk - 1]);
-    for (std::size_t l = 0; l < L; ++l) {
-      if (k > 0) {
-        // Exact for s linear over the interval: h <- e h + (ds/dt) tau (1 - e).
-        const double dt = t.time_s[uk] - t.time_s[uk - 1], tau = m.relaxation_time_s[l];
+  std::size_t next = 0;  // the next sample's index
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    if (j > 0)
+      for (std::size_t l = 0; l < L; ++l) {
+        // Exact for s linear over the piece: h <- e h + (ds/dt) tau (1 - e).
+        const double dt = path.time_s[j] - path.time_s[j - 1], tau = m.relaxation_time_s[l];
         const tissue::MemoryStep step = tissue::MemoryStep::make(1.0 / tau, dt);
-        h[l] = step.e * h[l] + (s[uk] - s[uk - 1]) / dt * tau * step.a;
+        h[l] = step.e * h[l] + (s[j] - s[j - 1]) / dt * tau * step.a;
       }
-      A(k, static_cast<Eigen::Index>(2 + l)) = h[l];
-    }
+    if (path.sample[next] != j) continue;
+    const auto k = static_cast<Eigen::Index>(next++);
+    A(k, 0) = s[j];
+    A(k, 1) = j == 0 ? 0.0 : (s[j] - s[j - 1]) / (path.time_s[j] - path.time_s[j - 1]);
+    for (std::size_t l = 0; l < L; ++l) A(k, static_cast<Eigen::Index>(2 + l)) = h[l];
   }
   return A;
 }
@@ -99,30 +120,6 @@ Eigen::VectorXd coefficients(const MaterialModel& m) {
 std::vector<double> predict_stress(const MaterialModel& m, const TestData& t) {
   const Eigen::VectorXd y = basis(m, t) * coefficients(m);
   return {y.data(), y.data() + y.size()};
-}
-
-std::vector<double> predict_strain(const MaterialModel& m, const TestData& t) {
-  // Sample by sample: find eps_k with sigma_k(eps_k | history) = measured stress; sigma is
-  // increasing in eps_k, so bisection on a bracket is robust for every mechanism.
-  std::vector<double> eps;
-  TestData probe = t;
-  for (std::size_t k = 0; k < t.time_s.size(); ++k) {
-    probe.time_s.assign(t.time_s.begin(), t.time_s.begin() + static_cast<long>(k) + 1);
-    probe.stress_pa.assign(t.stress_pa.begin(), t.stress_pa.begin() + static_cast<long>(k) + 1);
-    probe.strain = eps;
-    probe.strain.push_back(0.0);
-    const auto stress_at = [&](double e) {
-      probe.strain.back() = e;
-      return predict_stress(m, probe).back();
-    };
-    double lo = -2.0, hi = 2.0;
-    for (int it = 0; it < 60; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (stress_at(mid) < t.stress_pa[k] ? lo : hi) = mid;
-    }
-    eps.push_back(0.5 * (lo + hi));
-  }
-  return eps;
 }
 
 std::vector<double> relaxation_times_for(const Dataset& d) {

@@ -5,7 +5,9 @@
 #include <functional>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/lab/command_path.hpp"
 #include "viscera/lab/golden_section.hpp"
+#include "viscera/lab/stress_controlled.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
@@ -31,16 +33,6 @@ bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
                 : "";
   return true;
 }
-
-namespace {
-double interpolate(const std::vector<double>& t, const std::vector<double>& v, double x) {
-  if (x <= t.front()) return v.front();
-  if (x >= t.back()) return v.back();
-  const auto it = std::upper_bound(t.begin(), t.end(), x);
-  const std::size_t k = static_cast<std::size_t>(it - t.begin());
-  return v[k - 1] + (v[k] - v[k - 1]) * (x - t[k - 1]) / (t[k] - t[k - 1]);
-}
-}  // namespace
 
 namespace {
 
@@ -214,14 +206,14 @@ GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCal
 
 /// The test's loading on the rig's moving face: its strain history prescribed on the moving
 /// nodes' x, or its stress history as a traction on the moving face (per pascal, scaled by the
-/// history). The returned conditions refer to `t`, which must outlive them.
-BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const TestData& t) {
+/// history), along its command path (command_path.hpp), which must outlive them.
+BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const TestData& t, const CommandPath& path) {
   BoundaryConditions bc = rig.bc;
   const bool shear = rig.shear;
-  const double t0 = t.time_s.front();
+  const double t0 = path.time_s.front();
   if (t.control == Control::strain) {
-    bc.prescribed_axes.push_back({rig.moving, 0, [&t, t0, shear](const Vec3& X, double time) {
-                                    const double e = interpolate(t.time_s, t.strain, time + t0);
+    bc.prescribed_axes.push_back({rig.moving, 0, [&path, t0, shear](const Vec3& X, double time) {
+                                    const double e = path.at(time + t0);
                                     return X.x() + e * (shear ? X.z() : X.x());
                                   }});
     return bc;
@@ -238,7 +230,7 @@ BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const Test
     const Vec3 &a = mesh.nodes[tri[0]], &b = mesh.nodes[tri[1]], &c = mesh.nodes[tri[2]];
     for (auto v : tri) bc.nodal_forces[v].x() += 0.5 * (b - a).cross(c - a).norm() / 3.0;  // per pascal
   }
-  bc.force_amplitude = [&t, t0](double time) { return interpolate(t.time_s, t.stress_pa, time + t0); };
+  bc.force_amplitude = [&path, t0](double time) { return path.at(time + t0); };
   return bc;
 }
 
@@ -275,10 +267,11 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
   double E_u = 0.0;
   const GpsOptions options = specimen_gps(m, d, calibration, &E_u, &r.shape);
   const GpsModel model(mesh, {specimen_elasticity(E_u, rig.shear)}, {}, options);
-  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), d.specimen.density_kg_m3), specimen_loading(rig, d, t),
+  const CommandPath path = command_path(t.time_s, t.control == Control::strain ? t.strain : t.stress_pa);
+  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), d.specimen.density_kg_m3), specimen_loading(rig, d, t, path),
                                 {1e-3, 0.0, 1e-8, 25});
   State s = State::at_rest(*mesh);
-  // The first sample is taken as an equilibrium state, as the material-point law does: grip (or
+  // The command path's start is taken as an equilibrium state, as the material-point law does: grip (or
   // load) at its first value, solved statically, memory variables fully relaxed there.
   integrator.solve_static(s);
   s.memory.assign(model.memory_size(), 0.0);
@@ -304,11 +297,14 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
     }
     return std::pair{reaction / rig.area, u / static_cast<double>(rig.moving.size()) / rig.gauge};
   };
-  const double t0 = t.time_s.front();
+  const double t0 = path.time_s.front(), equivalent = apparent_modulus_pa(t);  // strain error -> equivalent stress, as the law's
   double sq = 0.0;
-  for (std::size_t k = 0; k < t.time_s.size(); ++k) {
-    if (k > 0) advance_to(integrator, s, t.time_s[k] - t0, t.time_s[k] - t.time_s[k - 1], t.time_s.back() - t0, r);
-    const auto [stress, strain] = measure(k == 0);
+  // Point to point along the path, so that no step straddles one of its corners.
+  std::size_t k = 0;
+  for (std::size_t j = 0; j < path.time_s.size(); ++j) {
+    if (j > 0) advance_to(integrator, s, path.time_s[j] - t0, path.time_s[j] - path.time_s[j - 1], path.time_s.back() - t0, r);
+    if (path.sample[k] != j) continue;
+    const auto [stress, strain] = measure(r.steps == 0);
     if (t.control == Control::strain) {
       r.stress_pa.push_back(stress);
       r.strain.push_back(t.strain[k]);
@@ -316,8 +312,9 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
     } else {
       r.stress_pa.push_back(t.stress_pa[k]);
       r.strain.push_back(strain);
-      sq += (strain - t.strain[k]) * (strain - t.strain[k]) * E_u * E_u;
+      sq += (strain - t.strain[k]) * (strain - t.strain[k]) * equivalent * equivalent;
     }
+    ++k;
   }
   r.rms_pa = std::sqrt(sq / static_cast<double>(t.time_s.size()));
   return r;

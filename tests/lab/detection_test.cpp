@@ -7,6 +7,7 @@
 
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
+#include "viscera/lab/stress_controlled.hpp"
 
 #include "synthetic_data.hpp"
 
@@ -73,22 +74,38 @@ TEST(HiddenEffect, ContinuousPowerLawRelaxationOutsideTheFamilyIsNamedBroadband)
 
 TEST(Specimen, TetrahedralSpecimenAgreesWithTheMaterialPointLaw) {
   // Two code paths for the same model: the GPS on a meshed specimen (implicit, inertia, memory
-  // variables) and the lab's material-point recurrence: the RMS errors against the data agree.
+  // variables) and the lab's material-point law, each run along the test's command path: their
+  // histories of the measured quantity (stress under strain control, strain under stress control)
+  // agree, as a relative RMS difference.
   for (unsigned seed : {1u, 5u, 7u}) {  // broadband; baseline; strain stiffening, uniaxial (energy form, calibrated B)
     const std::string folder = std::string(VISCERA_TEST_TMP) + "/specimen_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
     test::write_synthetic_dataset(seed, folder);
-    const Analysis a = analyze(read_dataset(folder));
+    const Dataset d = read_dataset(folder);
+    const Analysis a = analyze(d);
     ASSERT_FALSE(a.specimen.empty());
-    for (const auto& c : a.specimen) {
-      ASSERT_TRUE(c.ran) << c.note;
-      for (std::size_t k = 0; k < c.files.size(); ++k) {
-        std::cout << "[ figure ] seed " << seed << " " << c.model << " " << c.files[k] << ": specimen RMS " << c.specimen_rms_pa[k]
-                  << " Pa, material-point law " << c.law_rms_pa[k] << " Pa\n";
-        // Creep: the law's Kelvin-Voigt rate is a backward difference on the data grid (first order),
-        // the specimen integrates with fine adaptive steps, so they differ by that discretisation.
-        const double tolerance = c.files[k] == "creep.csv" ? 0.25 : 0.03;
-        EXPECT_NEAR(c.specimen_rms_pa[k] / c.law_rms_pa[k], 1.0, tolerance) << c.files[k];
+    for (const auto& c : a.specimen) ASSERT_TRUE(c.ran) << c.note;
+    std::vector<MaterialModel> models{a.baseline.model};
+    if (!a.causes.empty()) models.push_back(a.final.model);
+    for (const MaterialModel& m : models) {
+      const ShapeCalibration calibration = calibrate_elastic_shape(m, d);
+      for (const auto& t : d.tests) {
+        const SpecimenResult r = simulate_specimen(m, d, t, &calibration);
+        const bool creep = t.control == Control::stress;
+        const std::vector<double> law = predict_measured(m, t), specimen = creep ? r.strain : r.stress_pa;
+        double diff = 0.0, norm = 0.0;
+        for (std::size_t k = 0; k < law.size(); ++k) {
+          diff += (specimen[k] - law[k]) * (specimen[k] - law[k]);
+          norm += law[k] * law[k];
+        }
+        const double relative = std::sqrt(diff / norm);
+        std::cout << "[ figure ] seed " << seed << " " << m.describe() << " " << t.file << ": specimen against the law, RMS difference "
+                  << 100 * relative << "% of the law's RMS " << (creep ? "strain" : "stress") << "\n";
+        // Linear models agree to 0.1% (both are exact along the path but for the specimen's time
+        // steps); a shaped model's specimen constant is calibrated on static curves (2-4% apart
+        // in time); creep on the specimen is backward Euler through the strain's transients (1-3%).
+        const bool shaped = m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry);
+        EXPECT_LT(relative, creep || shaped ? 0.05 : 0.005) << t.file;
       }
     }
   }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/lab/fit.hpp"
+#include "viscera/lab/stress_controlled.hpp"
 #include "viscera/plot/svg_plot.hpp"
 
 #include "model_file.hpp"
@@ -24,8 +25,15 @@ json figures(const ModelEvaluation& e) {
   j["heldout_rms_pa"] = e.heldout_rms_pa;
   j["parameters"] = e.model.parameter_count();
   j["tests"] = json::array();
-  for (const auto& t : e.tests)
-    j["tests"].push_back({{"file", t.file}, {"fit_rms_pa", t.fit_rms_pa}, {"heldout_rms_pa", t.heldout_rms_pa}, {"noise_pa", t.noise_pa}});
+  for (const auto& t : e.tests) {
+    json jt{{"file", t.file}, {"fit_rms_pa", t.fit_rms_pa}, {"heldout_rms_pa", t.heldout_rms_pa}, {"noise_pa", t.noise_pa}};
+    if (t.noise_strain > 0 || t.heldout_rms_strain > 0) {  // stress-controlled: the measured quantity is the strain
+      jt["fit_rms_strain"] = t.fit_rms_strain;
+      jt["heldout_rms_strain"] = t.heldout_rms_strain;
+      jt["noise_strain"] = t.noise_strain;
+    }
+    j["tests"].push_back(jt);
+  }
   return j;
 }
 
@@ -68,7 +76,9 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
 
   std::ofstream md(fs::path(out_dir) / "report.md");
   md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
-  md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences): " << a.noise_pa << " Pa. "
+  md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences; for a stress-controlled test that of its strain, as "
+        "an equivalent stress): "
+     << a.noise_pa << " Pa. "
      << "Analysis time: " << seconds << " s.\n\n";
   for (const auto& line : a.decimated) md << "Decimated for the fit and the plots: " << line << ".\n\n";
   md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out "
@@ -78,7 +88,14 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
        << a.baseline.tests[k].heldout_rms_pa << " | " << a.final.tests[k].fit_rms_pa << " | " << a.final.tests[k].heldout_rms_pa << " |\n";
   md << "| **all (RMS over tests)** | " << a.noise_pa << " | " << a.baseline.fit_rms_pa << " | " << a.baseline.heldout_rms_pa << " | "
      << a.final.fit_rms_pa << " | " << a.final.heldout_rms_pa << " |\n\n";
-  md << "Held-out: the model is fitted to the other tests only and predicts this one.\n\n";
+  md << "Held-out: the model is fitted to the other tests only and predicts this one. A stress-controlled test is simulated "
+        "under its measured stress and judged on the strain it measured; its figures here are the strain errors times its apparent "
+        "modulus (largest stress over largest strain), an equivalent stress:\n\n";
+  for (std::size_t k = 0; k < a.baseline.tests.size(); ++k)
+    if (d.tests[k].control == Control::stress)
+      md << "- " << a.baseline.tests[k].file << " in strain: noise " << a.baseline.tests[k].noise_strain << ", baseline held-out "
+         << a.baseline.tests[k].heldout_rms_strain << ", final held-out " << a.final.tests[k].heldout_rms_strain << "\n";
+  md << "\n";
   md << "## Candidate mechanisms\n\n| round | mechanism | held-out RMS before | after | accepted | evidence in the residuals "
         "|\n|---|---|---|---|---|---|\n";
   for (const auto& c : a.candidates)
@@ -88,7 +105,7 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
         "held-out RMS by at least 5%; rounds add the best accepted mechanism and try the rest on top.\n\n";
   md << "## On the tetrahedral specimen\n\nEach model also runs on the specimen meshed with tetrahedra (viscera's GPS with memory "
         "variables, backward Euler with adaptive steps, inertia from the specimen's density), driven by the measured history. "
-        "For stress-controlled tests both columns are the strain error times the unrelaxed modulus.\n\n";
+        "For stress-controlled tests both columns are the strain error times the test's apparent modulus.\n\n";
   for (const auto& c : a.specimen) {
     md << "- `" << c.model << "`: ";
     if (!c.ran) {
@@ -106,11 +123,15 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   md << "## Data, baseline and final model\n\n";
   for (std::size_t k = 0; k < d.tests.size(); ++k) {
     const TestData& t = d.tests[k];
-    const auto yb = predict_stress(a.baseline.model, t), yf = predict_stress(a.final.model, t);
+    // What the test measured: stress under strain control, strain under stress control.
+    const bool strain_measured = t.control == Control::stress;
+    const std::vector<double>& data = strain_measured ? t.strain : t.stress_pa;
+    const std::string quantity = strain_measured ? "strain" : "stress", unit = strain_measured ? "strain [-]" : "stress [Pa]";
+    const auto yb = predict_measured(a.baseline.model, t), yf = predict_measured(a.final.model, t);
     std::vector<double> rb, rf;
     for (std::size_t i = 0; i < yb.size(); ++i) {
-      rb.push_back(t.stress_pa[i] - yb[i]);
-      rf.push_back(t.stress_pa[i] - yf[i]);
+      rb.push_back(data[i] - yb[i]);
+      rf.push_back(data[i] - yf[i]);
     }
     const std::string name_fit = stem(t.file) + "_fit.svg", name_res = stem(t.file) + "_residual.svg";
     // Time since the first sample (plus one sampling interval), on a log axis: ramps and holds
@@ -118,17 +139,17 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
     std::vector<double> since;
     const double offset = t.time_s[1] - t.time_s[0];
     for (double x : t.time_s) since.push_back(x - t.time_s[0] + offset);
-    plot::Figure fit{t.file + ": stress, data and models (fitted to all tests)",
+    plot::Figure fit{t.file + ": " + quantity + ", data and models (fitted to all tests)",
                      "time since the first sample [s] (log)",
-                     "stress [Pa]",
-                     {{"data", since, t.stress_pa, "#000000", "", 2.0},
+                     unit,
+                     {{"data", since, data, "#000000", "", 2.0},
                       {"baseline (" + std::to_string(a.baseline.model.parameter_count()) + " parameters)", since, yb, "#1f77b4", "8 4", 1.6},
                       {"final (" + std::to_string(a.final.model.parameter_count()) + " parameters)", since, yf, "#d62728", "", 1.6}}};
     fit.log_x = true;
     plot::write_svg((fs::path(out_dir) / name_fit).string(), fit);
     plot::Figure res{t.file + ": residual (data - model)",
                      "time since the first sample [s] (log)",
-                     "residual [Pa]",
+                     "residual, " + unit,
                      {{"baseline", since, rb, "#1f77b4", "8 4", 1.6}, {"final", since, rf, "#d62728", "", 1.6}}};
     res.log_x = true;
     plot::write_svg((fs::path(out_dir) / name_res).string(), res);
@@ -148,7 +169,9 @@ void write_prediction(const MaterialModel& m, const std::string& model_path, con
   for (const auto& t : d.tests) {
     const double r = rms_error_pa(m, t);
     s += r * r;
-    j["tests"].push_back({{"file", t.file}, {"rms_pa", r}});
+    json jt{{"file", t.file}, {"rms_pa", r}};
+    if (t.control == Control::stress) jt["rms_strain"] = rms_error_measured(m, t);
+    j["tests"].push_back(jt);
   }
   j["rms_pa"] = std::sqrt(s / static_cast<double>(d.tests.size()));
   std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";

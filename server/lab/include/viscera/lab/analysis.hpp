@@ -16,6 +16,9 @@ struct TestFigures {
   double fit_rms_pa = 0.0;  ///< model fitted to all tests
   double heldout_rms_pa = 0.0;  ///< model fitted to the other tests (leave one test out)
   double noise_pa = 0.0;
+  /// Stress-controlled tests: the same in the measured quantity, strain (the _pa figures are these
+  /// times the test's apparent modulus, an equivalent stress so that tests compare).
+  double fit_rms_strain = 0.0, heldout_rms_strain = 0.0, noise_strain = 0.0;
 };
 
 struct ModelEvaluation {
@@ -61,7 +64,11 @@ struct Analysis {
   std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen
 };
 
-/// Noise of one test [Pa]: RMS of stress_sd_pa if given, else from second differences (MAD).
+/// Noise of what a test measured: under strain control the stress [Pa], the RMS of stress_sd_pa
+/// if given, else from the second differences of the stress (median absolute value); under stress
+/// control the strain, from its second differences.
+double noise_level_measured(const TestData& t);
+/// The same in pascals (strain noise times the apparent modulus under stress control).
 double noise_level_pa(const TestData& t);
 
 /// Fits `structure` to all tests and, for every test, to the others (held-out prediction).

@@ -14,11 +14,18 @@ namespace viscera::lab {
 Eigen::VectorXd nonnegative_least_squares(const Eigen::MatrixXd& A, const Eigen::VectorXd& b);
 
 /// Fits `structure` (mechanisms and relaxation times set; parameters ignored) to the tests.
-/// Each test weighs equally (rows scaled by 1/sqrt(rows)). Stress-controlled tests enter through
-/// the stress predicted from their measured strain.
+/// Each test weighs equally (rows scaled by 1/sqrt(rows)). Strain-controlled tests are fitted on
+/// their stress; stress-controlled tests on their strain, simulated under the measured stress
+/// (stress_controlled.hpp), in equivalent stress (strain error x apparent modulus). The nonlinear
+/// parameters are searched on the strain-controlled tests; a last Gauss-Newton refinement of the
+/// moduli and viscosities takes every test.
 MaterialModel fit_model(const MaterialModel& structure, const std::vector<const TestData*>& tests);
 
-/// RMS of measured minus predicted stress over one test [Pa].
+/// RMS error of one test in what it measured: stress [Pa] under strain control, strain under
+/// stress control.
+double rms_error_measured(const MaterialModel& m, const TestData& t);
+
+/// The same in pascals: strain errors times the test's apparent modulus under stress control.
 double rms_error_pa(const MaterialModel& m, const TestData& t);
 
 }  // namespace viscera::lab

@@ -45,17 +45,27 @@ struct MaterialModel {
   int parameter_count() const;
 };
 
-/// Elastic shape s at every sample of a strain history (first-load softening needs the history).
+/// The elastic shape s(eps) of a model along one history (first-load softening remembers the
+/// largest strain seen in tension and in compression).
+struct ElasticShape {
+  const MaterialModel& m;
+  double max_tension = 0.0, max_compression = 0.0;
+  double value(double eps) const;
+  /// The strain whose shape is s, with the history so far (s is increasing in eps).
+  double strain_for(double s) const;
+  /// Records eps in the history.
+  void advance(double eps);
+};
+
+/// Elastic shape s at every sample of a strain history.
 std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<double>& strain);
 
-/// Columns of the linear model at the samples: s, ds/dt (backward difference), h_l for each tau_l.
+/// Columns of the linear model at the samples: s, ds/dt, h_l for each tau_l, along the strain's
+/// command path (command_path.hpp).
 Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t);
 
 /// Stress from the measured strain (the equation the fit minimises, for any control).
 std::vector<double> predict_stress(const MaterialModel& m, const TestData& t);
-
-/// Strain under the measured stress (stress-controlled tests): the law solved sample by sample.
-std::vector<double> predict_strain(const MaterialModel& m, const TestData& t);
 
 /// Log-spaced relaxation times, one per decade, covering the sampling intervals and durations.
 std::vector<double> relaxation_times_for(const Dataset& d);
