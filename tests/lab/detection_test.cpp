@@ -21,7 +21,7 @@ TEST(HiddenEffect, NamedCorrectlyIn95PercentOf40SeedsWithGainAboveNoise) {
     const std::string folder = root + "/seed_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
     const test::Truth truth = test::write_synthetic_dataset(seed, folder);
-    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false});  // the lab sees only the folder
+    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});  // the lab sees only the folder
     const std::string expected = test::effect_name(truth.effect);
     std::string found = a.causes.empty() ? "none" : name(a.causes.front());
     const bool ok = (truth.effect == test::Effect::none) ? a.causes.empty() : (a.causes.size() == 1 && found == expected);
@@ -56,7 +56,7 @@ TEST(HiddenEffect, ContinuousPowerLawRelaxationOutsideTheFamilyIsNamedBroadband)
     const std::string folder = root + "/seed_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
     const test::Truth truth = test::write_power_law_dataset(seed, folder);
-    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false});
+    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});
     const bool ok = a.causes.size() == 1 && a.causes.front() == Mechanism::broadband_relaxation;
     correct += ok;
     std::cout << "[ power-law seed " << seed << " ] alpha " << truth.power_alpha << ", tau0 " << truth.power_tau0_s << " s: found";

@@ -64,6 +64,9 @@ int main(int argc, char** argv) {
       for (Mechanism m : a.causes) std::printf(" %s", name(m));
       std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
                   a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
+      if (!a.nested.empty())
+        std::printf("honest gain (nested leave-one-out: mechanisms chosen without the test predicted): %.3gx, held-out RMS %.4g Pa\n", a.nested_gain,
+                    a.nested_heldout_rms_pa);
       return 0;
     }
     if (positional[0] == "predict") {
