@@ -227,8 +227,29 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
   if (params.empty()) {
     solve_linear(m, p);
   } else {
-    for (int round = 0; round < (params.size() > 1 ? 3 : 1); ++round)
-      for (const auto& q : params) search(m, p, q);
+    // Stiffening's form is a discrete parameter: the search runs for each allowed form and the
+    // best fit is kept.
+    std::vector<StiffeningForm> forms{m.stiffening_form};
+    if (m.has(Mechanism::strain_stiffening)) {
+      forms = {StiffeningForm::odd_exponential, StiffeningForm::odd_polynomial};
+      if (!m.odd_only) forms.insert(forms.begin(), StiffeningForm::exponential);
+    }
+    MaterialModel best;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (StiffeningForm form : forms) {
+      m.stiffening_form = form;
+      m.stiffening_b = 0.0;
+      m.compression_ratio = 1.0;
+      m.softening_d = 0.0;
+      for (int round = 0; round < (params.size() > 1 ? 3 : 1); ++round)
+        for (const auto& q : params) search(m, p, q);
+      const double cost = solve_linear(m, p);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = m;
+      }
+    }
+    m = best;
   }
   if (output_error) {
     if (p.creep.empty()) {  // the start came from the equation error: now fit what was measured

@@ -27,6 +27,24 @@ bool parse_mechanism(const std::string& s, Mechanism* out) {
   return false;
 }
 
+const char* name(StiffeningForm f) {
+  switch (f) {
+    case StiffeningForm::exponential: return "exponential";
+    case StiffeningForm::odd_exponential: return "odd_exponential";
+    case StiffeningForm::odd_polynomial: return "odd_polynomial";
+  }
+  return "?";
+}
+
+bool parse_stiffening_form(const std::string& s, StiffeningForm* out) {
+  for (StiffeningForm f : {StiffeningForm::exponential, StiffeningForm::odd_exponential, StiffeningForm::odd_polynomial})
+    if (s == name(f)) {
+      *out = f;
+      return true;
+    }
+  return false;
+}
+
 std::string MaterialModel::describe() const {
   std::string s = "kelvin_voigt_linear";
   for (Mechanism m : kMechanisms)
@@ -43,7 +61,14 @@ int MaterialModel::parameter_count() const {
 
 double ElasticShape::value(double e) const {
   double v = e;
-  if (m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0) v = std::expm1(m.stiffening_b * e) / m.stiffening_b;
+  if (m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0) {
+    const double B = m.stiffening_b;
+    switch (m.stiffening_form) {
+      case StiffeningForm::exponential: v = std::expm1(B * e) / B; break;
+      case StiffeningForm::odd_exponential: v = std::copysign(std::expm1(B * std::abs(e)) / B, e); break;
+      case StiffeningForm::odd_polynomial: v = e * (1 + B * B * e * e / 6); break;
+    }
+  }
   if (m.has(Mechanism::tension_compression_asymmetry) && e < 0) v *= m.compression_ratio;
   if (m.has(Mechanism::first_load_softening)) {
     const double peak = e >= 0 ? max_tension : max_compression, a = std::abs(e);

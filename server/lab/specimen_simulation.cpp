@@ -21,20 +21,31 @@ using namespace viscera::tissue;
 
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
   const bool shaped = m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry);
-  if (shaped && mode == Mode::simple_shear) {
+  const bool even_part =
+      m.has(Mechanism::tension_compression_asymmetry) || (m.has(Mechanism::strain_stiffening) && m.stiffening_form == StiffeningForm::exponential);
+  if (even_part && mode == Mode::simple_shear) {
     *why =
         "the law's elastic shape differs between positive and negative shear (exp(B gamma), or a compression ratio); an "
         "isotropic solid's shear stress is odd in the shear strain (mirror symmetry), so the GPS cannot represent it: "
         "not simulated on the specimen";
     return false;
   }
-  *why = shaped ? "the elastic shape (Fung stiffening, tension/compression asymmetry) in the GPS's energy form, its constants "
+  *why = shaped ? "the elastic shape (stiffening, tension/compression asymmetry) in the GPS's energy form, its constants "
                   "calibrated to the law's curve over the data's strain range"
                 : "";
   return true;
 }
 
 namespace {
+
+StiffeningShape gps_shape(StiffeningForm f) {
+  switch (f) {
+    case StiffeningForm::exponential: return StiffeningShape::exponential;
+    case StiffeningForm::odd_exponential: return StiffeningShape::odd_exponential;
+    case StiffeningForm::odd_polynomial: return StiffeningShape::odd_polynomial;
+  }
+  return StiffeningShape::exponential;
+}
 
 /// The specimen meshed with tetrahedra and the grips of its mode (x: pulling / shearing
 /// direction; z: thickness); `moving` are the nodes the loading acts on.
@@ -89,11 +100,11 @@ Mat6 specimen_elasticity(double modulus_pa, bool shear) {
 }
 
 /// The specimen's instantaneous elastic stress at each strain (static solves in order, each from
-/// the last), with the GPS's energy map of Fung's b and the compression ratio r.
-std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, double r, const std::vector<double>& strains) {
+/// the last), with the GPS's energy map of the stiffening shape with b and the compression ratio r.
+std::vector<double> static_curve(const Rig& rig, double modulus_pa, StiffeningShape shape, double b, double r, const std::vector<double>& strains) {
   GpsOptions options;
   options.variant = GpsVariant::energy_consistent;
-  options.mechanisms.stiffening = {b, GpsStiffening::Form::energy};
+  options.mechanisms.stiffening = {b, GpsStiffening::Form::energy, shape};
   options.mechanisms.asymmetry.compression_ratio = r;
   const GpsModel model(rig.mesh, {specimen_elasticity(modulus_pa, rig.shear)}, {}, options);
   double strain = 0.0;
@@ -102,10 +113,28 @@ std::vector<double> static_curve(const Rig& rig, double modulus_pa, double b, do
   ImplicitIntegrator integrator(model, std::vector<double>(rig.mesh->tet_count(), 1000.0), bc, {1e-3, 0.0, 1e-8, 50});
   State s = State::at_rest(*rig.mesh);
   std::vector<double> stress;
+  // Static solve at strain `to` from the converged state at `strain`; where Newton does not
+  // converge (strong stiffening far from the last state), reach it through the midpoint first.
+  const std::function<void(double, int)> solve_at = [&](double to, int depth) {
+    const State before = s;
+    const double from = strain;
+    strain = to;
+    try {
+      integrator.solve_static(s);
+    } catch (const SimulationError&) {
+      if (depth >= 10) throw;
+      s = before;
+      strain = from;
+      solve_at(0.5 * (from + to), depth + 1);
+      solve_at(to, depth + 1);
+    }
+  };
   for (const double e : strains) {
-    if (e * strain < 0) s = State::at_rest(*rig.mesh);  // the other side of rest: start again from it
-    strain = e;
-    integrator.solve_static(s);
+    if (e * strain < 0) {  // the other side of rest: start again from it
+      s = State::at_rest(*rig.mesh);
+      strain = 0.0;
+    }
+    solve_at(e, 0);
     double reaction = 0.0;
     for (auto i : rig.moving) reaction -= integrator.last_internal_forces()[i].x();
     stress.push_back(reaction / rig.area);
@@ -136,13 +165,11 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   }
   const Rig rig = make_rig(d);
   const double E = 1e4;  // the shape is what is calibrated (the stress scales with the modulus)
-  const auto law = [&](double e) {
-    const double g = stiffens ? std::expm1(c.law_b * e) / c.law_b : e;
-    return E * (e < 0 ? c.law_r * g : g);
-  };
+  const auto law = [&](double e) { return E * ElasticShape{m}.value(e); };  // the virgin curve
+  const StiffeningShape shape = gps_shape(m.stiffening_form);
   const auto mismatch = [&](double b, double r, const std::vector<double>& strains) {
     if (strains.empty()) return 0.0;
-    const auto curve = static_curve(rig, E, b, r, strains);
+    const auto curve = static_curve(rig, E, shape, b, r, strains);
     double sq = 0.0, norm = 0.0;
     for (std::size_t k = 0; k < strains.size(); ++k) {
       sq += (curve[k] - law(strains[k])) * (curve[k] - law(strains[k]));
@@ -158,7 +185,8 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   // stretched specimen are compressed (and those of a compressed one stretched).
   for (int round = 0; round < 2; ++round) {
     if (stiffens && !tension.empty())
-      c.gps_b = golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, 1.5 * c.law_b, 1e-4 * c.law_b).x;
+      c.gps_b =
+          golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, (rig.shear ? 4.0 : 1.5) * c.law_b, 1e-4 * c.law_b).x;
     if (asymmetric && !compression.empty())
       c.gps_r = std::exp(
           golden_section([&](double lr) { return mismatch(c.gps_b, std::exp(lr), compression); }, std::log(c.law_r / 4), std::log(c.law_r * 4), 1e-4)
@@ -194,7 +222,7 @@ GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCal
   if (m.has(Mechanism::first_load_softening)) ve.softening.d = m.softening_d;
   if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
     *shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
-    ve.stiffening = {shape->gps_b, GpsStiffening::Form::energy};
+    ve.stiffening = {shape->gps_b, GpsStiffening::Form::energy, gps_shape(m.stiffening_form)};
     ve.asymmetry.compression_ratio = shape->gps_r;
   }
   GpsOptions options;

@@ -20,7 +20,7 @@ TEST(BaselineFamily, KelvinVoigtTruthsArePredictedWithinTheNoiseOnEveryHeldOutTe
   for (unsigned seed = 1; seed <= 100; ++seed) {
     const std::string folder = root + "/seed_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
-    const test::KelvinVoigtTruth truth = test::write_kelvin_voigt_lab_dataset(seed, folder);
+    const test::LabDatasetTruth truth = test::write_kelvin_voigt_lab_dataset(seed, folder);
     const Dataset d = read_dataset(folder);
     MaterialModel structure;
     const ModelEvaluation ev = evaluate(structure, d);

@@ -7,6 +7,38 @@
 
 namespace viscera::lab::test {
 
+const char* name(LabTruth t) {
+  switch (t) {
+    case LabTruth::none: return "none";
+    case LabTruth::exponential_stiffening: return "exponential_stiffening";
+    case LabTruth::polynomial_stiffening: return "polynomial_stiffening";
+    case LabTruth::asymmetry: return "asymmetry";
+    case LabTruth::softening: return "softening";
+    case LabTruth::recovering_softening: return "recovering_softening";
+    case LabTruth::broadband: return "broadband";
+    case LabTruth::power_law: return "power_law";
+    case LabTruth::broadband_and_stiffening: return "broadband_and_stiffening";
+  }
+  return "?";
+}
+
+std::vector<std::string> expected_causes(LabTruth t) {
+  switch (t) {
+    case LabTruth::none: return {};
+    case LabTruth::exponential_stiffening:
+    case LabTruth::polynomial_stiffening: return {"strain_stiffening"};
+    case LabTruth::asymmetry: return {"tension_compression_asymmetry"};
+    case LabTruth::softening:
+    case LabTruth::recovering_softening: return {"first_load_softening"};
+    case LabTruth::broadband:
+    case LabTruth::power_law: return {"broadband_relaxation"};
+    case LabTruth::broadband_and_stiffening: return {"broadband_relaxation", "strain_stiffening"};
+  }
+  return {};
+}
+
+bool out_of_family(LabTruth t) { return t == LabTruth::polynomial_stiffening || t == LabTruth::recovering_softening || t == LabTruth::power_law; }
+
 namespace {
 
 // A piecewise-linear command: knots (t, v), constant after the last knot.
@@ -44,8 +76,7 @@ std::vector<double> sample_times(const Command& c, std::mt19937_64& rng) {
     const std::size_t p = c.piece(next);
     if (p != last_piece) {  // crossed a knot: restart dense just after it
       const double knot = c.t[std::min(p, c.t.size()) - 1];
-      next = std::max(next, knot + 0.2e-3);
-      next = std::min(next, knot + 1e-3);
+      next = std::clamp(next, knot + 0.2e-3, knot + 1e-3);
       dt = 1e-3;
       last_piece = c.piece(next);
     }
@@ -74,22 +105,143 @@ Command growing_cycles(double amplitude, double period_s) {
   return c;
 }
 
+// The truth's elastic law with its history (the largest |strain| seen on each side).
+struct Elastic {
+  const LabDatasetTruth& tr;
+  double peak_tension = 0, peak_compression = 0;
+  double value(double e) const {
+    const double E = tr.modulus_pa, B = tr.stiffening_b;
+    switch (tr.truth) {
+      case LabTruth::exponential_stiffening:
+      case LabTruth::broadband_and_stiffening:
+        if (tr.mode == Mode::simple_shear) return (e < 0 ? -1.0 : 1.0) * E / B * std::expm1(B * std::abs(e));
+        return E / B * std::expm1(B * e);
+      case LabTruth::polynomial_stiffening: return E * e * (1 + B * B * e * e / 6);
+      case LabTruth::asymmetry: return e < 0 ? tr.compression_ratio * E * e : E * e;
+      case LabTruth::softening:
+      case LabTruth::recovering_softening: {
+        const double m = e >= 0 ? peak_tension : peak_compression;
+        return std::abs(e) < m ? E * e * (1 - tr.softening_d * (1 - std::abs(e) / m)) : E * e;
+      }
+      default: return E * e;
+    }
+  }
+  double slope(double e) const { return (value(e + 1e-8) - value(e - 1e-8)) / 2e-8; }
+  // Moves the history over a time step h at strain e (recovery only for recovering softening).
+  void advance(double e, double h) {
+    double& m = e >= 0 ? peak_tension : peak_compression;
+    m = std::max(m, std::abs(e));
+    if (tr.truth == LabTruth::recovering_softening && tr.recovery_s > 0) {
+      // Each side's memory relaxes towards the strain now on that side (0 on the other side).
+      const double decay = std::exp(-h / tr.recovery_s), on_tension = std::max(e, 0.0), on_compression = std::max(-e, 0.0);
+      peak_tension = on_tension + (peak_tension - on_tension) * decay;
+      peak_compression = on_compression + (peak_compression - on_compression) * decay;
+    }
+  }
+};
+
+// Stress at the sample times under strain control.
+std::vector<double> stress_under_strain(const LabDatasetTruth& tr, const Command& c, const std::vector<double>& times) {
+  std::vector<double> out;
+  Elastic f{tr};
+  double walked = 0.0;
+  for (double t : times) {
+    // The history, walked finely up to t.
+    const double h = std::max((t - walked) / 50, 1e-6);
+    for (double u = walked + h; u < t; u += h) f.advance(c.at(u), h);
+    walked = t;
+    double sigma = f.value(c.at(t)) + tr.viscosity_pa_s * c.slope(c.piece(t));
+    f.advance(c.at(t), 0.0);
+    // Hereditary relaxation on the strain, each linear piece in closed form.
+    for (std::size_t k = 1; k < c.t.size() && c.t[k - 1] < t; ++k) {
+      const double a = c.t[k - 1], b = std::min(c.t[k], t), slope = c.slope(k);
+      for (int l = 0; l < 2; ++l) {
+        const double tau = tr.spectrum_tau_s[l];
+        if (tr.spectrum_pa[l] > 0) sigma += tr.spectrum_pa[l] * slope * tau * (std::exp(-(t - b) / tau) - std::exp(-(t - a) / tau));
+      }
+      if (tr.power_pa > 0) {
+        const double tau0 = tr.power_tau0_s, q = 1.0 - tr.power_alpha;
+        sigma += tr.power_pa * slope * tau0 / q * (std::pow(1 + (t - a) / tau0, q) - std::pow(1 + (t - b) / tau0, q));
+      }
+    }
+    out.push_back(sigma);
+  }
+  return out;
+}
+
+// Strain at the sample times under stress control: backward Euler at `substeps` per sample
+// interval, Newton on the strain each step; relaxation terms h_l exact for a linear strain step.
+std::vector<double> strain_under_stress(const LabDatasetTruth& tr, const Command& c, const std::vector<double>& times, int substeps) {
+  Elastic f{tr};
+  double e = 0.0, t = 0.0, hl[2] = {0, 0};
+  std::vector<double> out;
+  for (double target : times) {
+    const double h = (target - t) / substeps;
+    for (int s = 0; s < substeps && h > 0; ++s) {
+      const double sigma = c.at(t + h);
+      double decay[2], gain[2];
+      for (int l = 0; l < 2; ++l) {
+        decay[l] = std::exp(-h / tr.spectrum_tau_s[l]);
+        gain[l] = tr.spectrum_tau_s[l] * (1 - decay[l]) / h;
+      }
+      double x = e;
+      for (int it = 0; it < 50; ++it) {
+        double r = tr.viscosity_pa_s * (x - e) / h + f.value(x) - sigma, dr = tr.viscosity_pa_s / h + f.slope(x);
+        for (int l = 0; l < 2; ++l) {
+          r += tr.spectrum_pa[l] * (decay[l] * hl[l] + (x - e) * gain[l]);
+          dr += tr.spectrum_pa[l] * gain[l];
+        }
+        const double dx = r / dr;
+        x -= dx;
+        if (std::abs(dx) < 1e-15) break;
+      }
+      for (int l = 0; l < 2; ++l) hl[l] = decay[l] * hl[l] + (x - e) * gain[l];
+      e = x;
+      t += h;
+      f.advance(e, h);
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
 }  // namespace
 
-KelvinVoigtTruth write_kelvin_voigt_lab_dataset(unsigned seed, const std::string& folder) {
-  std::mt19937_64 rng(0x5eed0000ull + seed);
+LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, const std::string& folder) {
+  std::mt19937_64 rng(0x5eed0000ull + seed * 131ull + static_cast<unsigned>(truth) * 1000003ull + static_cast<unsigned long long>(size * 1000));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto between = [&](double a, double b) { return a + (b - a) * u(rng); };
   const auto log_between = [&](double a, double b) { return std::exp(between(std::log(a), std::log(b))); };
-  KelvinVoigtTruth tr;
+  LabDatasetTruth tr;
+  tr.truth = truth;
+  tr.size = size;
   tr.modulus_pa = log_between(1e3, 100e3);
-  const double tau = log_between(0.005, 0.05);
-  tr.viscosity_pa_s = tr.modulus_pa * tau;
+  tr.viscosity_pa_s = tr.modulus_pa * log_between(0.005, 0.05);
+  // Simple shear in every other seed, but not for asymmetry: an isotropic solid's shear stress is
+  // odd in the shear strain, so tension/compression asymmetry exists only under uniaxial load.
+  tr.mode = seed % 2 || truth == LabTruth::asymmetry ? Mode::uniaxial : Mode::simple_shear;
+  tr.noise_column = seed % 3 != 0;
   const double strain = between(0.05, 0.2);
+  const bool stiffening = truth == LabTruth::exponential_stiffening || truth == LabTruth::broadband_and_stiffening;
+  if (stiffening) tr.stiffening_b = between(1.5, 5.0) / strain * size;
+  if (truth == LabTruth::polynomial_stiffening) tr.stiffening_b = between(1.5, 4.0) / strain * size;
+  if (truth == LabTruth::asymmetry) tr.compression_ratio = 1 + ((u(rng) < 0.5 ? between(0.3, 0.6) : between(1.7, 3.0)) - 1) * size;
+  if (truth == LabTruth::softening || truth == LabTruth::recovering_softening) tr.softening_d = between(0.3, 0.6) * size;
+  if (truth == LabTruth::recovering_softening) tr.recovery_s = between(2.0, 10.0);
+  if (truth == LabTruth::broadband || truth == LabTruth::broadband_and_stiffening)
+    for (int l = 0; l < 2; ++l) {
+      tr.spectrum_pa[l] = tr.modulus_pa * between(0.3, 1.0) * size;
+      tr.spectrum_tau_s[l] = l == 0 ? log_between(0.3, 3.0) : log_between(5.0, 40.0);
+    }
+  if (truth == LabTruth::power_law) {
+    tr.power_pa = tr.modulus_pa * between(0.5, 1.5) * size;
+    tr.power_alpha = between(0.1, 0.4);
+    tr.power_tau0_s = log_between(0.01, 0.1);
+  }
 
   Dataset d;
-  d.name = "Kelvin-Voigt truth, seed " + std::to_string(seed);
-  d.mode = seed % 2 ? Mode::uniaxial : Mode::simple_shear;
+  d.name = std::string(name(truth)) + " truth at size " + std::to_string(size) + ", seed " + std::to_string(seed);
+  d.mode = tr.mode;
   d.specimen = {between(0.005, 0.03), between(0.005, 0.02), between(0.001, 0.005), between(1000, 1100)};
 
   struct Spec {
@@ -97,18 +249,18 @@ KelvinVoigtTruth write_kelvin_voigt_lab_dataset(unsigned seed, const std::string
     Command c;
   };
   const std::vector<Spec> strain_tests = {
-      {"ramp_0.05s.csv", ramp_hold(strain, 0.05, between(5, 15))},
-      {"ramp_medium.csv", ramp_hold(strain, between(0.3, 1.0), between(5, 15))},
-      {"ramp_slow.csv", ramp_hold(strain, between(3, 10), between(5, 15))},
-      {"ramp_compression.csv", ramp_hold(-strain * between(0.5, 1.0), between(0.1, 1.0), between(5, 15))},
+      {"ramp_0.05s.csv", ramp_hold(strain, 0.05, between(10, 30))},
+      {"ramp_medium.csv", ramp_hold(strain, between(0.3, 1.0), between(10, 30))},
+      {"ramp_slow.csv", ramp_hold(strain, between(3, 10), between(10, 30))},
+      {"ramp_compression.csv", ramp_hold(-strain * between(0.5, 1.0), between(0.1, 1.0), between(10, 30))},
       {"cycles_growing.csv", growing_cycles(strain, between(1.0, 4.0))},
   };
-  const auto stress_at = [&](const Command& c, double t) { return tr.modulus_pa * c.at(t) + tr.viscosity_pa_s * c.slope(c.piece(t)); };
-  std::vector<std::vector<double>> times;
+  std::vector<std::vector<double>> times, stresses;
   double peak = 0;
   for (const auto& s : strain_tests) {
     times.push_back(sample_times(s.c, rng));
-    for (double t : times.back()) peak = std::max(peak, std::abs(stress_at(s.c, t)));
+    stresses.push_back(stress_under_strain(tr, s.c, times.back()));
+    for (double v : stresses.back()) peak = std::max(peak, std::abs(v));
   }
   tr.stress_noise_pa = peak * between(0.005, 0.02);
   std::normal_distribution<double> stress_noise(0.0, tr.stress_noise_pa);
@@ -117,55 +269,47 @@ KelvinVoigtTruth write_kelvin_voigt_lab_dataset(unsigned seed, const std::string
     t.file = strain_tests[k].file;
     t.control = Control::strain;
     t.time_s = times[k];
-    for (double x : t.time_s) {
-      t.strain.push_back(strain_tests[k].c.at(x));
-      t.stress_pa.push_back(stress_at(strain_tests[k].c, x) + stress_noise(rng));
+    for (std::size_t i = 0; i < t.time_s.size(); ++i) {
+      t.strain.push_back(strain_tests[k].c.at(t.time_s[i]));
+      t.stress_pa.push_back(stresses[k][i] + stress_noise(rng));
     }
-    t.stress_sd_pa.assign(t.time_s.size(), tr.stress_noise_pa);
+    if (tr.noise_column) t.stress_sd_pa.assign(t.time_s.size(), tr.stress_noise_pa);
     d.tests.push_back(std::move(t));
   }
 
-  // Creep and recovery: stress ramped in 0.05 s, held, released in 0.05 s, recovery.
-  const double level = tr.modulus_pa * strain * between(0.3, 0.8);
-  Command c{{0.0}, {0.0}};
-  c.to(0.05, level);
-  c.to(between(5, 15), level);
-  c.to(0.05, 0.0);
-  c.to(between(5, 15), 0.0);
-  TestData creep;
-  creep.file = "creep_recovery.csv";
-  creep.control = Control::stress;
-  creep.time_s = sample_times(c, rng);
-  // Exact strain of eta eps' + E eps = sigma on each linear piece of sigma, knot to knot.
-  double e = 0.0, t0 = 0.0;
-  std::size_t piece = 1;
-  const auto advance = [&](double t1) {  // within one piece: sigma = sigma(t0) + m (t - t0)
-    const double m = c.slope(piece), s0 = c.at(t0), dt = t1 - t0;
-    const double particular0 = s0 / tr.modulus_pa - m * tau / tr.modulus_pa;
-    const double particular1 = (s0 + m * dt) / tr.modulus_pa - m * tau / tr.modulus_pa;
-    e = particular1 + (e - particular0) * std::exp(-dt / tau);
-    t0 = t1;
-  };
-  std::vector<double> exact;
-  for (double t : creep.time_s) {
-    while (piece < c.t.size() && c.t[piece] <= t) {
-      advance(c.t[piece]);
-      ++piece;
+  if (truth != LabTruth::power_law) {
+    // Creep and recovery: stress ramped in 0.05 s to what the virgin material carries at a
+    // fraction of the strain, held, released in 0.05 s, recovery.
+    const Elastic virgin{tr};
+    const double level = virgin.value(strain * between(0.3, 0.8));
+    Command c{{0.0}, {0.0}};
+    c.to(0.05, level);
+    c.to(between(5, 15), level);
+    c.to(0.05, 0.0);
+    c.to(between(5, 15), 0.0);
+    TestData creep;
+    creep.file = "creep_recovery.csv";
+    creep.control = Control::stress;
+    creep.time_s = sample_times(c, rng);
+    const std::vector<double> exact = strain_under_stress(tr, c, creep.time_s, 1000);
+    double largest = 0;
+    for (double e : exact) largest = std::max(largest, std::abs(e));
+    tr.strain_noise = largest * between(0.005, 0.02);
+    tr.creep_stress_noise_pa = std::abs(level) * 0.005;
+    std::normal_distribution<double> strain_noise(0.0, tr.strain_noise), load_noise(0.0, tr.creep_stress_noise_pa);
+    for (std::size_t k = 0; k < exact.size(); ++k) {
+      creep.strain.push_back(exact[k] + strain_noise(rng));
+      creep.stress_pa.push_back(c.at(creep.time_s[k]) + load_noise(rng));
     }
-    advance(t);
-    exact.push_back(e);
+    if (tr.noise_column) creep.stress_sd_pa.assign(creep.time_s.size(), tr.creep_stress_noise_pa);
+    d.tests.push_back(std::move(creep));
   }
-  tr.strain_noise = *std::max_element(exact.begin(), exact.end()) * between(0.005, 0.02);
-  tr.creep_stress_noise_pa = level * 0.005;
-  std::normal_distribution<double> strain_noise(0.0, tr.strain_noise), load_noise(0.0, tr.creep_stress_noise_pa);
-  for (std::size_t k = 0; k < exact.size(); ++k) {
-    creep.strain.push_back(exact[k] + strain_noise(rng));
-    creep.stress_pa.push_back(c.at(creep.time_s[k]) + load_noise(rng));
-  }
-  creep.stress_sd_pa.assign(creep.time_s.size(), tr.creep_stress_noise_pa);
-  d.tests.push_back(std::move(creep));
   write_dataset(d, folder);
   return tr;
+}
+
+LabDatasetTruth write_kelvin_voigt_lab_dataset(unsigned seed, const std::string& folder) {
+  return write_lab_dataset(seed, LabTruth::none, 1.0, folder);
 }
 
 }  // namespace viscera::lab::test

@@ -41,7 +41,8 @@ struct Shape {
   double peak_t = 0, peak_c = 0;
   double value(double e) const {
     double s = e;
-    if (tr.effect == Effect::strain_stiffening) s = std::expm1(tr.stiffening_b * e) / tr.stiffening_b;
+    if (tr.effect == Effect::strain_stiffening)  // odd in shear: an isotropic solid's shear stress is
+      s = tr.odd ? std::copysign(std::expm1(tr.stiffening_b * std::abs(e)) / tr.stiffening_b, e) : std::expm1(tr.stiffening_b * e) / tr.stiffening_b;
     if (tr.effect == Effect::tension_compression_asymmetry && e < 0) s *= tr.compression_ratio;
     if (tr.effect == Effect::first_load_softening) {
       const double peak = e >= 0 ? peak_t : peak_c;
@@ -194,7 +195,10 @@ Truth write_dataset_of(unsigned seed, const std::string& folder, bool power_law)
   }
   Dataset d;
   d.name = std::string(power_law ? "synthetic power-law seed " : "synthetic seed ") + std::to_string(seed);
-  d.mode = seed % 2 ? Mode::uniaxial : Mode::simple_shear;
+  // Simple shear in every other seed, but never for asymmetry, which an isotropic solid shows only
+  // under uniaxial load (its shear stress is odd in the shear strain); stiffening in shear is odd.
+  d.mode = seed % 2 || tr.effect == Effect::tension_compression_asymmetry ? Mode::uniaxial : Mode::simple_shear;
+  tr.odd = d.mode == Mode::simple_shear;
   d.specimen = {0.01, 0.01, 0.003, 1050};
   // Protocols: ramp-holds at two rates in tension and one in compression, cycles at two rates in
   // tension and compression, and a creep test.

@@ -21,6 +21,7 @@ struct Truth {
   // instead of the two exponentials (no finite set of memory variables is exact for it).
   double power_pa = 0, power_alpha = 0, power_tau0_s = 1;
   double noise_pa = 0;
+  bool odd = false;  // simple shear: the elastic shape is odd in the strain
 };
 
 /// Writes the data set for `seed` into `folder` and returns its truth (for messages only).

@@ -160,7 +160,7 @@ TEST(MaterialRegions, ARegionOverTheWholeOrganIsTheOrganMadeOfItsMaterial) {
   ASSERT_GT(layout.regions.at(0).elements, 0u);
   std::size_t inside_element = 0, outside_element = 0;
   for (std::size_t e = 0; e < layout.material_of_tet.size(); ++e) (layout.material_of_tet[e] ? inside_element : outside_element) = e;
-  for (const auto [e, changes] : {std::pair{inside_element, true}, std::pair{outside_element, false}}) {
+  for (const auto& [e, changes] : {std::pair{inside_element, true}, std::pair{outside_element, false}}) {
     std::vector<Vec3> y = nodule->mesh->nodes;
     y[nodule->mesh->tets[e][0]] += Vec3(1e-4, -2e-4, 1e-4);
     std::vector<Vec3> a(y.size(), Vec3::Zero()), b(y.size(), Vec3::Zero());

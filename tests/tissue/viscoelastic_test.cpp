@@ -545,6 +545,35 @@ TEST(Qlv, EnergyMapSatisfiesItsDefinition) {
   }
 }
 
+TEST(Qlv, OddShapesEnergyMapsSatisfyTheirDefinitions) {
+  // The odd shapes against their closed-form laws g: h h' = g, h odd, h' > 0, and h', h'' equal
+  // central differences (away from 0 for the odd exponential, whose h'' jumps there).
+  const auto g_odd_exp = [](double B, double e) { return std::copysign(std::expm1(B * std::abs(e)) / B, e); };
+  const auto g_poly = [](double B, double e) { return e * (1 + B * B * e * e / 6); };
+  for (const auto shape : {StiffeningShape::odd_exponential, StiffeningShape::odd_polynomial})
+    for (const double B : {0.5, 8.0, 30.0})
+      for (const double e : {-0.2, -0.05, -1e-3, 1e-3, 0.05, 0.2}) {
+        const FungEnergyMap m = stiffening_energy_map(shape, B, e);
+        const double g = shape == StiffeningShape::odd_exponential ? g_odd_exp(B, e) : g_poly(B, e);
+        EXPECT_NEAR(m.h * m.dh, g, 1e-12 * (1 + std::abs(g))) << B << " " << e;
+        EXPECT_NEAR(stiffening_energy_map(shape, B, -e).h, -m.h, 1e-15 * (1 + std::abs(m.h)));
+        EXPECT_GT(m.dh, 0.0);
+        const double d = 1e-6 / B * std::min(1.0, std::abs(e) * B);
+        EXPECT_NEAR(m.dh, (stiffening_energy_map(shape, B, e + d).h - stiffening_energy_map(shape, B, e - d).h) / (2 * d), 1e-6 * m.dh)
+            << B << " " << e;
+        EXPECT_NEAR(m.d2h, (stiffening_energy_map(shape, B, e + d).dh - stiffening_energy_map(shape, B, e - d).dh) / (2 * d),
+                    1e-4 * (B + std::abs(m.d2h)))
+            << B << " " << e;
+      }
+  // Odd shapes exist in the energy form only.
+  GpsMechanisms mech;
+  mech.stiffening.b = 5.0;
+  mech.stiffening.shape = StiffeningShape::odd_polynomial;
+  EXPECT_THROW(mech.validate(), std::invalid_argument);
+  mech.stiffening.form = GpsStiffening::Form::energy;
+  EXPECT_NO_THROW(mech.validate());
+}
+
 // Each part of the composition refuses what it cannot run, naming itself; the rules between parts
 // are checked where the parts meet; a valid composition reaches the model unchanged.
 TEST(GpsMechanisms, EachPartAndEachRuleBetweenPartsRefusesWhatItCannotRun) {

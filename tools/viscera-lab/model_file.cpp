@@ -25,7 +25,10 @@ void write_model(const std::string& path, const MaterialModel& m, const std::str
     j["relaxation_time_s"] = m.relaxation_time_s;
     j["relaxation_modulus_pa"] = m.relaxation_modulus_pa;
   }
-  if (m.has(Mechanism::strain_stiffening)) j["stiffening_b"] = m.stiffening_b;
+  if (m.has(Mechanism::strain_stiffening)) {
+    j["stiffening_form"] = name(m.stiffening_form);
+    j["stiffening_b"] = m.stiffening_b;
+  }
   if (m.has(Mechanism::tension_compression_asymmetry)) j["compression_ratio"] = m.compression_ratio;
   if (m.has(Mechanism::first_load_softening)) j["softening_d"] = m.softening_d;
   std::ofstream out(path);
@@ -38,7 +41,7 @@ MaterialModel read_model(const std::string& path) {
   if (!j.is_object()) throw common::InputError(path, 0, "", "not a JSON object (a model.json written by viscera-lab analyze)");
   const common::JsonObject top(j, path);
   top.require_known({"model", "fitted_to", "units", "mechanisms", "modulus_pa", "viscosity_pa_s", "relaxation_time_s", "relaxation_modulus_pa",
-                     "stiffening_b", "compression_ratio", "softening_d"});
+                     "stiffening_form", "stiffening_b", "compression_ratio", "softening_d"});
   // Each value in the range a fit can produce (finite; open ends checked where they matter).
   const double big = 1e300;
   const auto numbers = [&](const char* key, bool positive) {
@@ -61,7 +64,12 @@ MaterialModel read_model(const std::string& path) {
     m.relaxation_modulus_pa = numbers("relaxation_modulus_pa", false);
     if (m.relaxation_time_s.size() != m.relaxation_modulus_pa.size()) top.fail("relaxation_modulus_pa", "one modulus per relaxation time expected");
   }
-  if (m.has(Mechanism::strain_stiffening)) m.stiffening_b = top.number("stiffening_b", 0.0, big);
+  if (m.has(Mechanism::strain_stiffening)) {
+    m.stiffening_b = top.number("stiffening_b", 0.0, big);
+    // Files from before the forms existed are Fung's exponential.
+    const std::string form = top.choice("stiffening_form", {"exponential", "odd_exponential", "odd_polynomial"}, "exponential");
+    parse_stiffening_form(form, &m.stiffening_form);
+  }
   if (m.has(Mechanism::tension_compression_asymmetry)) {
     m.compression_ratio = top.number("compression_ratio", 0.0, big);
     if (!(m.compression_ratio > 0)) top.fail("compression_ratio", "0 is outside (0, inf)");

@@ -21,6 +21,8 @@ void GpsViscous::validate() const {
 
 void GpsStiffening::validate() const {
   if (!finite_at_least_zero(b)) throw std::invalid_argument("GPS stiffening: Fung's B must be >= 0");
+  if (shape != StiffeningShape::exponential && form != Form::energy)
+    throw std::invalid_argument("GPS stiffening: the odd shapes exist in the energy form only");
 }
 
 void GpsAsymmetry::validate() const {

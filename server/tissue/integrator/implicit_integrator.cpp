@@ -236,12 +236,12 @@ NewtonReport ImplicitIntegrator::step(State& state) {
   }
   for (std::size_t i = 0; i < mass_.size(); ++i) state.v[i] = (state.x[i] - x_n[i]) / dt;
   state.time_s += dt;
+  if (free_dofs_ == 0) {  // no Newton ran: evaluate once at the constrained positions (forces, memory)
+    std::vector<double> r;
+    residual(state.x, true, x_n, v_n, r);
+    if (memory_before_) memory_accepted_.swap(memory_trial_);
+  }
   if (memory_before_) {
-    if (free_dofs_ == 0) {  // no Newton ran: evaluate once at the constrained positions
-      std::vector<double> r;
-      residual(state.x, true, x_n, v_n, r);
-      memory_accepted_.swap(memory_trial_);
-    }
     state.memory.swap(memory_accepted_);
     state.memory_time_s = state.time_s;
     memory_before_ = nullptr;
@@ -253,6 +253,10 @@ NewtonReport ImplicitIntegrator::solve_static(State& state) {
   apply_constraints(state, state.time_s);
   update_external(state.time_s);
   NewtonReport rep = free_dofs_ > 0 ? newton(state, false, state.x, state.v) : NewtonReport{0, 0, 0, 0, 0, true, false};
+  if (free_dofs_ == 0) {  // every position prescribed: the forces there (last_internal_forces) still
+    std::vector<double> r;
+    residual(state.x, false, state.x, state.v, r);
+  }
   std::fill(state.v.begin(), state.v.end(), Vec3::Zero());
   if (!rep.converged) {
     std::ostringstream msg;

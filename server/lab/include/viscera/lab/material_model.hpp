@@ -6,7 +6,13 @@
 // recurrence). The baseline is what published simulators use: linear elasticity with Kelvin-Voigt
 // damping (s = eps, no h_l). Each named mechanism extends it:
 //   broadband_relaxation          E_l on log-spaced tau_l over the data's time scales (memory variables)
-//   strain_stiffening             Fung: s = (exp(B eps) - 1) / B
+//   strain_stiffening             one of three forms, chosen by the fit:
+//                                   exponential (Fung, 1D): s = (exp(B eps) - 1) / B
+//                                   odd exponential:        s = sign(eps) (exp(B |eps|) - 1) / B
+//                                   odd polynomial:         s = eps (1 + B^2 eps^2 / 6)
+//                                 (same slope and curvature of stiffness at small B eps); in simple
+//                                 shear only the odd forms (an isotropic solid's shear stress is odd
+//                                 in the shear strain)
 //   tension_compression_asymmetry s = eps (eps >= 0), r eps (eps < 0)
 //   first_load_softening          s = eps on the virgin curve, (1 - d (1 - |eps|/m)) eps below the
 //                                 previous extreme m (Ogden-Roxburgh-like softening on reloading)
@@ -28,8 +34,17 @@ const char* name(Mechanism m);
 /// Parses a mechanism name; false if unknown.
 bool parse_mechanism(const std::string& s, Mechanism* out);
 
+enum class StiffeningForm { exponential, odd_exponential, odd_polynomial };
+const char* name(StiffeningForm f);
+/// Parses a form's name; false if unknown.
+bool parse_stiffening_form(const std::string& s, StiffeningForm* out);
+
 struct MaterialModel {
   unsigned mechanisms = 0;  ///< bit (1 << Mechanism)
+  /// The data's elastic response must be odd in the strain (simple shear of an isotropic solid):
+  /// the fit offers only odd stiffening forms. Set from the data set's mode.
+  bool odd_only = false;
+  StiffeningForm stiffening_form = StiffeningForm::exponential;
   double stiffening_b = 0.0;
   double compression_ratio = 1.0;
   double softening_d = 0.0;

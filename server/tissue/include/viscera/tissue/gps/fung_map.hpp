@@ -34,11 +34,37 @@ inline FungEnergyMap fung_energy_map(double B, double e) {
   return {h, dh, (em1 + 1 - dh * dh) * B / (x * s)};  // h'' = (e^x - h'^2) / h, h = x s / B
 }
 
+/// Stiffening laws g(e) with the same small-strain start (g'(0) = 1, stiffness growing with |e|):
+///  - exponential: Fung's (exp(B e) - 1) / B (stiffer in tension than in compression);
+///  - odd_exponential: sign(e) (exp(B |e|) - 1) / B, odd in e (a shear response must be: an
+///    isotropic solid's shear stress is odd in the shear strain). Energy map: h(e) = sign(e)
+///    h_exp(|e|), h' even, h'' odd (it jumps from -B/3 to B/3 at 0, where it multiplies a zero
+///    tension, so the tangent stays continuous);
+///  - odd_polynomial: e (1 + B^2 e^2 / 6). Energy map h = e sqrt(q), q = 1 + c e^2, c = B^2 / 12:
+///    h h' = e (1 + 2 c e^2) = g.
+enum class StiffeningShape { exponential, odd_exponential, odd_polynomial };
+
+inline FungEnergyMap stiffening_energy_map(StiffeningShape shape, double B, double e) {
+  switch (shape) {
+    case StiffeningShape::exponential: break;
+    case StiffeningShape::odd_exponential: {
+      const FungEnergyMap f = fung_energy_map(B, std::abs(e));
+      const double sign = e < 0 ? -1.0 : 1.0;
+      return {sign * f.h, f.dh, sign * f.d2h};
+    }
+    case StiffeningShape::odd_polynomial: {
+      const double c = B * B / 12, q = 1 + c * e * e, sq = std::sqrt(q);
+      return {e * sq, (1 + 2 * c * e * e) / sq, c * e * (3 + 2 * c * e * e) / (q * sq)};
+    }
+  }
+  return fung_energy_map(B, e);
+}
+
 constexpr double kAsymmetryWidth = 0.005;
 
-/// The energy map with Fung's B and the compression ratio r (r = 1: symmetric).
-inline FungEnergyMap edge_energy_map(double B, double r, double e) {
-  const FungEnergyMap f = fung_energy_map(B, e);
+/// The energy map of a stiffening shape with B and the compression ratio r (r = 1: symmetric).
+inline FungEnergyMap edge_energy_map(double B, double r, double e, StiffeningShape shape = StiffeningShape::exponential) {
+  const FungEnergyMap f = stiffening_energy_map(shape, B, e);
   if (r == 1.0) return f;
   const double q = std::sqrt(r) - 1.0, w = kAsymmetryWidth;
   const double S = 1.0 / (1.0 + std::exp(e / w));  // logistic of -e/w: 1 in compression, 0 in tension

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "viscera/tissue/gps/fung_map.hpp"
+
 namespace viscera::tissue {
 
 /// Every tetrahedron keeps per mechanism a 6-vector zeta_l of filtered edge elongations
@@ -42,6 +44,8 @@ struct GpsStiffening {
   /// 0.5 h^T H h of the energy map h (h h' = the edge map, so a bar responds alike), tensions
   /// t_k = h'(e_k) (H (h - memory))_k (gps/fung_map.hpp).
   enum class Form { edge_map, energy } form = Form::edge_map;
+  /// The law g(e) (gps/fung_map.hpp): Fung's exponential, or an odd shape (energy form only).
+  StiffeningShape shape = StiffeningShape::exponential;
 
   bool active() const { return b > 0; }
   void validate() const;

@@ -1,0 +1,123 @@
+// viscera-lab's accuracy on data it has never seen (issue 23): data sets from tests/lab's
+// independent generator (lab_protocols.hpp), one truth each, at today's effect sizes and at 0.3x
+// and 0.1x; the lab sees only the folder. Prints the accuracy per truth and size, the confusion
+// between causes and the false-positive rate on the "none" sets, as Markdown (docs/LAB.md).
+//   lab_accuracy [--seeds N] [--none N] [--dir DIR]
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "viscera/lab/analysis.hpp"
+
+#include "lab_protocols.hpp"
+
+using namespace viscera::lab;
+
+namespace {
+
+std::string causes_of(const Analysis& a) {
+  std::string s;
+  for (Mechanism m : a.causes) s += (s.empty() ? "" : " + ") + std::string(name(m));
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int seeds = 20, nones = 100;
+  std::string dir = (std::filesystem::temp_directory_path() / "viscera_lab_accuracy").string();
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    if (a == "--help" || a == "-h") {
+      std::printf(
+          "Usage: lab_accuracy [--seeds N] [--none N] [--dir DIR]\n"
+          "Runs viscera-lab on data sets from the independent generator of tests/lab (N seeds per truth and effect size,\n"
+          "and N 'none' sets) and prints accuracy per truth, the confusion between causes and the false-positive rate\n"
+          "as Markdown. Defaults: 20 seeds, 100 none sets, data sets written under the system's temporary folder.\n");
+      return 0;
+    }
+    if (k + 1 >= argc) {
+      std::fprintf(stderr, "lab_accuracy: %s needs a value (see --help)\n", a.c_str());
+      return 2;
+    }
+    const std::string v = argv[++k];
+    if (a == "--seeds")
+      seeds = std::atoi(v.c_str());
+    else if (a == "--none")
+      nones = std::atoi(v.c_str());
+    else if (a == "--dir")
+      dir = v;
+    else {
+      std::fprintf(stderr, "lab_accuracy: unknown option %s (see --help)\n", a.c_str());
+      return 2;
+    }
+    if ((a == "--seeds" || a == "--none") && std::atoi(v.c_str()) <= 0) {
+      std::fprintf(stderr, "lab_accuracy: %s must be a positive whole number, not '%s'\n", a.c_str(), v.c_str());
+      return 2;
+    }
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const auto run = [&](test::LabTruth truth, double size, unsigned seed) {
+    const std::string folder = dir + "/" + test::name(truth) + "_" + std::to_string(size) + "_" + std::to_string(seed);
+    std::filesystem::remove_all(folder);
+    test::write_lab_dataset(seed, truth, size, folder);
+    return analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});
+  };
+  const auto right = [](test::LabTruth truth, const Analysis& a) {
+    const auto expected = test::expected_causes(truth);
+    if (expected.size() != a.causes.size()) return false;
+    for (const auto& e : expected) {
+      bool found = false;
+      for (Mechanism m : a.causes) found |= e == name(m);
+      if (!found) return false;
+    }
+    return true;
+  };
+  std::printf("| truth | in the lab's forms | size | right | named instead (count) |\n|---|---|---|---|---|\n");
+  const std::vector<test::LabTruth> truths = {test::LabTruth::exponential_stiffening,
+                                              test::LabTruth::polynomial_stiffening,
+                                              test::LabTruth::asymmetry,
+                                              test::LabTruth::softening,
+                                              test::LabTruth::recovering_softening,
+                                              test::LabTruth::broadband,
+                                              test::LabTruth::power_law,
+                                              test::LabTruth::broadband_and_stiffening};
+  for (test::LabTruth truth : truths)
+    for (double size : {1.0, 0.3, 0.1}) {
+      int ok = 0;
+      std::map<std::string, int> instead;
+      for (int s = 1; s <= seeds; ++s) {
+        const Analysis a = run(truth, size, static_cast<unsigned>(s));
+        if (right(truth, a))
+          ++ok;
+        else
+          ++instead[causes_of(a)];
+      }
+      std::string other;
+      for (const auto& [k, v] : instead) other += (other.empty() ? "" : ", ") + k + " (" + std::to_string(v) + ")";
+      std::printf("| %s | %s | %.1fx | %d of %d | %s |\n", test::name(truth), test::out_of_family(truth) ? "no" : "yes", size, ok, seeds,
+                  other.c_str());
+      std::fflush(stdout);
+      std::fprintf(stderr, "[%6.0f s] %s at %.1fx done\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(),
+                   test::name(truth), size);
+    }
+  int false_positives = 0;
+  std::map<std::string, int> named;
+  for (int s = 1; s <= nones; ++s) {
+    const Analysis a = run(test::LabTruth::none, 1.0, static_cast<unsigned>(s));
+    if (!a.causes.empty()) {
+      ++false_positives;
+      ++named[causes_of(a)];
+    }
+  }
+  std::string other;
+  for (const auto& [k, v] : named) other += (other.empty() ? "" : ", ") + k + " (" + std::to_string(v) + ")";
+  std::printf("\nFalse positives on %d 'none' sets (linear Kelvin-Voigt truths): %d%s%s\n", nones, false_positives, other.empty() ? "" : ": ",
+              other.c_str());
+  std::fprintf(stderr, "[%6.0f s] done\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  return 0;
+}
