@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <future>
+#include <optional>
 #include <sstream>
 
 #include "viscera/common/input_error.hpp"
@@ -22,6 +23,10 @@ namespace {
 // of the noise variance, and the held-out RMS by at least kMinGain relatively.
 constexpr double kNoiseFraction = 0.5;
 constexpr double kMinGain = 0.05;
+// First-load softening needs the data's own evidence (softening_evidence) at this z-score.
+constexpr double kSofteningZ = 3.0;
+// Held-out blocks per test (evaluate()).
+constexpr std::size_t kBlocks = 4;
 
 double rms(const std::vector<double>& v) {
   double s = 0;
@@ -33,6 +38,60 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, f, a, b, c);
   return buf;
+}
+
+// First-load softening's physical evidence: at the same strain, the stress on reloading below the
+// previous peak differs from the stress on first loading. A stiffening response
+// cannot show it (it depends on the strain only), nor can rate effects the model already carries.
+// Residuals of `model` (data - model, sign-corrected) on strain-controlled tests, in ten bins of
+// |strain| over 20-100% of the largest, within each test (same rates, same protocol); in each bin
+// with both kinds, first loading minus below the peak, combined as a z-score against the noise.
+struct SofteningEvidence {
+  double z = 0.0;
+  int bins = 0;
+  long virgin = 0, below_peak = 0;
+};
+SofteningEvidence softening_evidence(const MaterialModel& model, const Dataset& d, double noise_pa) {
+  constexpr int kBins = 10;
+  double max_strain = 0;
+  for (const auto& t : d.tests)
+    for (double e : t.strain) max_strain = std::max(max_strain, std::abs(e));
+  SofteningEvidence ev;
+  double diff = 0.0, var = 0.0;
+  for (const auto& t : d.tests) {  // within each test: the same rates, the same protocol
+    if (t.control != Control::strain) continue;
+    double sum_v[kBins] = {}, sum_b[kBins] = {};
+    long n_v[kBins] = {}, n_b[kBins] = {};
+    const auto y = predict_stress(model, t);
+    double peak_t = 0, peak_c = 0;
+    for (std::size_t k = 0; k < y.size(); ++k) {
+      const double e = t.strain[k], a = std::abs(e), r = (t.stress_pa[k] - y[k]) * (e >= 0 ? 1 : -1);
+      const double peak = e >= 0 ? peak_t : peak_c;
+      const int bin = static_cast<int>((a / max_strain - 0.2) / 0.8 * kBins);
+      // Loading only (|strain| growing), so that both kinds move the same way at the same rate.
+      const bool loading = k > 0 && a > std::abs(t.strain[k - 1]) && e * t.strain[k - 1] >= 0;
+      if (bin >= 0 && bin < kBins && loading) {
+        if (a >= peak) {
+          sum_v[bin] += r;
+          ++n_v[bin];
+        } else if (a < 0.9 * peak) {
+          sum_b[bin] += r;
+          ++n_b[bin];
+        }
+      }
+      (e >= 0 ? peak_t : peak_c) = std::max(peak, a);
+    }
+    for (int b = 0; b < kBins; ++b)
+      if (n_v[b] > 0 && n_b[b] > 0) {
+        diff += sum_v[b] / static_cast<double>(n_v[b]) - sum_b[b] / static_cast<double>(n_b[b]);
+        var += noise_pa * noise_pa * (1.0 / static_cast<double>(n_v[b]) + 1.0 / static_cast<double>(n_b[b]));
+        ++ev.bins;
+        ev.virgin += n_v[b];
+        ev.below_peak += n_b[b];
+      }
+  }
+  ev.z = var > 0 ? diff / std::sqrt(var) : 0.0;
+  return ev;
 }
 
 // Residual signatures of a fitted model (data - model), the evidence behind each mechanism.
@@ -115,19 +174,52 @@ double noise_level_measured(const TestData& t) {
 
 double noise_level_pa(const TestData& t) { return noise_level_measured(t) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t)); }
 
-ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d) {
+ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d, HeldOut unit) {
   if (d.tests.size() < 2) throw common::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
   ModelEvaluation ev;
   std::vector<const TestData*> all;
   for (const auto& t : d.tests) all.push_back(&t);
-  // The full fit and the leave-one-out fits are independent: use both cores.
-  auto full = std::async(std::launch::async, [&] { return fit_model(structure, all); });
+  // Held-out units (HeldOut): whole tests, or each test in kBlocks consecutive blocks of rows. For
+  // a block the model is fitted to every row of every test but the block's, runs through the whole
+  // history (driven by the measured strain or stress) and predicts the block. Either way every row
+  // is predicted once by a fit that did not see it. The fits are independent: both cores.
+  struct Fold {
+    std::size_t test, begin, end;
+  };
+  std::vector<Fold> folds;
+  for (std::size_t k = 0; k < d.tests.size(); ++k) {
+    const std::size_t n = d.tests[k].time_s.size(), blocks = unit == HeldOut::blocks && n >= 4 * kBlocks ? kBlocks : 1;
+    for (std::size_t b = 0; b < blocks; ++b) folds.push_back({k, n * b / blocks, n * (b + 1) / blocks});
+  }
+  std::vector<std::vector<double>> predicted(d.tests.size());
+  for (std::size_t k = 0; k < d.tests.size(); ++k) predicted[k].resize(d.tests[k].time_s.size());
+  const auto run = [&](std::size_t from, std::size_t step) {
+    for (std::size_t f = from; f < folds.size(); f += step) {
+      const TestData& t = d.tests[folds[f].test];
+      MaterialModel fitted;
+      if (folds[f].begin == 0 && folds[f].end == t.time_s.size()) {  // the whole test: fit the others
+        std::vector<const TestData*> others;
+        for (const TestData* o : all)
+          if (o != &t) others.push_back(o);
+        fitted = fit_model(structure, others);
+      } else {
+        fitted = fit_model(structure, all, {&t, folds[f].begin, folds[f].end});
+      }
+      const std::vector<double> y = predict_measured(fitted, t);
+      for (std::size_t j = folds[f].begin; j < folds[f].end; ++j) predicted[folds[f].test][j] = y[j];
+    }
+  };
+  auto half = std::async(std::launch::async, [&] { run(0, 2); });
+  run(1, 2);
+  half.get();
+  auto full = std::async(std::launch::deferred, [&] { return fit_model(structure, all); });
   std::vector<double> heldout(d.tests.size());
   for (std::size_t k = 0; k < d.tests.size(); ++k) {
-    std::vector<const TestData*> others;
-    for (std::size_t j = 0; j < d.tests.size(); ++j)
-      if (j != k) others.push_back(&d.tests[j]);
-    heldout[k] = rms_error_pa(fit_model(structure, others), d.tests[k]);
+    const TestData& t = d.tests[k];
+    const std::vector<double>& measured = t.control == Control::strain ? t.stress_pa : t.strain;
+    double sq = 0.0;
+    for (std::size_t j = 0; j < measured.size(); ++j) sq += (predicted[k][j] - measured[j]) * (predicted[k][j] - measured[j]);
+    heldout[k] = std::sqrt(sq / static_cast<double>(measured.size())) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t));
   }
   ev.model = full.get();
   for (std::size_t k = 0; k < d.tests.size(); ++k) {
@@ -212,6 +304,7 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
   // asymmetry to find there (and stiffening is offered in its odd forms only).
   if (start.model.odd_only) remaining.erase(std::find(remaining.begin(), remaining.end(), Mechanism::tension_compression_asymmetry));
   for (int round = 1; !remaining.empty(); ++round) {
+    std::optional<ModelEvaluation> current_blocks;  // the current model on held-out blocks, when needed
     const Mechanism* best = nullptr;
     ModelEvaluation best_eval;
     double best_gain = 0.0;
@@ -226,11 +319,40 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
       ++evaluated;
       Candidate c{m, round, current.heldout_rms_pa, ev.heldout_rms_pa, false, evidence(m, current.model, d)};
       const double reduction = current.heldout_rms_pa * current.heldout_rms_pa - ev.heldout_rms_pa * ev.heldout_rms_pa;
-      const bool above_noise = reduction > kNoiseFraction * noise_pa * noise_pa && ev.heldout_rms_pa < (1.0 - kMinGain) * current.heldout_rms_pa;
+      bool above_noise = reduction > kNoiseFraction * noise_pa * noise_pa && ev.heldout_rms_pa < (1.0 - kMinGain) * current.heldout_rms_pa;
       say(fmt("  held-out RMS %.4g -> %.4g Pa (noise %.4g Pa)", current.heldout_rms_pa, ev.heldout_rms_pa, noise_pa) +
           (above_noise ? ": gain above noise" : ": no gain above noise"));
-      if (above_noise && reduction > best_gain) {
-        best_gain = reduction;
+      double gain_measure = reduction;
+      if (m == Mechanism::first_load_softening) {
+        // Softening only where the data show it: on reloading below the previous peak, at the
+        // same strain, the stress differs from first loading's.
+        const SofteningEvidence se = softening_evidence(current.model, d, noise_pa);
+        char text[300];
+        std::snprintf(text, sizeof text,
+                      "; at the same strain, first loading against reloading below the previous peak: z = %.2f over %d strain bins (%ld and %ld "
+                      "samples)%s",
+                      se.z, se.bins, se.virgin, se.below_peak, se.z > kSofteningZ ? "" : ": not the evidence softening needs (z > 3)");
+        c.evidence += text;
+        if (above_noise && se.z <= kSofteningZ) {
+          above_noise = false;
+          say(fmt("  rejected: no first loading stiffer than reloading at the same strain (z = %.2f)", se.z));
+        }
+        if (!above_noise && se.z > kSofteningZ) {
+          // Reloading is often in one test only (the cyclic one), so no other test can show the
+          // gain: judged on held-out blocks of the tests instead (HeldOut::blocks).
+          if (!current_blocks) current_blocks = evaluate(current.model, d, HeldOut::blocks);
+          const ModelEvaluation eb = evaluate(s, d, HeldOut::blocks);
+          const double rb = current_blocks->heldout_rms_pa * current_blocks->heldout_rms_pa - eb.heldout_rms_pa * eb.heldout_rms_pa;
+          above_noise = rb > kNoiseFraction * noise_pa * noise_pa && eb.heldout_rms_pa < (1.0 - kMinGain) * current_blocks->heldout_rms_pa;
+          gain_measure = rb;
+          c.evidence += fmt("; on held-out blocks of the tests (reloading shows within a test): held-out RMS %.4g -> %.4g Pa",
+                            current_blocks->heldout_rms_pa, eb.heldout_rms_pa);
+          say(fmt("  on held-out blocks: %.4g -> %.4g Pa", current_blocks->heldout_rms_pa, eb.heldout_rms_pa) +
+              (above_noise ? ": gain above noise" : ": no gain above noise"));
+        }
+      }
+      if (above_noise && gain_measure > best_gain) {
+        best_gain = gain_measure;
         best = &m;
         best_eval = ev;
       }

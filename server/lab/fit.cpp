@@ -65,11 +65,21 @@ namespace {
 // error (the stress the model needs for the measured strain) as a start.
 struct Problem {
   std::vector<const TestData*> linear;  // rows linear in the parameters
-  std::vector<double> linear_weight;
+  std::vector<Eigen::VectorXd> linear_weight;  // per row: 1/sqrt(rows kept), 0 on held-out rows
   std::vector<const TestData*> creep;  // stress-controlled, output error
-  std::vector<double> creep_weight;  // 1/sqrt(rows) x apparent modulus
+  std::vector<Eigen::VectorXd> creep_weight;  // the same x apparent modulus
   Eigen::VectorXd b;
 };
+
+// Each test weighs equally: its kept rows share a weight 1/sqrt(rows kept); held-out rows get 0.
+Eigen::VectorXd row_weights(const TestData* t, const HeldOutRows& held, double scale) {
+  const auto n = static_cast<Eigen::Index>(t->time_s.size());
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(n);
+  if (held.test == t)
+    for (std::size_t k = held.begin; k < held.end && k < t->time_s.size(); ++k) w(static_cast<Eigen::Index>(k)) = 0.0;
+  const double kept = w.sum();
+  return kept > 0 ? Eigen::VectorXd(w * (scale / std::sqrt(kept))) : w;
+}
 
 void assign(MaterialModel& m, const Eigen::VectorXd& x) {
   const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
@@ -96,7 +106,7 @@ Eigen::MatrixXd linear_rows(const MaterialModel& m, const Problem& p) {
   Eigen::Index r = 0;
   for (std::size_t k = 0; k < p.linear.size(); ++k) {
     const Eigen::MatrixXd Bk = basis(m, *p.linear[k]);
-    A.block(r, 0, Bk.rows(), Bk.cols()) = p.linear_weight[k] * Bk;
+    A.block(r, 0, Bk.rows(), Bk.cols()) = p.linear_weight[k].asDiagonal() * Bk;
     r += Bk.rows();
   }
   return A;
@@ -118,7 +128,7 @@ Eigen::VectorXd creep_residual(const MaterialModel& m, const Problem& p) {
   Eigen::Index i = 0;
   for (std::size_t k = 0; k < p.creep.size(); ++k) {
     const std::vector<double> e = predict_strain(m, *p.creep[k]);
-    for (std::size_t j = 0; j < e.size(); ++j) r(i++) = p.creep_weight[k] * (e[j] - p.creep[k]->strain[j]);
+    for (std::size_t j = 0; j < e.size(); ++j) r(i++) = p.creep_weight[k](static_cast<Eigen::Index>(j)) * (e[j] - p.creep[k]->strain[j]);
   }
   return r;
 }
@@ -202,7 +212,7 @@ void search(MaterialModel& m, const Problem& p, const Nonlinear& q) {
 
 }  // namespace
 
-MaterialModel fit_model(const MaterialModel& structure, const std::vector<const TestData*>& tests) {
+MaterialModel fit_model(const MaterialModel& structure, const std::vector<const TestData*>& tests, const HeldOutRows& held) {
   Problem p;
   for (const TestData* t : tests) (t->control == Control::strain ? p.linear : p.creep).push_back(t);
   const bool output_error = !p.creep.empty();
@@ -212,9 +222,8 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
   p.b.resize(rows);
   Eigen::Index r = 0;
   for (const TestData* t : p.linear) {
-    const double w = 1.0 / std::sqrt(static_cast<double>(t->time_s.size()));
-    p.linear_weight.push_back(w);
-    for (double s : t->stress_pa) p.b(r++) = w * s;
+    p.linear_weight.push_back(row_weights(t, held, 1.0));
+    for (std::size_t j = 0; j < t->stress_pa.size(); ++j) p.b(r++) = p.linear_weight.back()(static_cast<Eigen::Index>(j)) * t->stress_pa[j];
   }
   MaterialModel m = structure;
   m.stiffening_b = 0.0;
@@ -257,7 +266,7 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
       p.linear_weight.clear();
       p.b.resize(0);
     }
-    for (const TestData* t : p.creep) p.creep_weight.push_back(apparent_modulus_pa(*t) / std::sqrt(static_cast<double>(t->time_s.size())));
+    for (const TestData* t : p.creep) p.creep_weight.push_back(row_weights(t, held, apparent_modulus_pa(*t)));
     refine_on_measured(m, p);
   }
   return m;

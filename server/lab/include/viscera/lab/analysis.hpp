@@ -88,8 +88,13 @@ double noise_level_measured(const TestData& t);
 /// The same in pascals (strain noise times the apparent modulus under stress control).
 double noise_level_pa(const TestData& t);
 
-/// Fits `structure` to all tests and, for every test, to the others (held-out prediction).
-ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d);
+/// Fits `structure` to all tests and, for every held-out unit, to the rest (held-out prediction).
+/// What a held-out error holds out: a whole test (the model fitted to the other tests predicts
+/// it), or one of four consecutive blocks of a test's rows (fitted to every other row, the test's
+/// own other blocks included; for an effect that only one test's history shows, such as
+/// reloading below a previous peak).
+enum class HeldOut { tests, blocks };
+ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d, HeldOut unit = HeldOut::tests);
 
 /// The whole analysis; `progress` receives one line per stage, with an estimate of the time the
 /// rest will take once the baseline's fits have been timed.

@@ -19,7 +19,13 @@ Eigen::VectorXd nonnegative_least_squares(const Eigen::MatrixXd& A, const Eigen:
 /// (stress_controlled.hpp), in equivalent stress (strain error x apparent modulus). The nonlinear
 /// parameters are searched on the strain-controlled tests; a last Gauss-Newton refinement of the
 /// moduli and viscosities takes every test.
-MaterialModel fit_model(const MaterialModel& structure, const std::vector<const TestData*>& tests);
+/// Rows of one test the fit must not see (held out for cross-validation within tests); the
+/// model still runs through them, driven by the measured history.
+struct HeldOutRows {
+  const TestData* test = nullptr;
+  std::size_t begin = 0, end = 0;
+};
+MaterialModel fit_model(const MaterialModel& structure, const std::vector<const TestData*>& tests, const HeldOutRows& held = {});
 
 /// RMS error of one test in what it measured: stress [Pa] under strain control, strain under
 /// stress control.

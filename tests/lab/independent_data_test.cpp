@@ -1,0 +1,70 @@
+// viscera-lab on data it has never seen (issue 23): data sets from lab_protocols.hpp, whose
+// truths, protocols and forms were written outside the lab (linear damping on the strain rate;
+// symmetric polynomial stiffening, softening that recovers at rest and power-law relaxation
+// outside the lab's forms; creep-recovery under stress control; non-uniform sampling; no noise
+// column in every third set). The lab sees only the folder. A sample small enough for every run;
+// bench/lab_accuracy measures the full table in docs/LAB.md.
+#include <filesystem>
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "viscera/lab/analysis.hpp"
+
+#include "lab_protocols.hpp"
+
+using namespace viscera::lab;
+
+namespace {
+
+bool named_right(test::LabTruth truth, const Analysis& a) {
+  const auto expected = test::expected_causes(truth);
+  if (expected.size() != a.causes.size()) return false;
+  for (const auto& e : expected) {
+    bool found = false;
+    for (Mechanism m : a.causes) found |= e == name(m);
+    if (!found) return false;
+  }
+  return true;
+}
+
+Analysis analyze_truth(test::LabTruth truth, unsigned seed) {
+  const std::string folder = std::string(VISCERA_TEST_TMP) + "/independent/" + test::name(truth) + "_" + std::to_string(seed);
+  std::filesystem::remove_all(folder);
+  test::write_lab_dataset(seed, truth, 1.0, folder);
+  return analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});
+}
+
+}  // namespace
+
+TEST(IndependentData, CausesAreNamedAtTodaysSizesInsideAndOutsideTheLabsForms) {
+  int in_right = 0, in_total = 0, out_right = 0, out_total = 0;
+  for (test::LabTruth truth :
+       {test::LabTruth::exponential_stiffening, test::LabTruth::polynomial_stiffening, test::LabTruth::asymmetry, test::LabTruth::softening,
+        test::LabTruth::recovering_softening, test::LabTruth::broadband, test::LabTruth::power_law, test::LabTruth::broadband_and_stiffening})
+    for (unsigned seed = 1; seed <= 4; ++seed) {
+      const Analysis a = analyze_truth(truth, seed);
+      const bool right = named_right(truth, a);
+      (test::out_of_family(truth) ? out_right : in_right) += right;
+      (test::out_of_family(truth) ? out_total : in_total) += 1;
+      std::cout << "[ " << test::name(truth) << " seed " << seed << " ] named";
+      for (Mechanism m : a.causes) std::cout << " " << name(m);
+      std::cout << (a.causes.empty() ? " none" : "") << (right ? "" : "  <- wrong") << "\n";
+    }
+  std::cout << "[ figure ] in the lab's forms: " << in_right << " of " << in_total << "; outside them: " << out_right << " of " << out_total << "\n";
+  EXPECT_GE(in_right, in_total * 85 / 100);
+  EXPECT_GE(out_right, out_total * 75 / 100);
+}
+
+TEST(IndependentData, AtMostOneFalsePositiveIn20KelvinVoigtSets) {
+  int named = 0;
+  for (unsigned seed = 101; seed <= 120; ++seed) {
+    const Analysis a = analyze_truth(test::LabTruth::none, seed);
+    if (!a.causes.empty()) {
+      ++named;
+      std::cout << "[ none seed " << seed << " ] named " << name(a.causes.front()) << "\n";
+    }
+  }
+  std::cout << "[ figure ] causes named on " << named << " of 20 Kelvin-Voigt sets\n";
+  EXPECT_LE(named, 1);
+}
