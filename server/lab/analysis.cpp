@@ -155,17 +155,6 @@ double rms_over_tests(const std::vector<TestFigures>& t, double TestFigures::*f)
 
 }  // namespace
 
-namespace {
-// Noise of a sampled quantity from its second differences (robust: the median absolute value).
-double noise_from_second_differences(const std::vector<double>& v) {
-  std::vector<double> d2;
-  for (std::size_t k = 2; k < v.size(); ++k) d2.push_back(std::abs(v[k] - 2 * v[k - 1] + v[k - 2]));
-  if (d2.empty()) return 0.0;
-  std::nth_element(d2.begin(), d2.begin() + static_cast<long>(d2.size() / 2), d2.end());
-  return d2[d2.size() / 2] / 0.6745 / std::sqrt(6.0);
-}
-}  // namespace
-
 double noise_level_measured(const TestData& t) {
   if (t.control == Control::stress) return noise_from_second_differences(t.strain);
   if (!t.stress_sd_pa.empty()) return rms(t.stress_sd_pa);

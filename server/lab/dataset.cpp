@@ -167,7 +167,69 @@ void check_stress_units(const Dataset& d, const std::string& meta) {
                          " Pa): are the stresses or strains in another unit?");
 }
 
+/// A control that cannot be what the test claims: over a long stretch (a fifth of the test or
+/// more, five samples or more) the column said to respond is held within its noise while the
+/// column said to be commanded moves (between the first and the last quarter of the stretch,
+/// time-weighted) by an amount that, at the test's apparent modulus, should have moved the
+/// response by ten times that noise. A held strain under a changing stress is a relaxation test,
+/// a held stress under a creeping strain a creep test: the "control" of that test is the other one.
+void check_control(const TestData& t, const JsonObject& entry) {
+  const bool strain_control = t.control == Control::strain;
+  const std::vector<double>& command = strain_control ? t.strain : t.stress_pa;
+  const std::vector<double>& response = strain_control ? t.stress_pa : t.strain;
+  const std::size_t n = t.time_s.size();
+  double peak_stress = 0, peak_strain = 0, lo = response[0], hi = response[0];
+  for (std::size_t k = 0; k < n; ++k) {
+    peak_stress = std::max(peak_stress, std::abs(t.stress_pa[k]));
+    peak_strain = std::max(peak_strain, std::abs(t.strain[k]));
+    lo = std::min(lo, response[k]);
+    hi = std::max(hi, response[k]);
+  }
+  if (peak_stress <= 0 || peak_strain <= 0) return;
+  const double modulus = peak_stress / peak_strain;
+  const double to_response = strain_control ? modulus : 1.0 / modulus;  // response per unit of command
+  const double tol = 4 * noise_from_second_differences(response) + 1e-9 * (hi - lo);
+  const double duration = t.time_s.back() - t.time_s.front();
+  // Time-weighted mean of the command over [a, b] (each sample holds until the next).
+  const auto mean = [&](double a, double b) {
+    double sum = 0, w = 0;
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+      const double from = std::max(a, t.time_s[k]), to = std::min(b, t.time_s[k + 1]);
+      if (to > from) {
+        sum += command[k] * (to - from);
+        w += to - from;
+      }
+    }
+    return w > 0 ? sum / w : 0.0;
+  };
+  std::size_t start = 0;
+  for (std::size_t k = 1; k <= n; ++k) {
+    if (k < n && std::abs(response[k] - response[start]) <= tol) continue;
+    const std::size_t end = k - 1;  // response held over [start, end]
+    const double t0 = t.time_s[start], t1 = t.time_s[end], quarter = (t1 - t0) / 4;
+    if (end >= start + 4 && t1 - t0 >= 0.2 * duration) {
+      const double moved = std::abs(mean(t1 - quarter, t1) - mean(t0, t0 + quarter));
+      if (moved * to_response > 10 * tol)
+        entry.fail("control", std::string("'") + to_string(t.control) + "' claimed for " + t.file + ", but its " +
+                                  (strain_control ? "stress" : "strain") + " is held from " + common::short_number(t0) + " to " +
+                                  common::short_number(t1) + " s while its " + (strain_control ? "strain" : "stress") + " moves by " +
+                                  common::short_number(moved) + (strain_control ? "" : " Pa") + ": that is a " +
+                                  (strain_control ? "creep (stress-controlled)" : "relaxation (strain-controlled)") +
+                                  " test; is \"control\" the other one?");
+    }
+    start = k;
+  }
+}
+
 }  // namespace
+
+double noise_from_second_differences(const std::vector<double>& v) {
+  std::vector<double> d2;
+  for (std::size_t k = 2; k < v.size(); ++k) d2.push_back(std::abs(v[k] - 2 * v[k - 1] + v[k - 2]));
+  if (d2.empty()) return 0.0;
+  std::nth_element(d2.begin(), d2.begin() + static_cast<long>(d2.size() / 2), d2.end());
+  return d2[d2.size() / 2] / 0.6745 / std::sqrt(6.0);
+}
 
 Dataset read_dataset(const std::string& folder) {
   const std::string meta = (std::filesystem::path(folder) / "dataset.json").string();
@@ -193,6 +255,7 @@ Dataset read_dataset(const std::string& folder) {
     const Control control = t.choice("control", {"strain", "stress"}, "") == "strain" ? Control::strain : Control::stress;
     d.tests.push_back(read_csv(test_path(folder, file, t), file, control));
     const TestData& added = d.tests.back();
+    check_control(added, t);
     const double span = added.time_s.back() - added.time_s.front();
     if (span > max_duration_s)
       throw InputError((std::filesystem::path(folder) / file).string(), 0, "time_s",

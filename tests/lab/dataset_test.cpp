@@ -1,5 +1,6 @@
 // Data-set reading: the real titin data, and every kind of bad input named by file, line, field.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -98,6 +99,32 @@ TEST(Dataset, BadInputNamesFileLineAndField) {
     const std::string msg = error_of(make(c.name, c.json, c.csv));
     EXPECT_NE(msg.find(c.expect), std::string::npos) << c.name << ": " << msg;
   }
+}
+
+TEST(Dataset, AControlThatCannotBeTheTestsIsRefused) {
+  // A relaxation test (strain ramped in 1 s and held, the stress decaying) declared stress-
+  // controlled, and a creep test (stress ramped and held, the strain creeping) declared
+  // strain-controlled: the column said to respond is held while the commanded one changes.
+  std::string relaxation = "time_s,strain,stress_pa\n", creep = relaxation;
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.1 * k, ramp = std::min(t, 1.0);
+    char line[160];
+    std::snprintf(line, sizeof line, "%.2f,%.6f,%.4f\n", t, 0.1 * ramp, 1000 * 0.1 * ramp * (t > 1 ? 0.5 + 0.5 * std::exp(-(t - 1)) : 1.0));
+    relaxation += line;
+    std::snprintf(line, sizeof line, "%.2f,%.6f,%.4f\n", t, 0.01 * ramp + (t > 1 ? 0.01 * (1 - std::exp(-(t - 1))) : 0.0), 100 * ramp);
+    creep += line;
+  }
+  const std::string stress_json =
+      R"({"name": "x", "mode": "uniaxial", "specimen": {"length_m": 0.01, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": [{"file": "a.csv", "control": "stress"}, {"file": "b.csv", "control": "strain"}]})";
+  const std::string relaxation_error = error_of(make("relaxation_as_stress", stress_json, relaxation));
+  EXPECT_NE(relaxation_error.find("tests[0]"), std::string::npos) << relaxation_error;
+  EXPECT_NE(relaxation_error.find("control"), std::string::npos) << relaxation_error;
+  EXPECT_NE(relaxation_error.find("relaxation (strain-controlled)"), std::string::npos) << relaxation_error;
+  const std::string creep_error = error_of(make("creep_as_strain", kJson, creep));
+  EXPECT_NE(creep_error.find("creep (stress-controlled)"), std::string::npos) << creep_error;
+  // Declared as what they are, both read.
+  EXPECT_EQ(error_of(make("relaxation_as_strain", kJson, relaxation)), "no error");
+  EXPECT_EQ(error_of(make("creep_as_stress", stress_json, creep)), "no error");
 }
 
 TEST(Dataset, TitinAnalysisNamesBroadbandRelaxationAndStrainStiffening) {

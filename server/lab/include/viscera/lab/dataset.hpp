@@ -32,6 +32,10 @@ Dataset read_dataset(const std::string& folder);
 /// Writes a data set in the same format (used by the synthetic generator).
 void write_dataset(const Dataset& d, const std::string& folder);
 
+/// Noise of a sampled quantity from its second differences (the median absolute value, robust
+/// to the changes of a command): the SD for white noise.
+double noise_from_second_differences(const std::vector<double>& v);
+
 const char* to_string(Mode m);
 const char* to_string(Control c);
 
