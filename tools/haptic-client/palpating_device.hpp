@@ -2,9 +2,10 @@
 // A virtual device that palpates the organ from above to find what is stiffer inside it, as a
 // trainee's hand would: at each point of a grid over the organ's top (2 cm apart, then 1 cm apart
 // around the stiffest), it comes down until it touches, presses DEPTH further, notes the force it
-// feels there and lifts off; then it presses at the stiffest point and marks it (button 1). It
+// feels half way (deeper, the tip slips off a stiff spot on a coarse mesh) and lifts off; then it
+// presses at the stiffest point and marks it (button 1). It
 // never reads the scene's regions: only the forces tell it where the nodule is. Where the surface
-// slopes steeply (the force it feels leans more than about 37 degrees from the vertical) or the
+// slopes steeply (the force it feels half way leans more than about 37 degrees from the vertical) or the
 // force passes a safe 2 N before DEPTH, the point is left out: a hand presses along the surface's
 // normal, and a vertical press into a slope measures the slope, not the tissue.
 #include <string>
@@ -26,8 +27,9 @@ class PalpatingDevice : public client::Device {
   enum class Phase { travel, descend, press, dwell, lift, done };
   struct Probe {
     double x = 0, y = 0;
-    double force_n = -1;  ///< felt at DEPTH beyond contact; -1: not yet, or no tissue there
+    double force_n = -1;  ///< what the point is judged by: the force at DEPTH / 2; -1: not yet, no tissue, or steep
     double half_force_n = 0;  ///< felt at DEPTH / 2
+    bool half_vertical = false;  ///< ... and mostly vertical there
   };
   void next_point();
   void add_neighbours(double x, double y, double spacing);
