@@ -67,16 +67,6 @@ int main(int argc, char** argv) {
     test::write_lab_dataset(seed, truth, size, folder);
     return analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});
   };
-  const auto right = [](test::LabTruth truth, const Analysis& a) {
-    const auto expected = test::expected_causes(truth);
-    if (expected.size() != a.causes.size()) return false;
-    for (const auto& e : expected) {
-      bool found = false;
-      for (Mechanism m : a.causes) found |= e == name(m);
-      if (!found) return false;
-    }
-    return true;
-  };
   std::printf("| truth | in the lab's forms | size | right | named instead (count) |\n|---|---|---|---|---|\n");
   const std::vector<test::LabTruth> truths = {test::LabTruth::exponential_stiffening,
                                               test::LabTruth::polynomial_stiffening,
@@ -92,7 +82,7 @@ int main(int argc, char** argv) {
       std::map<std::string, int> instead;
       for (int s = 1; s <= seeds; ++s) {
         const Analysis a = run(truth, size, static_cast<unsigned>(s));
-        if (right(truth, a))
+        if (test::names_expected_causes(truth, a.causes))
           ++ok;
         else
           ++instead[causes_of(a)];

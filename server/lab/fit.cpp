@@ -81,23 +81,6 @@ Eigen::VectorXd row_weights(const TestData* t, const HeldOutRows& held, double s
   return kept > 0 ? Eigen::VectorXd(w * (scale / std::sqrt(kept))) : w;
 }
 
-void assign(MaterialModel& m, const Eigen::VectorXd& x) {
-  const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
-  m.modulus_pa = x(0);
-  m.viscosity_pa_s = x(1);
-  m.relaxation_modulus_pa.assign(L, 0.0);
-  for (std::size_t l = 0; l < L; ++l) m.relaxation_modulus_pa[l] = x(static_cast<Eigen::Index>(2 + l));
-}
-
-Eigen::VectorXd coefficients_of(const MaterialModel& m) {
-  const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
-  Eigen::VectorXd x(static_cast<Eigen::Index>(2 + L));
-  x(0) = m.modulus_pa;
-  x(1) = m.viscosity_pa_s;
-  for (std::size_t l = 0; l < L; ++l) x(static_cast<Eigen::Index>(2 + l)) = m.relaxation_modulus_pa[l];
-  return x;
-}
-
 Eigen::MatrixXd linear_rows(const MaterialModel& m, const Problem& p) {
   Eigen::Index rows = 0;
   for (const TestData* t : p.linear) rows += static_cast<Eigen::Index>(t->time_s.size());
@@ -116,7 +99,7 @@ Eigen::MatrixXd linear_rows(const MaterialModel& m, const Problem& p) {
 double solve_linear(MaterialModel& m, const Problem& p) {
   const Eigen::MatrixXd A = linear_rows(m, p);
   const Eigen::VectorXd x = nonnegative_least_squares(A, p.b);
-  assign(m, x);
+  set_linear_coefficients(m, x);
   return (A * x - p.b).squaredNorm();
 }
 
@@ -141,20 +124,20 @@ void refine_on_measured(MaterialModel& m, const Problem& p) {
   const Eigen::MatrixXd A = linear_rows(m, p);
   const auto cost = [&](const MaterialModel& x) {
     const Eigen::VectorXd c = creep_residual(x, p);
-    return (A.rows() ? (A * coefficients_of(x) - p.b).squaredNorm() : 0.0) + c.squaredNorm();
+    return (A.rows() ? (A * linear_coefficients(x) - p.b).squaredNorm() : 0.0) + c.squaredNorm();
   };
   double scale = 0.0;  // a modulus typical of the tests, for the difference steps
   for (const TestData* t : p.creep) scale = std::max(scale, apparent_modulus_pa(*t));
   double current = cost(m);
   for (int it = 0; it < 20; ++it) {
-    const Eigen::VectorXd x = coefficients_of(m), r = creep_residual(m, p);
+    const Eigen::VectorXd x = linear_coefficients(m), r = creep_residual(m, p);
     Eigen::MatrixXd J(r.size(), x.size());
     for (Eigen::Index j = 0; j < x.size(); ++j) {
       Eigen::VectorXd xs = x;
       const double h = 1e-6 * std::max(std::abs(x(j)), j == 1 ? 1e-2 * scale : scale);
       xs(j) += h;
       MaterialModel ms = m;
-      assign(ms, xs);
+      set_linear_coefficients(ms, xs);
       J.col(j) = (creep_residual(ms, p) - r) / h;
     }
     Eigen::MatrixXd M(A.rows() + J.rows(), x.size());
@@ -165,7 +148,7 @@ void refine_on_measured(MaterialModel& m, const Problem& p) {
     bool improved = false;
     for (double f = 1.0; f > 1e-3; f *= 0.5) {
       MaterialModel trial = m;
-      assign(trial, (x + f * step).cwiseMax(0.0));
+      set_linear_coefficients(trial, (x + f * step).cwiseMax(0.0));
       const double c = cost(trial);
       if (c < current) {
         improved = current - c > 1e-10 * current;

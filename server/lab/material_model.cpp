@@ -131,8 +131,7 @@ Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t) {
   return A;
 }
 
-namespace {
-Eigen::VectorXd coefficients(const MaterialModel& m) {
+Eigen::VectorXd linear_coefficients(const MaterialModel& m) {
   const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
   Eigen::VectorXd c(static_cast<Eigen::Index>(2 + L));
   c(0) = m.modulus_pa;
@@ -140,10 +139,17 @@ Eigen::VectorXd coefficients(const MaterialModel& m) {
   for (std::size_t l = 0; l < L; ++l) c(static_cast<Eigen::Index>(2 + l)) = m.relaxation_modulus_pa[l];
   return c;
 }
-}  // namespace
+
+void set_linear_coefficients(MaterialModel& m, const Eigen::VectorXd& c) {
+  const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
+  m.modulus_pa = c(0);
+  m.viscosity_pa_s = c(1);
+  m.relaxation_modulus_pa.assign(L, 0.0);
+  for (std::size_t l = 0; l < L; ++l) m.relaxation_modulus_pa[l] = c(static_cast<Eigen::Index>(2 + l));
+}
 
 std::vector<double> predict_stress(const MaterialModel& m, const TestData& t) {
-  const Eigen::VectorXd y = basis(m, t) * coefficients(m);
+  const Eigen::VectorXd y = basis(m, t) * linear_coefficients(m);
   return {y.data(), y.data() + y.size()};
 }
 

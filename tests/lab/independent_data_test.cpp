@@ -17,17 +17,6 @@ using namespace viscera::lab;
 
 namespace {
 
-bool named_right(test::LabTruth truth, const Analysis& a) {
-  const auto expected = test::expected_causes(truth);
-  if (expected.size() != a.causes.size()) return false;
-  for (const auto& e : expected) {
-    bool found = false;
-    for (Mechanism m : a.causes) found |= e == name(m);
-    if (!found) return false;
-  }
-  return true;
-}
-
 Analysis analyze_truth(test::LabTruth truth, unsigned seed) {
   const std::string folder = std::string(VISCERA_TEST_TMP) + "/independent/" + test::name(truth) + "_" + std::to_string(seed);
   std::filesystem::remove_all(folder);
@@ -44,7 +33,7 @@ TEST(IndependentData, CausesAreNamedAtTodaysSizesInsideAndOutsideTheLabsForms) {
         test::LabTruth::recovering_softening, test::LabTruth::broadband, test::LabTruth::power_law, test::LabTruth::broadband_and_stiffening})
     for (unsigned seed = 1; seed <= 4; ++seed) {
       const Analysis a = analyze_truth(truth, seed);
-      const bool right = named_right(truth, a);
+      const bool right = test::names_expected_causes(truth, a.causes);
       (test::out_of_family(truth) ? out_right : in_right) += right;
       (test::out_of_family(truth) ? out_total : in_total) += 1;
       std::cout << "[ " << test::name(truth) << " seed " << seed << " ] named";

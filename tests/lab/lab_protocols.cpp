@@ -37,6 +37,17 @@ std::vector<std::string> expected_causes(LabTruth t) {
   return {};
 }
 
+bool names_expected_causes(LabTruth t, const std::vector<Mechanism>& causes) {
+  const auto expected = expected_causes(t);
+  if (expected.size() != causes.size()) return false;
+  for (const auto& e : expected) {
+    bool found = false;
+    for (Mechanism m : causes) found |= e == name(m);
+    if (!found) return false;
+  }
+  return true;
+}
+
 bool out_of_family(LabTruth t) { return t == LabTruth::polynomial_stiffening || t == LabTruth::recovering_softening || t == LabTruth::power_law; }
 
 namespace {

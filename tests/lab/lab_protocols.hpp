@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "viscera/lab/dataset.hpp"
+#include "viscera/lab/material_model.hpp"
 
 namespace viscera::lab::test {
 
@@ -33,6 +34,8 @@ enum class LabTruth {
 const char* name(LabTruth t);
 /// What the lab should name for this truth (mechanism names, strongest expected first; empty: none).
 std::vector<std::string> expected_causes(LabTruth t);
+/// Whether `causes` (the lab's verdict) are exactly the ones expected for the truth, in any order.
+bool names_expected_causes(LabTruth t, const std::vector<Mechanism>& causes);
 /// Whether the truth lies outside the lab's candidate forms.
 bool out_of_family(LabTruth t);
 

@@ -79,6 +79,10 @@ std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<doub
 /// command path (command_path.hpp).
 Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t);
 
+/// The parameters the stress is linear in, in basis() column order: E, eta, E_l.
+Eigen::VectorXd linear_coefficients(const MaterialModel& m);
+void set_linear_coefficients(MaterialModel& m, const Eigen::VectorXd& c);
+
 /// Stress from the measured strain (the equation the fit minimises, for any control).
 std::vector<double> predict_stress(const MaterialModel& m, const TestData& t);
 
