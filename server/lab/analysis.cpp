@@ -198,10 +198,12 @@ ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d, HeldO
       for (std::size_t j = folds[f].begin; j < folds[f].end; ++j) predicted[folds[f].test][j] = y[j];
     }
   };
-  auto half = std::async(std::launch::async, [&] { run(0, 2); });
+  auto half = std::async(std::launch::async, [&] {
+    run(0, 2);
+    return fit_model(structure, all);  // and the fit to everything
+  });
   run(1, 2);
-  half.get();
-  auto full = std::async(std::launch::deferred, [&] { return fit_model(structure, all); });
+  ev.model = half.get();
   std::vector<double> heldout(d.tests.size());
   for (std::size_t k = 0; k < d.tests.size(); ++k) {
     const TestData& t = d.tests[k];
@@ -210,7 +212,6 @@ ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d, HeldO
     for (std::size_t j = 0; j < measured.size(); ++j) sq += (predicted[k][j] - measured[j]) * (predicted[k][j] - measured[j]);
     heldout[k] = std::sqrt(sq / static_cast<double>(measured.size())) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t));
   }
-  ev.model = full.get();
   for (std::size_t k = 0; k < d.tests.size(); ++k) {
     const TestData& t = d.tests[k];
     TestFigures f{t.file, rms_error_pa(ev.model, t), heldout[k], noise_level_pa(t)};
