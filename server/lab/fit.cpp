@@ -223,7 +223,7 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
     // best fit is kept.
     std::vector<StiffeningForm> forms{m.stiffening_form};
     if (m.has(Mechanism::strain_stiffening)) {
-      forms = {StiffeningForm::odd_exponential, StiffeningForm::odd_polynomial};
+      forms = {StiffeningForm::odd_exponential, StiffeningForm::odd_polynomial, StiffeningForm::ogden};
       if (!m.odd_only) forms.insert(forms.begin(), StiffeningForm::exponential);
     }
     MaterialModel best;

@@ -32,12 +32,13 @@ const char* name(StiffeningForm f) {
     case StiffeningForm::exponential: return "exponential";
     case StiffeningForm::odd_exponential: return "odd_exponential";
     case StiffeningForm::odd_polynomial: return "odd_polynomial";
+    case StiffeningForm::ogden: return "ogden";
   }
   return "?";
 }
 
 bool parse_stiffening_form(const std::string& s, StiffeningForm* out) {
-  for (StiffeningForm f : {StiffeningForm::exponential, StiffeningForm::odd_exponential, StiffeningForm::odd_polynomial})
+  for (StiffeningForm f : {StiffeningForm::exponential, StiffeningForm::odd_exponential, StiffeningForm::odd_polynomial, StiffeningForm::ogden})
     if (s == name(f)) {
       *out = f;
       return true;
@@ -59,6 +60,20 @@ int MaterialModel::parameter_count() const {
   return n;
 }
 
+namespace {
+// Ogden's one-term incompressible response with exponent a, normalised to slope 1 at rest:
+// uniaxial nominal stress over 3 mu, or the simple-shear stress over mu (docs in the header).
+double ogden_response(double a, double e, bool shear) {
+  if (shear) {
+    const double l = 0.5 * e + std::sqrt(1 + 0.25 * e * e);
+    return 2 / a * (std::pow(l, a) - std::pow(l, -a)) / (l + 1 / l);
+  }
+  const double l = 1 + e;
+  if (l <= 1e-6) return -1e300;  // a specimen compressed to nothing
+  return 2 / (3 * a) * (std::pow(l, a - 1) - std::pow(l, -a / 2 - 1));
+}
+}  // namespace
+
 double ElasticShape::value(double e) const {
   double v = e;
   if (m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0) {
@@ -67,6 +82,7 @@ double ElasticShape::value(double e) const {
       case StiffeningForm::exponential: v = std::expm1(B * e) / B; break;
       case StiffeningForm::odd_exponential: v = std::copysign(std::expm1(B * std::abs(e)) / B, e); break;
       case StiffeningForm::odd_polynomial: v = e * (1 + B * B * e * e / 6); break;
+      case StiffeningForm::ogden: v = ogden_response(B, e, m.odd_only); break;
     }
   }
   if (m.has(Mechanism::tension_compression_asymmetry) && e < 0) v *= m.compression_ratio;

@@ -20,6 +20,10 @@ namespace viscera::lab {
 using namespace viscera::tissue;
 
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
+  if (m.has(Mechanism::strain_stiffening) && m.stiffening_form == StiffeningForm::ogden) {
+    *why = "the GPS's energy form has the exponential and odd laws (gps/fung_map.hpp), not Ogden's: not simulated on the specimen";
+    return false;
+  }
   const bool shaped = m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry);
   const bool even_part =
       m.has(Mechanism::tension_compression_asymmetry) || (m.has(Mechanism::strain_stiffening) && m.stiffening_form == StiffeningForm::exponential);
@@ -43,6 +47,7 @@ StiffeningShape gps_shape(StiffeningForm f) {
     case StiffeningForm::exponential: return StiffeningShape::exponential;
     case StiffeningForm::odd_exponential: return StiffeningShape::odd_exponential;
     case StiffeningForm::odd_polynomial: return StiffeningShape::odd_polynomial;
+    case StiffeningForm::ogden: break;  // not on the specimen (specimen_supports)
   }
   return StiffeningShape::exponential;
 }

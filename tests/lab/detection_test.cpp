@@ -72,6 +72,32 @@ TEST(HiddenEffect, ContinuousPowerLawRelaxationOutsideTheFamilyIsNamedBroadband)
   EXPECT_GE(correct, 9);
 }
 
+TEST(StiffeningForms, OgdensFormIsNeoHookeanAtExponent2AndOddInShear) {
+  // At exponent 2 a one-term incompressible Ogden solid is neo-Hookean: uniaxial nominal stress
+  // mu (l - l^-2) (E = 3 mu), simple-shear stress mu g, exactly linear. The lab's form, normalised
+  // to slope 1, against those closed forms; in shear odd at any exponent; slope 1 at rest.
+  MaterialModel m;
+  m.mechanisms = 1u << static_cast<unsigned>(Mechanism::strain_stiffening);
+  m.stiffening_form = StiffeningForm::ogden;
+  m.stiffening_b = 2.0;
+  for (const double e : {-0.4, -0.1, 0.05, 0.3}) {
+    m.odd_only = false;
+    EXPECT_NEAR(ElasticShape{m}.value(e), ((1 + e) - 1 / ((1 + e) * (1 + e))) / 3, 1e-14) << e;
+    m.odd_only = true;
+    EXPECT_NEAR(ElasticShape{m}.value(e), e, 1e-14) << e;
+  }
+  for (const double a : {0.5, 8.0, 25.0})
+    for (const bool shear : {false, true}) {
+      m.stiffening_b = a;
+      m.odd_only = shear;
+      const double h = 1e-6;
+      EXPECT_NEAR((ElasticShape{m}.value(h) - ElasticShape{m}.value(-h)) / (2 * h), 1.0, 1e-8) << a;
+      if (shear) {
+        EXPECT_NEAR(ElasticShape{m}.value(-0.2), -ElasticShape{m}.value(0.2), 1e-12) << a;
+      }
+    }
+}
+
 TEST(Specimen, TetrahedralSpecimenAgreesWithTheMaterialPointLaw) {
   // Two code paths for the same model: the GPS on a meshed specimen (implicit, inertia, memory
   // variables) and the lab's material-point law, each run along the test's command path: their

@@ -71,8 +71,9 @@ int main(int argc, char** argv) {
     }
     if (positional[0] == "predict") {
       if (positional.size() != 3) return usage_error("predict takes MODEL_JSON and DATASET_DIR");
-      const MaterialModel m = read_model(positional[1]);
+      MaterialModel m = read_model(positional[1]);
       const Dataset d = read_dataset(positional[2]);
+      m.odd_only = d.mode == Mode::simple_shear;  // Ogden's form responds as the data's mode loads it
       write_prediction(m, positional[1], d, out);
       std::printf("wrote %s/report.json\n", out.c_str());
       return 0;

@@ -67,7 +67,7 @@ MaterialModel read_model(const std::string& path) {
   if (m.has(Mechanism::strain_stiffening)) {
     m.stiffening_b = top.number("stiffening_b", 0.0, big);
     // Files from before the forms existed are Fung's exponential.
-    const std::string form = top.choice("stiffening_form", {"exponential", "odd_exponential", "odd_polynomial"}, "exponential");
+    const std::string form = top.choice("stiffening_form", {"exponential", "odd_exponential", "odd_polynomial", "ogden"}, "exponential");
     parse_stiffening_form(form, &m.stiffening_form);
   }
   if (m.has(Mechanism::tension_compression_asymmetry)) {

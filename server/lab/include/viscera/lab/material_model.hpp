@@ -10,9 +10,13 @@
 //                                   exponential (Fung, 1D): s = (exp(B eps) - 1) / B
 //                                   odd exponential:        s = sign(eps) (exp(B |eps|) - 1) / B
 //                                   odd polynomial:         s = eps (1 + B^2 eps^2 / 6)
-//                                 (same slope and curvature of stiffness at small B eps); in simple
-//                                 shear only the odd forms (an isotropic solid's shear stress is odd
-//                                 in the shear strain)
+//                                   Ogden (one term, incompressible, exponent a = B), normalised to
+//                                   s'(0) = 1: uniaxial, with the stretch l = 1 + eps,
+//                                     s = 2/(3a) (l^(a-1) - l^(-a/2-1));
+//                                   simple shear, with l = g/2 + sqrt(1 + g^2/4),
+//                                     s = 2/a (l^a - l^-a) / (l + 1/l)   (odd in g)
+//                                 in simple shear only the odd forms and Ogden's shear response (an
+//                                 isotropic solid's shear stress is odd in the shear strain)
 //   tension_compression_asymmetry s = eps (eps >= 0), r eps (eps < 0)
 //   first_load_softening          s = eps on the virgin curve, (1 - d (1 - |eps|/m)) eps below the
 //                                 previous extreme m (Ogden-Roxburgh-like softening on reloading)
@@ -34,7 +38,7 @@ const char* name(Mechanism m);
 /// Parses a mechanism name; false if unknown.
 bool parse_mechanism(const std::string& s, Mechanism* out);
 
-enum class StiffeningForm { exponential, odd_exponential, odd_polynomial };
+enum class StiffeningForm { exponential, odd_exponential, odd_polynomial, ogden };
 const char* name(StiffeningForm f);
 /// Parses a form's name; false if unknown.
 bool parse_stiffening_form(const std::string& s, StiffeningForm* out);
@@ -42,7 +46,8 @@ bool parse_stiffening_form(const std::string& s, StiffeningForm* out);
 struct MaterialModel {
   unsigned mechanisms = 0;  ///< bit (1 << Mechanism)
   /// The data's elastic response must be odd in the strain (simple shear of an isotropic solid):
-  /// the fit offers only odd stiffening forms. Set from the data set's mode.
+  /// the fit offers only odd stiffening forms, and Ogden's form is its shear response. Set from
+  /// the data set's mode.
   bool odd_only = false;
   StiffeningForm stiffening_form = StiffeningForm::exponential;
   double stiffening_b = 0.0;
