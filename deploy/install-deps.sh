@@ -20,6 +20,8 @@ packages=(
   clang-format clang-tidy  # lint tests: the layout of every C++ file, clang-tidy on recent changes
   libzstd-dev liblz4-dev   # MCAP chunk compression (zstd, lz4) in session recordings
   libssl-dev               # SHA-256 of the files a scene was built from (recordings name them)
+  libboost-dev             # Boost.Beast: the console's HTTP and WebSocket server (header-only)
+  chromium                 # the browser tests of the console page (headless, driven by playwright-core)
 )
 # Node.js and npm: the official MCAP reader (@mcap/core) that judges recordings in the tests. Debian's
 # packages, unless a node and an npm are on the PATH already (a NodeSource install bundles npm).
@@ -45,12 +47,14 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# npm packages the tests run (tests/node/package.json, pinned by its lock file): installed again only
-# when the lock file changed.
+# npm packages, each folder pinned by its lock file and installed again only when the lock file
+# changed: tests/node (what the tests run: the MCAP reader, playwright-core, ws, the Foxglove
+# client) and the console page's (three.js, uPlot, esbuild), which the build bundles.
 root="$(cd "$(dirname "$0")/.." && pwd)"
-node_dir="$root/tests/node"
-if ! cmp -s "$node_dir/package-lock.json" "$node_dir/node_modules/.installed-lock.json"; then
-  echo "install-deps: npm ci in tests/node" >&2
-  (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
-  cp "$node_dir/package-lock.json" "$node_dir/node_modules/.installed-lock.json"
-fi
+for node_dir in "$root/tests/node" "$root/tools/viscera-console/web"; do
+  if ! cmp -s "$node_dir/package-lock.json" "$node_dir/node_modules/.installed-lock.json"; then
+    echo "install-deps: npm ci in ${node_dir#"$root"/}" >&2
+    (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+    cp "$node_dir/package-lock.json" "$node_dir/node_modules/.installed-lock.json"
+  fi
+done

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "viscera/client/client.hpp"
+#include "viscera/client/session_limits.hpp"
 #include "viscera/common/command_line.hpp"
 
 namespace {
@@ -90,25 +91,20 @@ Request parse(const viscera::common::CommandLine& cl) {
   if (k == known.end()) throw UsageError("ACTION '" + r.action + "' is not " + actions);
   if (k->second != (rest.size() == 2)) throw UsageError(k->second ? r.action + " needs its argument" : "unexpected argument '" + rest.back() + "'");
   if (rest.size() == 2) r.argument = rest[1];
-  if (r.action == "annotate" && r.argument.size() > 1024) throw UsageError("TEXT is " + std::to_string(r.argument.size()) + " bytes (at most 1024)");
-  const auto material_flag = [&](const char* name, double lo, double hi, std::optional<double>& out) {
-    if (cl.has(name)) out = cl.number_in(name, lo, hi);
-  };
-  material_flag("youngs-modulus-pa", 1.0, 1e9, r.change.youngs_modulus_pa);
-  material_flag("poisson-ratio", 0.0, 0.4999, r.change.poisson_ratio);
-  material_flag("density-kg-m3", 1.0, 1e5, r.change.density_kg_m3);
-  material_flag("shear-q", 0.5, 1e4, r.change.shear_q);
-  material_flag("damping-per-s", 0.0, 1e4, r.change.damping_per_s);
+  if (r.action == "annotate" && r.argument.size() > viscera::client::kMaxAnnotationBytes)
+    throw UsageError("TEXT is " + std::to_string(r.argument.size()) + " bytes (at most 1024)");
+  for (const auto& p : viscera::client::material_parameters())
+    if (cl.has(p.name)) {
+      const double v = cl.number(p.name);
+      if (const auto why = viscera::client::outside_range(std::string("--") + p.name, v, p.lo, p.hi)) throw UsageError(*why);
+      r.change.*p.field = v;
+    }
   if ((r.action == "material") != !r.change.empty())
     throw UsageError(r.action == "material"
                          ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
                          : "material flags are for the material action");
   if (r.action == "load") {
-    const std::string& n = r.argument;
-    const bool plain = !n.empty() && n.size() <= 64 && n[0] != '.' && std::all_of(n.begin(), n.end(), [](char c) {
-      return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
-    });
-    if (!plain) throw UsageError("SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)");
+    if (!viscera::client::is_scene_name(r.argument)) throw UsageError(viscera::client::not_a_scene_name(r.argument));
     if (cl.has("seed")) r.seed = static_cast<std::uint64_t>(cl.number_in("seed", 0, 9007199254740991.0));
   } else if (cl.has("seed")) {
     throw UsageError("--seed is for the load action");
@@ -226,11 +222,7 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
   cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
   cl.flag("seed", "N", "load: the seed of the scene's drawn material regions (a hidden nodule elsewhere; default: the scene file's)");
-  cl.flag("youngs-modulus-pa", "E", "material: Young's modulus [Pa] (isotropic materials)");
-  cl.flag("poisson-ratio", "NU", "material: Poisson's ratio (isotropic materials)");
-  cl.flag("density-kg-m3", "RHO", "material: density [kg/m^3]");
-  cl.flag("shear-q", "Q", "material: quality factor in shear (constant-Q materials)");
-  cl.flag("damping-per-s", "A", "material: mass-proportional damping [1/s]");
+  for (const auto& p : viscera::client::material_parameters()) cl.flag(p.name, p.value_name, std::string("material: ") + p.help);
   cl.allow_positional(2);
   try {
     if (!cl.parse(argc, argv)) return 0;

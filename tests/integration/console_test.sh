@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Integration, separate processes over a real DDS domain and a real browser: viscera-server, a
+# scripted haptic client pressing the liver, and viscera-console; the page opened in Debian's
+# headless Chromium by playwright-core (tests/node/console_page.mjs: refused without the token, the
+# mesh moves, the force plot rises, Pause pauses the server as its scene state says, a bookmark
+# reaches the events, the material form changes the tissue), then misbehaving browsers against
+# the bridge (tests/node/console_robustness.mjs: a slow one, malformed messages, an oversized one,
+# a flood, a wrong token) while a well-behaved one keeps receiving frames. Also the console's
+# refusals of a bad command line and token file.
+# Usage: console_test.sh BUILD_DIR SOURCE_DIR    (SHOTS=DIR keeps the page's screenshots)
+set -u
+build="$1"; src="$2"
+. "$(dirname "$0")/common.sh"
+pids=()
+trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+console="$build/tools/viscera-console/viscera-console"
+node_dir="$src/tests/node"
+[ -d "$node_dir/node_modules/playwright-core" ] || { echo "FAIL playwright-core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }
+command -v chromium >/dev/null || { echo "FAIL chromium is not installed (deploy/install-deps.sh installs Debian's chromium)"; exit 1; }
+
+# Refusals before anything runs.
+"$console" --help > "$tmp/help.txt"; rc=$?
+check "--help" '[ $rc -eq 0 ] && grep -q -- "--token-file" "$tmp/help.txt"'
+"$console" --token-file "$tmp/none" > "$tmp/e1.txt" 2>&1; rc=$?
+check "a missing token file is named" '[ $rc -eq 2 ] && grep -q "$tmp/none: --token-file: cannot be read" "$tmp/e1.txt"'
+echo short > "$tmp/short"
+"$console" --token-file "$tmp/short" > "$tmp/e2.txt" 2>&1; rc=$?
+check "a short token is refused" '[ $rc -eq 2 ] && grep -q "short:1: token: has 5 characters (at least 32" "$tmp/e2.txt"'
+openssl rand -hex 16 > "$tmp/token"
+"$console" --token-file "$tmp/token" --listen 127.0.0.1:99999 > "$tmp/e3.txt" 2>&1; rc=$?
+check "a bad --listen is refused" '[ $rc -eq 2 ] && grep -q "port is not in" "$tmp/e3.txt"'
+cat "$tmp/e1.txt" "$tmp/e2.txt" "$tmp/e3.txt"
+
+"$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 & pids+=($!)
+"$console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 > "$tmp/console.log" 2>&1 & bridge=$!; pids+=($bridge)
+wait_for "open http" "$tmp/console.log" || exit 1
+url=$(grep -o "http://[^ ]*" "$tmp/console.log")
+sleep 1
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 --duration 40 --quiet \
+  > "$tmp/haptic.log" 2>&1 & pids+=($!)
+shots="${SHOTS:-$tmp}"; mkdir -p "$shots"
+node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
+check "the page in Chromium (console_page.mjs)" '[ $rc_page -eq 0 ]'
+node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?
+check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
+check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'
+check "the server rejected nothing" 'grep "Hz physics" "$tmp/server.log" | tail -1 | grep -q "rejected 0 "'
+python3 - "$tmp/page.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+l = d["frame_delay_ms"]
+print(f"frame delay, server to page: p50 {l['p50']:.1f} ms, p99 {l['p99']:.1f} ms over {d['frames']} frames")
+PY
+echo "passed $passed, failed $failures"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,160 @@
+// viscera-console: the instructor's console in the browser. A client of the DDS domain (through
+// the client SDK) that serves the console page and a WebSocket to browsers: the organ's surface
+// live, instruments, forces, health and events out; pause, resume, reset, load a scene, change the
+// material, annotate and bookmark in (docs/CONSOLE.md).
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
+#include "viscera/console/access_token.hpp"
+
+#include "station.hpp"
+#include "web_server.hpp"
+
+#ifndef VISCERA_CONSOLE_WEB_DIR
+#define VISCERA_CONSOLE_WEB_DIR ""
+#endif
+
+namespace {
+
+namespace asio = boost::asio;
+using viscera::common::UsageError;
+
+/// "ADDRESS:PORT" (an IPv6 address in brackets: "[::1]:8080").
+asio::ip::tcp::endpoint parse_listen(const std::string& s) {
+  const auto colon = s.rfind(':');
+  if (colon == std::string::npos) throw UsageError("--listen '" + s + "' is not ADDRESS:PORT");
+  std::string host = s.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(host, ec);
+  if (ec) throw UsageError("--listen '" + s + "': '" + host + "' is not an IP address");
+  char* end = nullptr;
+  const long port = std::strtol(s.c_str() + colon + 1, &end, 10);
+  if (*end || colon + 1 == s.size() || port < 0 || port > 65535) throw UsageError("--listen '" + s + "': the port is not in [0, 65535]");
+  return {address, static_cast<unsigned short>(port)};
+}
+
+/// The page's files from the web folder the build made (index.html, console.js, console.css).
+std::map<std::string, std::string> read_page(const std::string& dir) {
+  std::map<std::string, std::string> files;
+  for (const char* name : {"index.html", "console.js", "console.css"}) {
+    const std::string path = dir + "/" + name;
+    if (!std::filesystem::exists(path))
+      throw viscera::common::InputError(dir, 0, "--web-root",
+                                        std::string(name) + " is missing (the build makes it from tools/viscera-console/web: npm ci there)");
+    files["/" + std::string(name)] = viscera::common::read_text_file(path, 16u << 20);
+  }
+  return files;
+}
+
+std::vector<std::string> split(const std::string& s, char c) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string part; std::getline(in, part, c);) out.push_back(part);
+  if (s.empty() || s.back() == c) out.emplace_back();
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  viscera::common::CommandLine cl("viscera-console",
+                                  "The instructor's console: serves a web page that shows a running viscera-server live (the organ deforming, the\n"
+                                  "instruments and their forces, health, events) and steers it (pause, resume, reset, load a scene, change the\n"
+                                  "material, annotate, bookmark). Open the address it prints; it carries the access token.");
+  cl.flag("domain", "ID", "DDS domain", "0");
+  cl.flag("stations", "P1,P2", "the stations to offer, as DDS partitions (a trainee station's server in each; empty: the default partition)", "");
+  cl.flag("listen", "ADDRESS:PORT", "where browsers connect (port 0: any free one); another address than loopback makes the console remote",
+          "127.0.0.1:8080");
+  cl.flag("token-file", "FILE", "the access token's file (one line, at least 32 characters: openssl rand -hex 16 > FILE)");
+  cl.flag("web-root", "DIR", "the page's files (built by the project's build)", VISCERA_CONSOLE_WEB_DIR);
+  cl.flag("client-id", "N", "the console's client id on the domain", "950");
+  cl.flag("force-limit-n", "N", "the safe force limit drawn on the force plot [N]", "3");
+  cl.flag("force-rate-hz", "HZ", "force summaries per second and instrument sent to browsers (the peak of each period kept)", "30");
+  cl.flag("outbox-kib", "KIB", "what may wait for one browser before its oldest forces and telemetry are dropped [KiB]", "4096");
+  cl.flag("requests-per-s", "R", "requests a browser may send a second (bursts of twice that)", "20");
+  cl.flag("stats-every-s", "S", "print the browsers' traffic every S seconds (0: never)", "0");
+  try {
+    if (!cl.parse(argc, argv)) return 0;
+    if (!cl.has("token-file")) throw UsageError("--token-file is required (the access token: openssl rand -hex 16 > FILE)");
+    const auto listen = parse_listen(cl.text("listen"));
+    viscera::console::WebOptions options;
+    options.token = viscera::console::read_token_file(cl.text("token-file"));
+    options.files = read_page(cl.text("web-root"));
+    options.outbox_bytes = static_cast<std::size_t>(1024 * cl.number_in("outbox-kib", 64, 1 << 20));
+    options.requests_per_s = cl.number_in("requests-per-s", 1, 1000);
+    options.request_burst = 2 * options.requests_per_s;
+    options.page_settings = {{"force_limit_n", cl.number_in("force-limit-n", 0.01, 1000)}};
+    const auto domain = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
+    const auto client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
+    const double force_period_s = 1.0 / cl.number_in("force-rate-hz", 1, 1000);
+    const double stats_every_s = cl.number_in("stats-every-s", 0, 3600);
+
+    asio::io_context io(1);
+    std::atomic<viscera::console::WebServer*> web{nullptr};
+    std::vector<std::unique_ptr<viscera::console::Station>> stations;
+    std::vector<viscera::console::Station*> station_list;
+    const auto partitions = split(cl.text("stations"), ',');
+    for (std::size_t k = 0; k < partitions.size(); ++k) {
+      viscera::console::StationSink sink{[&web, k](std::shared_ptr<const std::string> f) {
+                                           if (auto* w = web.load()) w->post_frame(k, std::move(f));
+                                         },
+                                         [&web, k](viscera::console::OutMessage m) {
+                                           if (auto* w = web.load()) w->post_message(k, std::move(m));
+                                         }};
+      stations.push_back(std::make_unique<viscera::console::Station>(domain, partitions[k], client_id, force_period_s, std::move(sink)));
+      station_list.push_back(stations.back().get());
+    }
+    auto server = std::make_unique<viscera::console::WebServer>(io, listen, std::move(options), station_list);
+    web = server.get();
+    const auto ep = server->endpoint();
+    const std::string host = ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
+    std::printf("viscera-console: domain %u, %zu station(s); open http://%s:%u/?token=%s\n", domain, stations.size(), host.c_str(), ep.port(),
+                viscera::console::read_token_file(cl.text("token-file")).c_str());
+    std::fflush(stdout);
+
+    asio::signal_set signals(io, SIGINT, SIGTERM);
+    signals.async_wait([&](const boost::system::error_code&, int) { io.stop(); });
+    asio::steady_timer timer(io);
+    std::function<void()> print_stats = [&] {
+      timer.expires_after(std::chrono::milliseconds(static_cast<long>(1000 * stats_every_s)));
+      timer.async_wait([&](const boost::system::error_code& ec) {
+        if (ec) return;
+        const auto s = server->stats();
+        for (const auto& b : s["browsers"])
+          std::printf("viscera-console: browser %s: %.0f B/s, %s frames skipped, %s KiB waiting\n", b["address"].get<std::string>().c_str(),
+                      b["bytes_per_s"].get<double>(), b["frames_skipped"].dump().c_str(),
+                      std::to_string(b["queued_bytes"].get<std::size_t>() / 1024).c_str());
+        std::fflush(stdout);
+        print_stats();
+      });
+    };
+    if (stats_every_s > 0) print_stats();
+    io.run();
+    web = nullptr;
+    server.reset();
+    std::printf("viscera-console: stopped\n");
+    return 0;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "viscera-console: %s\n", e.what());
+    return 2;
+  } catch (const viscera::common::InputError& e) {
+    std::fprintf(stderr, "viscera-console: %s\n", e.what());
+    return 2;
+  } catch (const boost::system::system_error& e) {
+    std::fprintf(stderr, "viscera-console: cannot listen on %s: %s\n", cl.text("listen").c_str(), e.code().message().c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "viscera-console: %s\n", e.what());
+    return 1;
+  }
+}

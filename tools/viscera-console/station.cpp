@@ -1,0 +1,195 @@
+#include "station.hpp"
+
+#include <chrono>
+#include <map>
+
+#include "viscera/client/client.hpp"
+#include "viscera/client/stream_tap.hpp"
+#include "viscera/console/console_wire.hpp"
+#include "viscera/console/force_decimator.hpp"
+
+namespace viscera::console {
+
+namespace proto = viscera::protocol;
+
+namespace {
+
+std::shared_ptr<const std::string> text(const nlohmann::json& j) { return std::make_shared<const std::string>(j.dump()); }
+
+}  // namespace
+
+Station::Station(std::uint32_t domain, std::string partition, std::uint32_t client_id, double force_period_s, StationSink sink)
+    : domain_(domain),
+      partition_(std::move(partition)),
+      name_(partition_.empty() ? "default" : partition_),
+      client_id_(client_id),
+      force_period_s_(force_period_s),
+      sink_(std::move(sink)) {
+  streams_ = std::thread([this] { stream_loop(); });
+  worker_ = std::thread([this] { request_loop(); });
+}
+
+Station::~Station() {
+  stop_ = true;
+  requests_cv_.notify_all();
+  streams_.join();
+  worker_.join();
+}
+
+StationSnapshot Station::snapshot() const {
+  const std::lock_guard lock(mutex_);
+  return snapshot_;
+}
+
+void Station::stream_loop() {
+  const std::vector<proto::Stream> streams = {
+      proto::Stream::instrument_command, proto::Stream::force_feedback, proto::Stream::scene_state, proto::Stream::telemetry,
+      proto::Stream::surface_topology,   proto::Stream::mesh_frame,     proto::Stream::event};
+  client::StreamTap tap(domain_, partition_, streams, 256);
+  ForceDecimator forces(force_period_s_);
+  std::map<std::uint32_t, proto::Vector3> tips;
+  std::uint32_t mesh_id = 0, vertex_count = 0;
+  const auto now_s = [] { return 1e-9 * static_cast<double>(client::now_ns()); };
+  while (!stop_) {
+    tap.wait(std::chrono::milliseconds(5));
+    tap.take([&](const client::TapSample& s) {
+      std::string why;
+      switch (s.stream) {
+        case proto::Stream::instrument_command:
+          if (const auto c = proto::decode_command(s.payload, &why)) tips[c->instrument_id] = c->tip_position;
+          break;
+        case proto::Stream::force_feedback:
+          if (const auto f = proto::decode_force(s.payload, &why)) forces.add(*f);
+          break;
+        case proto::Stream::scene_state:
+          if (const auto sc = proto::decode_scene(s.payload, &why)) {
+            auto j = to_json(*sc);
+            j["station"] = name_;
+            auto m = text(j);
+            {
+              const std::lock_guard lock(mutex_);
+              snapshot_.scene = m;
+            }
+            sink_.message({m, false, false});
+          }
+          break;
+        case proto::Stream::telemetry:
+          if (const auto t = proto::decode_telemetry(s.payload, &why)) {
+            auto j = to_json(*t);
+            j["station"] = name_;
+            auto m = text(j);
+            {
+              const std::lock_guard lock(mutex_);
+              snapshot_.telemetry = m;
+            }
+            sink_.message({m, false, true});
+          }
+          break;
+        case proto::Stream::surface_topology:
+          if (const auto t = proto::decode_surface_topology(s.payload, &why)) {
+            mesh_id = t->mesh_id;
+            vertex_count = t->vertex_count;
+            auto m = std::make_shared<const std::string>(encode_topology(*t));
+            {
+              const std::lock_guard lock(mutex_);
+              snapshot_.topology = m;
+              snapshot_.frame = nullptr;
+            }
+            sink_.message({m, true, false});
+          }
+          break;
+        case proto::Stream::mesh_frame:
+          if (const auto f = proto::decode_mesh_frame(s.payload, &why)) {
+            // A frame of another mesh than the topology's (a scene being swapped) waits for its own.
+            if (f->mesh_id != mesh_id || f->positions.size() != 3 * std::size_t{vertex_count}) break;
+            auto m = std::make_shared<const std::string>(encode_frame(*f, 1e-6 * static_cast<double>(f->server_stamp_ns)));
+            {
+              const std::lock_guard lock(mutex_);
+              snapshot_.frame = m;
+            }
+            sink_.frame(m);
+          }
+          break;
+        case proto::Stream::event:
+          if (const auto e = proto::decode_event(s.payload, &why)) {
+            auto j = to_json(*e);
+            j["station"] = name_;
+            sink_.message({text(j), false, false});
+          }
+          break;
+        default: break;
+      }
+      if (!why.empty()) ++rejected_;
+    });
+    const auto summaries = forces.flush(now_s());
+    if (!summaries.empty()) {
+      std::vector<std::pair<std::uint32_t, proto::Vector3>> tip_list(tips.begin(), tips.end());
+      auto j = forces_json(summaries, tip_list);
+      j["station"] = name_;
+      sink_.message({text(j), false, true});
+    }
+  }
+}
+
+bool Station::request(const BrowserRequest& r, std::function<void(nlohmann::json)> reply) {
+  {
+    const std::lock_guard lock(mutex_);
+    if (requests_.size() >= 32) return false;
+    requests_.emplace_back(r, std::move(reply));
+  }
+  requests_cv_.notify_one();
+  return true;
+}
+
+void Station::request_loop() {
+  client::Client client(domain_, client_id_, partition_);
+  while (true) {
+    std::pair<BrowserRequest, std::function<void(nlohmann::json)>> job;
+    {
+      std::unique_lock lock(mutex_);
+      requests_cv_.wait(lock, [&] { return stop_ || !requests_.empty(); });
+      if (stop_) return;
+      job = std::move(requests_.front());
+      requests_.pop_front();
+    }
+    const BrowserRequest& r = job.first;
+    nlohmann::json out = {{"type", "reply"}, {"id", r.id}, {"request", request_type_name(r.type)}, {"station", name_}};
+    const auto done = [&](bool ok, const std::string& message) {
+      out["ok"] = ok;
+      out["message"] = message;
+    };
+    const auto outcome = [&](const std::optional<proto::RequestOutcome>& o) {
+      if (!o)
+        done(false, "no answer from the server in time");
+      else
+        done(o->accepted, o->message);
+    };
+    using namespace std::chrono_literals;
+    switch (r.type) {
+      case RequestType::pause:
+      case RequestType::resume:
+      case RequestType::reset: {
+        const auto action = r.type == RequestType::pause    ? proto::Action::pause
+                            : r.type == RequestType::resume ? proto::Action::resume
+                                                            : proto::Action::reset;
+        const bool ok = client.control(action, 5s);
+        done(ok, ok ? std::string(proto::action_name(action)) + ": done" : "no confirmation from the server in 5 s");
+        break;
+      }
+      case RequestType::load_scene: outcome(client.load_scene(r.text, 60s, r.seed)); break;
+      case RequestType::material: outcome(client.set_material(r.change, 60s)); break;
+      case RequestType::annotate:
+        client.annotate(r.text);
+        done(true, "annotated");
+        break;
+      case RequestType::bookmark:
+        client.annotate("bookmark" + (r.text.empty() ? std::string() : ": " + r.text));
+        done(true, "bookmarked");
+        break;
+      case RequestType::watch: done(true, "watching " + name_); break;
+    }
+    job.second(std::move(out));
+  }
+}
+
+}  // namespace viscera::console

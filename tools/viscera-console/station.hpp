@@ -1,0 +1,70 @@
+#pragma once
+// One trainee station: a server on the domain in a DDS partition of its own. Its streams are
+// taken on a thread of the station's (client SDK's StreamTap), decoded, thinned to what a page
+// needs and handed to the bridge as ready-to-send messages; requests from browsers are carried out
+// on a second thread through the SDK's Client, whose calls wait for the server's answer.
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "viscera/console/browser_request.hpp"
+#include "viscera/console/outbox.hpp"
+
+namespace viscera::console {
+
+/// Where a station's messages go (called on the station's thread; must not block).
+struct StationSink {
+  std::function<void(std::shared_ptr<const std::string> frame)> frame;
+  std::function<void(OutMessage m)> message;
+};
+
+/// What a browser that starts watching gets at once.
+struct StationSnapshot {
+  std::shared_ptr<const std::string> topology, frame, scene, telemetry;
+};
+
+class Station {
+ public:
+  /// `partition`: the DDS partition ("" : the default). `client_id`: the console's id on the
+  /// domain (its annotations and requests carry it).
+  Station(std::uint32_t domain, std::string partition, std::uint32_t client_id, double force_period_s, StationSink sink);
+  ~Station();
+  Station(const Station&) = delete;
+  Station& operator=(const Station&) = delete;
+
+  const std::string& name() const { return name_; }
+  StationSnapshot snapshot() const;
+  /// Queues a request; `reply` gets {"type": "reply", "id", "ok", "message"} from the request
+  /// thread. False (nothing queued) when 32 are already waiting.
+  bool request(const BrowserRequest& r, std::function<void(nlohmann::json)> reply);
+  /// Payloads that failed verification and were dropped.
+  std::uint64_t rejected() const { return rejected_; }
+
+ private:
+  void stream_loop();
+  void request_loop();
+  nlohmann::json carry_out(const BrowserRequest& r);
+
+  std::uint32_t domain_;
+  std::string partition_, name_;
+  std::uint32_t client_id_;
+  double force_period_s_;
+  StationSink sink_;
+  mutable std::mutex mutex_;
+  StationSnapshot snapshot_;
+  std::deque<std::pair<BrowserRequest, std::function<void(nlohmann::json)>>> requests_;
+  std::condition_variable requests_cv_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> rejected_{0};
+  std::thread streams_, worker_;
+};
+
+}  // namespace viscera::console

@@ -1,0 +1,434 @@
+#include "web_server.hpp"
+
+#include <chrono>
+#include <map>
+
+#include <boost/asio/post.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "viscera/console/access_token.hpp"
+#include "viscera/console/browser_request.hpp"
+#include "viscera/console/rate_limit.hpp"
+
+#include "station.hpp"
+
+namespace viscera::console {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); }
+
+/// The value of `key` in a query string or a cookie header ("a=1&b=2", "a=1; b=2").
+std::string field_value(std::string_view list, std::string_view key, char separator) {
+  while (!list.empty()) {
+    const auto end = list.find(separator);
+    std::string_view item = list.substr(0, end);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    if (item.size() > key.size() && item.substr(0, key.size()) == key && item[key.size()] == '=') return std::string(item.substr(key.size() + 1));
+    if (end == std::string_view::npos) break;
+    list.remove_prefix(end + 1);
+  }
+  return {};
+}
+
+const char* content_type(const std::string& path) {
+  const auto ends = [&](const char* e) {
+    return path.size() >= std::strlen(e) && path.compare(path.size() - std::strlen(e), std::string::npos, e) == 0;
+  };
+  if (ends(".html")) return "text/html; charset=utf-8";
+  if (ends(".js")) return "text/javascript; charset=utf-8";
+  if (ends(".css")) return "text/css; charset=utf-8";
+  if (ends(".png")) return "image/png";
+  if (ends(".svg")) return "image/svg+xml";
+  return "application/octet-stream";
+}
+
+struct Counters {
+  std::uint64_t http_requests = 0, refused = 0, not_found = 0, browsers_opened = 0, malformed = 0, rate_limited = 0, oversized = 0, closed_slow = 0,
+                closed_flood = 0, busy = 0;
+};
+
+class Browser;
+
+}  // namespace
+
+struct WebServer::Impl : std::enable_shared_from_this<WebServer::Impl> {
+  asio::io_context& io;
+  tcp::acceptor acceptor;
+  WebOptions opt;
+  std::vector<Station*> stations;
+  Counters counters;
+  std::map<std::uint64_t, std::shared_ptr<Browser>> browsers;
+  std::uint64_t next_id = 1;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  bool stopped = false;
+
+  Impl(asio::io_context& io_, const tcp::endpoint& ep, WebOptions o, std::vector<Station*> s)
+      : io(io_), acceptor(io_, ep), opt(std::move(o)), stations(std::move(s)) {}
+  void accept();
+  void handle_http(tcp::socket socket);
+  bool authorised(const http::request<http::string_body>& req, bool* from_query) const;
+  nlohmann::json stats() const;
+};
+
+namespace {
+
+/// One browser's WebSocket.
+class Browser : public std::enable_shared_from_this<Browser> {
+ public:
+  Browser(tcp::socket socket, std::shared_ptr<WebServer::Impl> server, std::uint64_t id)
+      : ws_(std::move(socket)),
+        server_(std::move(server)),
+        id_(id),
+        outbox_(server_->opt.outbox_bytes),
+        limit_(server_->opt.requests_per_s, server_->opt.request_burst) {
+    beast::error_code ec;
+    address_ = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec).address().to_string();
+    // A small kernel send buffer: what a slow browser has not taken waits in its outbox, where the
+    // newest frame replaces an older one, not in a socket buffer that grows to megabytes of stale
+    // frames.
+    beast::get_lowest_layer(ws_).socket().set_option(asio::socket_base::send_buffer_size(128 * 1024), ec);
+  }
+
+  void start(http::request<http::string_body>&& req) {
+    upgrade_ = std::move(req);  // kept until the handshake completes
+    auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeouts.idle_timeout = std::chrono::seconds(30);  // a browser that answers no ping for 30 s is gone
+    ws_.set_option(timeouts);
+    ws_.read_message_max(kMaxRequestBytes);
+    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& r) { r.set(http::field::server, "viscera-console"); }));
+    ws_.async_accept(upgrade_, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return;
+      self->server_->browsers[self->id_] = self;
+      ++self->server_->counters.browsers_opened;
+      self->hello();
+      self->read();
+    });
+  }
+
+  std::size_t station() const { return station_; }
+
+  void send(OutMessage m) {
+    if (closing_) return;
+    if (!outbox_.put(std::move(m))) {
+      ++server_->counters.closed_slow;
+      close_now();
+      return;
+    }
+    pump();
+  }
+  void send_frame(std::shared_ptr<const std::string> f) {
+    if (closing_) return;
+    outbox_.put_frame(std::move(f));
+    pump();
+  }
+  void send_json(const nlohmann::json& j) { send({std::make_shared<const std::string>(j.dump()), false, false}); }
+
+  nlohmann::json stats() const {
+    const double age = seconds_since(opened_);
+    return {{"id", id_},
+            {"address", address_},
+            {"station", server_->stations[station_]->name()},
+            {"connected_s", age},
+            {"bytes_sent", bytes_sent_},
+            {"bytes_per_s", age > 0 ? static_cast<double>(bytes_sent_) / age : 0.0},
+            {"messages_sent", messages_sent_},
+            {"frames_skipped", outbox_.frames_skipped()},
+            {"messages_dropped", outbox_.messages_dropped()},
+            {"queued_bytes", outbox_.queued_bytes()},
+            {"errors_sent", errors_sent_}};
+  }
+
+  void close_now() {
+    if (closing_) return;
+    closing_ = true;
+    beast::error_code ec;
+    beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
+    beast::get_lowest_layer(ws_).socket().close(ec);
+    server_->browsers.erase(id_);
+  }
+
+ private:
+  void hello() {
+    nlohmann::json names = nlohmann::json::array();
+    for (const Station* s : server_->stations) names.push_back(s->name());
+    send_json({{"type", "hello"},
+               {"stations", names},
+               {"settings", server_->opt.page_settings},
+               {"limits", {{"requests_per_s", server_->opt.requests_per_s}, {"max_request_bytes", kMaxRequestBytes}}}});
+    send_snapshot();
+  }
+
+  void send_snapshot() {
+    const StationSnapshot s = server_->stations[station_]->snapshot();
+    if (s.topology) send({s.topology, true, false});
+    if (s.scene) send({s.scene, false, false});
+    if (s.telemetry) send({s.telemetry, false, true});
+    if (s.frame) send_frame(s.frame);
+  }
+
+  void error(std::uint64_t id, const std::string& message) {
+    ++errors_sent_;
+    send_json({{"type", "error"}, {"id", id}, {"message", message}});
+  }
+
+  void read() {
+    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+  }
+
+  void on_read(beast::error_code ec) {
+    if (ec) {
+      if (ec == websocket::error::message_too_big) ++server_->counters.oversized;
+      if (!closing_) server_->browsers.erase(id_);
+      closing_ = true;
+      return;
+    }
+    const std::string message = beast::buffers_to_string(in_.data());
+    in_.consume(in_.size());
+    if (!limit_.allow(seconds_since(server_->start))) {
+      ++server_->counters.rate_limited;
+      // A browser that keeps flooding after being told is closed.
+      if (++refused_in_a_row_ > 200) {
+        ++server_->counters.closed_flood;
+        close_now();
+        return;
+      }
+      error(0, "rate limit: at most " + std::to_string(static_cast<int>(server_->opt.requests_per_s)) + " requests a second");
+    } else if (!ws_.got_text()) {
+      refused_in_a_row_ = 0;
+      ++server_->counters.malformed;
+      error(0, "binary messages are not requests (send JSON text)");
+    } else {
+      refused_in_a_row_ = 0;
+      handle(message);
+    }
+    if (!closing_) read();
+  }
+
+  void handle(const std::string& message) {
+    std::string why;
+    const auto r = parse_browser_request(message, &why);
+    if (!r) {
+      ++server_->counters.malformed;
+      error(0, why);
+      return;
+    }
+    if (r->type == RequestType::watch) {
+      for (std::size_t k = 0; k < server_->stations.size(); ++k)
+        if (server_->stations[k]->name() == r->text) {
+          station_ = k;
+          send_json({{"type", "reply"}, {"id", r->id}, {"request", "watch"}, {"ok", true}, {"message", "watching " + r->text}, {"station", r->text}});
+          send_snapshot();
+          return;
+        }
+      error(r->id, "watch: no station '" + r->text + "'");
+      return;
+    }
+    std::weak_ptr<Browser> weak = shared_from_this();
+    asio::io_context& io = server_->io;
+    const bool queued = server_->stations[station_]->request(*r, [weak, &io](nlohmann::json reply) {
+      asio::post(io, [weak, reply = std::move(reply)] {
+        if (auto b = weak.lock()) b->send_json(reply);
+      });
+    });
+    if (!queued) {
+      ++server_->counters.busy;
+      error(r->id, "busy: 32 requests are waiting for the server");
+    }
+  }
+
+  void pump() {
+    if (writing_ || closing_) return;
+    auto m = outbox_.take();
+    if (!m) return;
+    writing_ = true;
+    current_ = std::move(m->data);
+    ws_.binary(m->binary);
+    ws_.async_write(asio::buffer(*current_), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+      self->writing_ = false;
+      self->current_.reset();
+      if (ec) {
+        if (!self->closing_) self->server_->browsers.erase(self->id_);
+        self->closing_ = true;
+        return;
+      }
+      self->bytes_sent_ += n;
+      ++self->messages_sent_;
+      self->pump();
+    });
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  http::request<http::string_body> upgrade_;
+  std::shared_ptr<WebServer::Impl> server_;
+  std::uint64_t id_;
+  Outbox outbox_;
+  RateLimit limit_;
+  beast::flat_buffer in_;
+  std::shared_ptr<const std::string> current_;
+  std::size_t station_ = 0;
+  bool writing_ = false, closing_ = false;
+  std::uint64_t bytes_sent_ = 0, messages_sent_ = 0, errors_sent_ = 0, refused_in_a_row_ = 0;
+  std::string address_;
+  std::chrono::steady_clock::time_point opened_ = std::chrono::steady_clock::now();
+};
+
+/// One HTTP connection: requests for the page's files, /stats, or the upgrade to a WebSocket.
+class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
+ public:
+  HttpConnection(tcp::socket socket, std::shared_ptr<WebServer::Impl> server) : stream_(std::move(socket)), server_(std::move(server)) {}
+
+  void read() {
+    parser_.emplace();
+    parser_->header_limit(8 * 1024);
+    parser_->body_limit(16 * 1024);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+  }
+
+ private:
+  void on_read(beast::error_code ec) {
+    if (ec) return;  // closed, timed out, or a request over the limits: the connection ends
+    auto req = parser_->release();
+    ++server_->counters.http_requests;
+    bool from_query = false;
+    const bool ok = server_->authorised(req, &from_query);
+    if (websocket::is_upgrade(req)) {
+      const std::string target(req.target());
+      if (!ok) return respond(req, http::status::unauthorized, "text/plain", "the console's token is missing or wrong\n", false);
+      if (target.substr(0, target.find('?')) != "/ws") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
+      if (server_->browsers.size() >= server_->opt.max_browsers)
+        return respond(req, http::status::service_unavailable, "text/plain", "too many browsers\n", false);
+      stream_.expires_never();
+      auto b = std::make_shared<Browser>(stream_.release_socket(), server_, server_->next_id++);
+      b->start(std::move(req));
+      return;
+    }
+    if (req.method() != http::verb::get && req.method() != http::verb::head)
+      return respond(req, http::status::method_not_allowed, "text/plain", "only GET\n", false);
+    if (!ok)
+      return respond(req, http::status::unauthorized, "text/html; charset=utf-8",
+                     "<!doctype html><title>viscera console</title><p>This console needs its access token: open the address the console "
+                     "printed when it started (it ends in <code>?token=...</code>).</p>\n",
+                     false);
+    std::string path(req.target().substr(0, req.target().find('?')));
+    if (path == "/") path = "/index.html";
+    if (path == "/stats") return respond(req, http::status::ok, "application/json", server_->stats().dump(1) + "\n", from_query);
+    const auto f = server_->opt.files.find(path);
+    if (f == server_->opt.files.end()) {
+      ++server_->counters.not_found;
+      return respond(req, http::status::not_found, "text/plain", "not found\n", from_query);
+    }
+    respond(req, http::status::ok, content_type(path), f->second, from_query);
+  }
+
+  void respond(const http::request<http::string_body>& req, http::status status, const char* type, std::string body, bool set_cookie) {
+    if (status == http::status::unauthorized) ++server_->counters.refused;
+    auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
+    res->set(http::field::server, "viscera-console");
+    res->set(http::field::content_type, type);
+    res->set(http::field::cache_control, "no-store");
+    res->set("X-Content-Type-Options", "nosniff");
+    if (set_cookie) res->set(http::field::set_cookie, "viscera_token=" + server_->opt.token + "; HttpOnly; SameSite=Strict; Path=/");
+    res->keep_alive(req.keep_alive() && status == http::status::ok);
+    res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
+    res->prepare_payload();
+    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+      if (ec || !res->keep_alive()) {
+        beast::error_code ignored;
+        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+        return;
+      }
+      self->read();
+    });
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  std::shared_ptr<WebServer::Impl> server_;
+};
+
+}  // namespace
+
+void WebServer::Impl::accept() {
+  acceptor.async_accept([self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
+    if (self->stopped) return;
+    if (!ec) std::make_shared<HttpConnection>(std::move(socket), self)->read();
+    self->accept();
+  });
+}
+
+bool WebServer::Impl::authorised(const http::request<http::string_body>& req, bool* from_query) const {
+  const std::string_view target(req.target().data(), req.target().size());
+  const auto q = target.find('?');
+  const std::string query = q == std::string_view::npos ? std::string() : std::string(target.substr(q + 1));
+  const std::string given = field_value(query, "token", '&');
+  if (!given.empty()) {
+    *from_query = token_matches(given, opt.token);
+    return *from_query;
+  }
+  const auto cookie = req.find(http::field::cookie);
+  return cookie != req.end() &&
+         token_matches(field_value(std::string_view(cookie->value().data(), cookie->value().size()), "viscera_token", ';'), opt.token);
+}
+
+nlohmann::json WebServer::Impl::stats() const {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [id, b] : browsers) list.push_back(b->stats());
+  nlohmann::json st = nlohmann::json::array();
+  for (const Station* s : stations) st.push_back({{"name", s->name()}, {"rejected_payloads", s->rejected()}});
+  return {{"uptime_s", seconds_since(start)},
+          {"browsers", list},
+          {"stations", st},
+          {"http_requests", counters.http_requests},
+          {"refused_unauthorised", counters.refused},
+          {"not_found", counters.not_found},
+          {"browsers_opened", counters.browsers_opened},
+          {"malformed_requests", counters.malformed},
+          {"rate_limited_requests", counters.rate_limited},
+          {"closed_oversized", counters.oversized},
+          {"closed_slow", counters.closed_slow},
+          {"closed_flood", counters.closed_flood},
+          {"busy_refusals", counters.busy}};
+}
+
+WebServer::WebServer(asio::io_context& io, const tcp::endpoint& listen, WebOptions options, std::vector<Station*> stations)
+    : impl_(std::make_shared<Impl>(io, listen, std::move(options), std::move(stations))) {
+  impl_->accept();
+}
+
+WebServer::~WebServer() {
+  impl_->stopped = true;
+  beast::error_code ec;
+  impl_->acceptor.close(ec);
+  for (auto& [id, b] : std::map(impl_->browsers)) b->close_now();
+}
+
+tcp::endpoint WebServer::endpoint() const { return impl_->acceptor.local_endpoint(); }
+
+void WebServer::post_frame(std::size_t station, std::shared_ptr<const std::string> frame) {
+  asio::post(impl_->io, [impl = impl_, station, frame = std::move(frame)] {
+    for (auto& [id, b] : std::map(impl->browsers))
+      if (b->station() == station) b->send_frame(frame);
+  });
+}
+
+void WebServer::post_message(std::size_t station, OutMessage m) {
+  asio::post(impl_->io, [impl = impl_, station, m = std::move(m)] {
+    for (auto& [id, b] : std::map(impl->browsers))
+      if (b->station() == station) b->send(m);
+  });
+}
+
+nlohmann::json WebServer::stats() const { return impl_->stats(); }
+
+}  // namespace viscera::console

@@ -1,0 +1,50 @@
+#pragma once
+// The bridge's side toward browsers: an HTTP server (Boost.Beast) that serves the page's files
+// and a WebSocket at /ws. Access needs the token (in the address, ?token=..., or the cookie the
+// page is given), checked before anything is served or upgraded. Each browser has a bounded
+// outbox (outbox.hpp), a rate limit on its requests and a size limit on its messages; everything
+// runs on one thread (the io_context's), stations hand their messages over by posting to it.
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "viscera/console/outbox.hpp"
+
+namespace viscera::console {
+
+class Station;
+
+struct WebOptions {  // NOLINT(bugprone-exception-escape): its defaults do not throw
+  std::string token;
+  std::map<std::string, std::string> files;  ///< path ("/console.js") -> content
+  std::size_t outbox_bytes = 4u << 20;  ///< per browser
+  double requests_per_s = 20, request_burst = 40;
+  std::uint32_t max_browsers = 32;
+  nlohmann::json page_settings;  ///< sent to each browser in its hello (force limit, ...)
+};
+
+class WebServer {
+ public:
+  WebServer(boost::asio::io_context& io, const boost::asio::ip::tcp::endpoint& listen, WebOptions options, std::vector<Station*> stations);
+  ~WebServer();
+  /// The address it listens on (the port chosen when 0 was asked for).
+  boost::asio::ip::tcp::endpoint endpoint() const;
+  /// Thread-safe: hand a station's newest frame / a message to every browser watching it.
+  void post_frame(std::size_t station, std::shared_ptr<const std::string> frame);
+  void post_message(std::size_t station, OutMessage m);
+  /// Counters, per browser and in all (the io thread's view; call on it, or from /stats).
+  nlohmann::json stats() const;
+
+  struct Impl;
+
+ private:
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace viscera::console
