@@ -178,6 +178,20 @@ std::optional<proto::RequestOutcome> Client::set_physics_rate(double rate_hz, st
   return request(std::move(r), timeout);
 }
 
+std::optional<proto::RequestOutcome> Client::take_over(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
+  proto::SessionRequest r;
+  r.action = proto::Action::take_over;
+  r.instrument_id = instrument_id;
+  return request(std::move(r), timeout);
+}
+
+std::optional<proto::RequestOutcome> Client::hand_back(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
+  proto::SessionRequest r;
+  r.action = proto::Action::hand_back;
+  r.instrument_id = instrument_id;
+  return request(std::move(r), timeout);
+}
+
 std::optional<proto::RequestOutcome> Client::seek(double seconds, std::chrono::milliseconds timeout) {
   proto::SessionRequest r;
   r.action = proto::Action::seek;

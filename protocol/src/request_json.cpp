@@ -3,13 +3,16 @@
 namespace viscera::protocol {
 
 namespace {
-constexpr Action kActions[] = {Action::claim_instrument, Action::release_instrument, Action::pause, Action::resume, Action::reset, Action::load_scene,
-                               Action::set_material,     Action::set_physics_rate,   Action::seek};
+constexpr Action kActions[] = {
+    Action::claim_instrument, Action::release_instrument, Action::pause, Action::resume,    Action::reset,    Action::load_scene,
+    Action::set_material,     Action::set_physics_rate,   Action::seek,  Action::take_over, Action::hand_back};
 }  // namespace
 
 nlohmann::json to_json(const SessionRequest& r) {
   nlohmann::json j = {{"action", action_name(r.action)}, {"client_id", r.client_id}, {"request_seq", r.request_seq}};
-  if (r.action == Action::claim_instrument || r.action == Action::release_instrument) j["instrument_id"] = r.instrument_id;
+  if (r.action == Action::claim_instrument || r.action == Action::release_instrument || r.action == Action::take_over ||
+      r.action == Action::hand_back)
+    j["instrument_id"] = r.instrument_id;
   if (r.action == Action::load_scene) j["scene_name"] = r.scene_name;
   if (r.action == Action::load_scene && r.scene_seed) j["scene_seed"] = *r.scene_seed;
   if (r.action == Action::set_physics_rate) j["physics_rate_hz"] = r.physics_rate_hz;

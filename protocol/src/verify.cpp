@@ -149,6 +149,8 @@ const char* action_name(Action a) {
     case Action::set_material: return "set_material";
     case Action::set_physics_rate: return "set_physics_rate";
     case Action::seek: return "seek";
+    case Action::take_over: return "take_over";
+    case Action::hand_back: return "hand_back";
   }
   return "unknown";
 }
@@ -249,7 +251,7 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
   const auto* m = verified_root<fb::SessionRequest>(bytes, why);
   if (!m) return std::nullopt;
   const auto a = static_cast<int>(m->action());
-  if (a < 0 || a > static_cast<int>(Action::seek)) {
+  if (a < 0 || a > static_cast<int>(Action::hand_back)) {
     *why = "unknown action " + std::to_string(a);
     return std::nullopt;
   }

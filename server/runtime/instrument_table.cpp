@@ -42,7 +42,39 @@ HandoverResult InstrumentTable::hand_over(std::uint32_t instrument_id, std::uint
   std::lock_guard lock(mutex_);
   const auto it = entries_.find(instrument_id);
   if (it == entries_.end()) return HandoverResult::unknown_instrument;
+  return hand_over_locked(it->second, from, to, now_ns);
+}
+
+Handover InstrumentTable::take_over(std::uint32_t instrument_id, std::uint32_t to, std::int64_t now_ns) {
+  std::lock_guard lock(mutex_);
+  const auto it = entries_.find(instrument_id);
+  if (it == entries_.end()) return {HandoverResult::unknown_instrument, 0};
   Entry& e = it->second;
+  const std::uint32_t from = e.owner;
+  if (from == to) return {HandoverResult::already_owner, from};
+  if (from == 0) {
+    e = {to, false, now_ns, {}, 0};
+    return {HandoverResult::handed_over, 0};
+  }
+  hand_over_locked(e, from, to, now_ns);
+  e.taken_from = from;
+  return {HandoverResult::handed_over, from};
+}
+
+Handover InstrumentTable::hand_back(std::uint32_t instrument_id, std::uint32_t by, std::int64_t now_ns) {
+  std::lock_guard lock(mutex_);
+  const auto it = entries_.find(instrument_id);
+  if (it == entries_.end()) return {HandoverResult::unknown_instrument, 0};
+  Entry& e = it->second;
+  if (e.owner != by) return {HandoverResult::not_owner, 0};
+  if (e.taken_from == 0) return {HandoverResult::not_taken_over, 0};
+  const std::uint32_t to = e.taken_from;
+  hand_over_locked(e, by, to, now_ns);
+  e.taken_from = 0;
+  return {HandoverResult::handed_over, to};
+}
+
+HandoverResult InstrumentTable::hand_over_locked(Entry& e, std::uint32_t from, std::uint32_t to, std::int64_t now_ns) {
   if (e.owner != from || from == 0) return HandoverResult::not_owner;
   e.owner = to;
   e.last_heard_ns = now_ns;

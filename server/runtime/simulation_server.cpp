@@ -386,6 +386,11 @@ struct SimulationServer::Impl {
             case ClaimResult::taken: break;  // no fault: its owner may let it go
           }
           return;
+        case proto::Action::take_over:
+        case proto::Action::hand_back:
+          hand_over(*req, status);
+          changed = true;
+          return;
         case proto::Action::release_instrument:
           switch (instruments.release(req->instrument_id, req->client_id)) {
             case ReleaseResult::released:
@@ -450,6 +455,36 @@ struct SimulationServer::Impl {
   }
 
   /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
+  /// An instructor takes an instrument over from its owner, or hands it back: ownership moves in
+  /// one step (never free in between), with an event naming both clients and an outcome.
+  void hand_over(const proto::SessionRequest& req, const Status& status) {
+    const bool take = req.action == proto::Action::take_over;
+    const std::string id = "instrument " + std::to_string(req.instrument_id);
+    const Handover h = take ? instruments.take_over(req.instrument_id, req.client_id, proto::now_ns())
+                            : instruments.hand_back(req.instrument_id, req.client_id, proto::now_ns());
+    std::string message;
+    switch (h.result) {
+      case HandoverResult::handed_over:
+        message = take ? (h.from ? id + " taken over from client " + std::to_string(h.from) : id + " was free: claimed")
+                       : id + " handed back to client " + std::to_string(h.from);
+        break;
+      case HandoverResult::already_owner: message = id + ": already this client's"; break;
+      case HandoverResult::not_owner: message = id + ": not this client's to hand back"; break;
+      case HandoverResult::not_taken_over: message = id + ": this client did not take it over"; break;
+      case HandoverResult::unknown_instrument: message = "the scene has no " + id; break;
+    }
+    const bool accepted = h.result == HandoverResult::handed_over || h.result == HandoverResult::already_owner;
+    session.record(req, accepted, message);
+    if (h.result == HandoverResult::handed_over) {
+      // The new owner's claim names the one it came from; no release in between.
+      const std::uint32_t to = take ? req.client_id : h.from;
+      event(proto::EventKind::instrument_claimed, req.instrument_id, to, message, req.request_seq);
+    } else if (!accepted) {
+      event(proto::EventKind::request_refused, req.instrument_id, req.client_id, message, req.request_seq);
+    }
+    if (status) status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + message);
+  }
+
   void conclude(const proto::SessionRequest& req, bool accepted, const std::string& message, const Status& status) {
     session.record(req, accepted, message);
     if (accepted && req.action != proto::Action::load_scene) {

@@ -74,6 +74,10 @@ TEST(BrowserRequest, AcceptsEachTypeWithItsFields) {
   ASSERT_TRUE(l) << why;
   EXPECT_EQ(l->text, "liver-nodule");
   EXPECT_EQ(l->seed, 12u);
+  const auto mv = vc::parse_browser_request(R"({"type":"move","instrument":3,"delta_m":[0.002,-0.01,0]})", &why);
+  ASSERT_TRUE(mv) << why;
+  EXPECT_EQ(mv->instrument, 3u);
+  EXPECT_EQ(mv->delta_m[1], -0.01);
   const auto b = vc::parse_browser_request(R"({"type":"bookmark"})", &why);
   ASSERT_TRUE(b) << why;
   EXPECT_TRUE(b->text.empty());
@@ -90,6 +94,10 @@ TEST(BrowserRequest, RefusesWithTheFieldAndTheValue) {
   EXPECT_EQ(error_of(R"({"type":"material"})").substr(0, 30), "material: needs at least one o");
   EXPECT_EQ(error_of(R"({"type":"load_scene","scene":"../x"})"), "SCENE '../x' is not a scene name (letters, digits, '.', '_', '-'; no path)");
   EXPECT_EQ(error_of(R"({"type":"pause","id":-1})"), "id: -1 is not a whole number >= 0");
+  EXPECT_EQ(error_of(R"({"type":"take_over"})"), "take_over: instrument missing");
+  EXPECT_EQ(error_of(R"({"type":"take_over","instrument":0})"), "instrument: 0 is not an instrument id (a whole number >= 1)");
+  EXPECT_EQ(error_of(R"({"type":"move","instrument":1,"delta_m":[0,0,0.05]})"), "delta_m: [0,0,0.05]: each step within +-0.01 m");
+  EXPECT_EQ(error_of(R"({"type":"move","instrument":1,"delta_m":[0,0]})"), "delta_m: [0,0] is not [dx, dy, dz] in metres");
   EXPECT_EQ(error_of(R"({"type":"annotate","text":")" + std::string(1025, 'a') + "\"}"), "text: not a string of at most 1024 bytes");
   EXPECT_EQ(error_of(std::string(vc::kMaxRequestBytes + 1, ' ')).substr(0, 11), "request of ");
 }

@@ -44,7 +44,7 @@ check "the page in Chromium (console_page.mjs)" '[ $rc_page -eq 0 ]'
 node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?
 check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'
-check "the server rejected nothing" 'grep "Hz physics" "$tmp/server.log" | tail -1 | grep -q "rejected 0 "'
+check "the server found nothing malformed" 'grep "Hz physics" "$tmp/server.log" | tail -1 | grep -q "malformed 0,"'
 python3 - "$tmp/page.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

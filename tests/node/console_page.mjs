@@ -81,6 +81,30 @@ try {
   const changed = await until(page, () => window.viscera.scene && Math.abs(window.viscera.scene.material.youngs_modulus_pa - 7000) < 1, null, 30000);
   check('the material form changes the tissue', changed, `E = ${await page.evaluate(() => window.viscera.scene.material.youngs_modulus_pa)} Pa`);
 
+  // Take over the trainee's probe, drive it, hand it back: ownership moves in one step each way
+  // (the server's scene state, read by viscera-control; no release event in between).
+  const owner = (text) => (/1 \(probe, (client \d+|free)\)/.exec(text) || [])[1];
+  const trainee = owner(ctl('show'));
+  const eventsAtTakeover = await page.evaluate(() => window.viscera.events.length);
+  await page.click('button[data-take-over="1"]');
+  const took = await until(page, () => window.viscera.held.includes(1), null, 10000);
+  const ownerDuring = owner(ctl('show'));
+  check('Take over moves the probe to the console', took && ownerDuring === 'client 950', `owner before: ${trainee}, during: ${ownerDuring}`);
+  const tipBefore = await page.evaluate(() => window.viscera.tips?.[1]);
+  for (let k = 0; k < 5; k++) await page.click('#drive .pad button[data-d="0,0,1"]');
+  const rose2 = await until(page, (z0) => window.viscera.tips?.[1] && z0 !== undefined && window.viscera.tips[1][2] > z0 + 0.008, tipBefore?.[2], 5000);
+  const tipAfter = await page.evaluate(() => window.viscera.tips?.[1]);
+  check('the console drives the taken-over probe', rose2, `tip z ${tipBefore?.[2]?.toFixed(4)} -> ${tipAfter?.[2]?.toFixed(4)} m after five 2 mm steps up`);
+  await page.screenshot({ path: `${shots}/console-takeover.png` });
+  await page.click('button[data-hand-back="1"]');
+  const back = await until(page, () => !window.viscera.held.includes(1), null, 10000);
+  const ownerAfter = owner(ctl('show'));
+  check('Hand back returns it to the trainee', back && ownerAfter === trainee, `owner after: ${ownerAfter}`);
+  const handover = await page.evaluate((n) => window.viscera.events.slice(n).filter((e) => e.instrument_id === 1 && /instrument_/.test(e.kind)).map((e) => `${e.kind} client ${e.client_id}: ${e.text}`), eventsAtTakeover);
+  check('no moment without an owner: claims with names, no release in between',
+        handover.length === 2 && handover.every((e) => e.startsWith('instrument_claimed')) && /taken over from client 1/.test(handover[0]) && /handed back to client 1/.test(handover[1]),
+        handover.join(' | '));
+
   const lat = await page.evaluate(() => window.viscera.latenciesMs);
   const sorted = [...lat].sort((a, b) => a - b);
   const q = (p) => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];

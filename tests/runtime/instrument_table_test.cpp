@@ -93,6 +93,30 @@ TEST(InstrumentTable, HandOverMovesOwnershipWithNoMomentWithoutAnOwner) {
   EXPECT_EQ(t.owner(1), 11u);
 }
 
+TEST(InstrumentTable, TakeOverRemembersWhomFromAndHandsBackToThem) {
+  InstrumentTable t = table();
+  t.claim(1, 11, 0);
+  t.command(command(1, 11, 7, 0.05), 10 * kMs);
+  EXPECT_EQ(t.hand_back(1, 950, 15 * kMs).result, HandoverResult::not_owner);  // nothing taken yet
+  const Handover h = t.take_over(1, 950, 20 * kMs);
+  EXPECT_EQ(h.result, HandoverResult::handed_over);
+  EXPECT_EQ(h.from, 11u);
+  EXPECT_EQ(t.owner(1), 950u);
+  EXPECT_EQ(t.take_over(1, 950, 21 * kMs).result, HandoverResult::already_owner);
+  EXPECT_EQ(t.hand_back(1, 11, 22 * kMs).result, HandoverResult::not_owner);  // only the taker hands back
+  const Handover back = t.hand_back(1, 950, 30 * kMs);
+  EXPECT_EQ(back.result, HandoverResult::handed_over);
+  EXPECT_EQ(back.from, 11u);
+  EXPECT_EQ(t.owner(1), 11u);
+  EXPECT_EQ(t.hand_back(1, 11, 31 * kMs).result, HandoverResult::not_taken_over);  // once only
+  // A free instrument is simply claimed; there is nobody to hand it back to.
+  const Handover free = t.take_over(3, 950, 40 * kMs);
+  EXPECT_EQ(free.result, HandoverResult::handed_over);
+  EXPECT_EQ(free.from, 0u);
+  EXPECT_EQ(t.hand_back(3, 950, 41 * kMs).result, HandoverResult::not_taken_over);
+  EXPECT_EQ(t.take_over(9, 950, 42 * kMs).result, HandoverResult::unknown_instrument);
+}
+
 TEST(InstrumentTable, ANewSceneTakesEveryInstrumentFromItsOwner) {
   InstrumentTable t = table();
   t.claim(1, 11, 0);

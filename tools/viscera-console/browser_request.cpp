@@ -18,8 +18,8 @@ struct TypeInfo {
   std::set<std::string> fields;  ///< besides "type" and "id"
 };
 
-const std::array<TypeInfo, 8>& types() {
-  static const std::array<TypeInfo, 8> t = {{
+const std::array<TypeInfo, 11>& types() {
+  static const std::array<TypeInfo, 11> t = {{
       {RequestType::pause, "pause", {}},
       {RequestType::resume, "resume", {}},
       {RequestType::reset, "reset", {}},
@@ -28,6 +28,9 @@ const std::array<TypeInfo, 8>& types() {
       {RequestType::annotate, "annotate", {"text"}},
       {RequestType::bookmark, "bookmark", {"label"}},
       {RequestType::watch, "watch", {"station"}},
+      {RequestType::take_over, "take_over", {"instrument"}},
+      {RequestType::hand_back, "hand_back", {"instrument"}},
+      {RequestType::move, "move", {"instrument", "delta_m"}},
   }};
   return t;
 }
@@ -98,6 +101,17 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
       const auto s = text(client::kMaxAnnotationBytes);
       if (!s) return fail(key + ": not a string of at most " + std::to_string(client::kMaxAnnotationBytes) + " bytes");
       r.text = *s;
+    } else if (key == "instrument") {
+      if (!value.is_number_unsigned() || value.get<std::uint64_t>() == 0 || value.get<std::uint64_t>() > 0xffffffffULL)
+        return fail("instrument: " + shown(value) + " is not an instrument id (a whole number >= 1)");
+      r.instrument = value.get<std::uint32_t>();
+    } else if (key == "delta_m") {
+      if (!value.is_array() || value.size() != 3) return fail("delta_m: " + shown(value) + " is not [dx, dy, dz] in metres");
+      for (int k = 0; k < 3; ++k) {
+        if (!value[k].is_number() || !(std::abs(value[k].get<double>()) <= kMaxMoveStepM))
+          return fail("delta_m: " + shown(value) + ": each step within +-" + std::to_string(kMaxMoveStepM).substr(0, 4) + " m");
+        r.delta_m[k] = value[k].get<double>();
+      }
     } else if (key == "station") {
       const auto s = text(64);
       if (!s) return fail("station: " + shown(value) + " is not a station name");
@@ -112,6 +126,8 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
     }
   }
   if (r.type == RequestType::load_scene && r.text.empty()) return fail("load_scene: scene missing");
+  if ((r.type == RequestType::take_over || r.type == RequestType::hand_back || r.type == RequestType::move) && r.instrument == 0)
+    return fail(std::string(info->name) + ": instrument missing");
   if (r.type == RequestType::annotate && r.text.empty()) return fail("annotate: text missing or empty");
   if (r.type == RequestType::material && r.change.empty())
     return fail("material: needs at least one of youngs-modulus-pa, poisson-ratio, density-kg-m3, shear-q, damping-per-s");

@@ -1,5 +1,6 @@
 #include "station.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 
@@ -27,6 +28,7 @@ Station::Station(std::uint32_t domain, std::string partition, std::uint32_t clie
       sink_(std::move(sink)) {
   streams_ = std::thread([this] { stream_loop(); });
   worker_ = std::thread([this] { request_loop(); });
+  driver_ = std::thread([this] { drive_loop(); });
 }
 
 Station::~Station() {
@@ -34,6 +36,7 @@ Station::~Station() {
   requests_cv_.notify_all();
   streams_.join();
   worker_.join();
+  driver_.join();
 }
 
 StationSnapshot Station::snapshot() const {
@@ -56,7 +59,11 @@ void Station::stream_loop() {
       std::string why;
       switch (s.stream) {
         case proto::Stream::instrument_command:
-          if (const auto c = proto::decode_command(s.payload, &why)) tips[c->instrument_id] = c->tip_position;
+          if (const auto c = proto::decode_command(s.payload, &why)) {
+            tips[c->instrument_id] = c->tip_position;
+            const std::lock_guard lock(mutex_);
+            tips_[c->instrument_id] = c->tip_position;
+          }
           break;
         case proto::Stream::force_feedback:
           if (const auto f = proto::decode_force(s.payload, &why)) forces.add(*f);
@@ -69,6 +76,14 @@ void Station::stream_loop() {
             {
               const std::lock_guard lock(mutex_);
               snapshot_.scene = m;
+              bounds_min_ = sc->bounds_min;
+              bounds_max_ = sc->bounds_max;
+              // An instrument the console no longer owns (a scene loaded, its lease lost) is not driven.
+              for (auto it = held_.begin(); it != held_.end();) {
+                const auto i =
+                    std::find_if(sc->instruments.begin(), sc->instruments.end(), [&](const auto& x) { return x.instrument_id == it->first; });
+                it = (i == sc->instruments.end() || i->owner_client_id != client_id_) ? held_.erase(it) : std::next(it);
+              }
             }
             sink_.message({m, false, false});
           }
@@ -141,6 +156,32 @@ bool Station::request(const BrowserRequest& r, std::function<void(nlohmann::json
   return true;
 }
 
+bool Station::move(std::uint32_t instrument, const proto::Vector3& delta, std::string* why) {
+  const std::lock_guard lock(mutex_);
+  const auto it = held_.find(instrument);
+  if (it == held_.end()) {
+    *why = "move: instrument " + std::to_string(instrument) + " is not taken over by this console";
+    return false;
+  }
+  for (int k = 0; k < 3; ++k) it->second[k] = std::clamp(it->second[k] + delta[k], bounds_min_[k] - 0.05, bounds_max_[k] + 0.05);
+  return true;
+}
+
+void Station::drive_loop() {
+  client::Client driver(domain_, client_id_, partition_);
+  auto next = std::chrono::steady_clock::now();
+  while (!stop_) {
+    std::map<std::uint32_t, proto::Vector3> held;
+    {
+      const std::lock_guard lock(mutex_);
+      held = held_;
+    }
+    for (const auto& [id, tip] : held) driver.send_tip(id, tip);
+    next += std::chrono::milliseconds(5);
+    std::this_thread::sleep_until(next);
+  }
+}
+
 void Station::request_loop() {
   client::Client client(domain_, client_id_, partition_);
   while (true) {
@@ -186,6 +227,34 @@ void Station::request_loop() {
         client.annotate("bookmark" + (r.text.empty() ? std::string() : ": " + r.text));
         done(true, "bookmarked");
         break;
+      case RequestType::take_over: {
+        // Driven from where its owner left it (above the organ if it was never commanded), from
+        // before the request: the server keeps that pose until the console's first command.
+        {
+          const std::lock_guard lock(mutex_);
+          const auto t = tips_.find(r.instrument);
+          held_[r.instrument] =
+              t != tips_.end() ? t->second
+                               : proto::Vector3{(bounds_min_[0] + bounds_max_[0]) / 2, (bounds_min_[1] + bounds_max_[1]) / 2, bounds_max_[2] + 0.02};
+        }
+        const auto o = client.take_over(r.instrument, 5s);
+        outcome(o);
+        if (!o || !o->accepted) {
+          const std::lock_guard lock(mutex_);
+          held_.erase(r.instrument);
+        }
+        break;
+      }
+      case RequestType::hand_back: {
+        const auto o = client.hand_back(r.instrument, 5s);
+        outcome(o);
+        if (o && o->accepted) {
+          const std::lock_guard lock(mutex_);
+          held_.erase(r.instrument);
+        }
+        break;
+      }
+      case RequestType::move:  // carried out at once (move())
       case RequestType::watch: done(true, "watching " + name_); break;
     }
     job.second(std::move(out));

@@ -2,12 +2,15 @@
 // One trainee station: a server on the domain in a DDS partition of its own. Its streams are
 // taken on a thread of the station's (client SDK's StreamTap), decoded, thinned to what a page
 // needs and handed to the bridge as ready-to-send messages; requests from browsers are carried out
-// on a second thread through the SDK's Client, whose calls wait for the server's answer.
+// on a second thread through the SDK's Client, whose calls wait for the server's answer. An
+// instrument the console has taken over is commanded by a third thread at 200 Hz, from the tip
+// the instructor moves it to (so its lease never runs out while the instructor thinks).
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -45,12 +48,16 @@ class Station {
   /// Queues a request; `reply` gets {"type": "reply", "id", "ok", "message"} from the request
   /// thread. False (nothing queued) when 32 are already waiting.
   bool request(const BrowserRequest& r, std::function<void(nlohmann::json)> reply);
+  /// Moves an instrument the console holds (taken over) by `delta` [m], kept within the organ's
+  /// bounds widened by 5 cm; false and why if the console does not hold it.
+  bool move(std::uint32_t instrument, const protocol::Vector3& delta, std::string* why);
   /// Payloads that failed verification and were dropped.
   std::uint64_t rejected() const { return rejected_; }
 
  private:
   void stream_loop();
   void request_loop();
+  void drive_loop();
   nlohmann::json carry_out(const BrowserRequest& r);
 
   std::uint32_t domain_;
@@ -60,11 +67,14 @@ class Station {
   StationSink sink_;
   mutable std::mutex mutex_;
   StationSnapshot snapshot_;
+  std::map<std::uint32_t, protocol::Vector3> tips_;  ///< each instrument's newest commanded tip [m]
+  protocol::Vector3 bounds_min_{}, bounds_max_{};  ///< the organ's, from the scene state [m]
+  std::map<std::uint32_t, protocol::Vector3> held_;  ///< instruments the console drives, at these tips
   std::deque<std::pair<BrowserRequest, std::function<void(nlohmann::json)>>> requests_;
   std::condition_variable requests_cv_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> rejected_{0};
-  std::thread streams_, worker_;
+  std::thread streams_, worker_, driver_;
 };
 
 }  // namespace viscera::console

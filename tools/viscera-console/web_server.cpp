@@ -221,6 +221,10 @@ class Browser : public std::enable_shared_from_this<Browser> {
       error(0, why);
       return;
     }
+    if (r->type == RequestType::move) {
+      if (!server_->stations[station_]->move(r->instrument, r->delta_m, &why)) error(r->id, why);
+      return;
+    }
     if (r->type == RequestType::watch) {
       for (std::size_t k = 0; k < server_->stations.size(); ++k)
         if (server_->stations[k]->name() == r->text) {

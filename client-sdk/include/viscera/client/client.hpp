@@ -68,6 +68,12 @@ class Client {
                                                      std::optional<std::uint64_t> seed = std::nullopt);
   std::optional<protocol::RequestOutcome> set_material(const protocol::MaterialChange& change, std::chrono::milliseconds timeout);
   std::optional<protocol::RequestOutcome> set_physics_rate(double rate_hz, std::chrono::milliseconds timeout);
+  /// An instructor's console: take an instrument from its owner at once (the server moves the
+  /// ownership in one step, never leaving it free; a free instrument is claimed), and hand it back
+  /// to the client it was taken from. Keep commanding it in between: an owner silent for the
+  /// liveliness lease loses it. The outcome says what was done or why not.
+  std::optional<protocol::RequestOutcome> take_over(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
+  std::optional<protocol::RequestOutcome> hand_back(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
   /// A replay (viscera-replay play, in its partition): jump to `seconds` from the recording's start.
   /// A live server refuses it.
   std::optional<protocol::RequestOutcome> seek(double seconds, std::chrono::milliseconds timeout);

@@ -49,7 +49,9 @@ enum class Action : std::int8_t {
   load_scene = 5,
   set_material = 6,
   set_physics_rate = 7,  // schema 3
-  seek = 8  // schema 7: replayers only
+  seek = 8,  // schema 7: replayers only
+  take_over = 9,  // schema 10: an instructor takes an instrument from its owner, no gap
+  hand_back = 10  // schema 10: and gives it back
 };
 const char* action_name(Action a);
 
@@ -227,7 +229,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 9;
+inline constexpr int kSchemaVersion = 10;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

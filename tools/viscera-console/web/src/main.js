@@ -10,7 +10,7 @@ import './style.css';
 const state = (window.viscera = {
   connected: false, stations: [], station: '', scene: null, telemetry: null, settings: { force_limit_n: 3 },
   topologyVertices: 0, framesReceived: 0, frame: -1, maxDisplacementM: 0, latenciesMs: [],
-  forcePeakN: 0, forceSummaries: 0, events: [], replies: [], errors: [],
+  forcePeakN: 0, forceSummaries: 0, events: [], replies: [], errors: [], held: [], tips: {},
 });
 
 const $ = (id) => document.getElementById(id);
@@ -148,7 +148,7 @@ function onForces(m) {
     const tool = tools.get(i.id);
     if (tool) {
       tool.force = i.peak_n;
-      if (i.tip) { tool.group.position.set(...i.tip); tool.group.visible = true; }
+      if (i.tip) { tool.group.position.set(...i.tip); tool.group.visible = true; state.tips[i.id] = i.tip; }
       const f = new THREE.Vector3(...i.force), len = f.length();
       if (i.contact && len > 1e-3) {
         tool.arrow.position.set(...i.contact_point);
@@ -210,10 +210,43 @@ function warn(text) { const w = $('warning'); w.hidden = !text; w.textContent = 
 
 function renderInstruments() {
   if (!state.scene) return;
-  $('instruments').tBodies[0].innerHTML = state.scene.instruments.map((i) =>
-    `<tr><td>${i.id}</td><td>${i.grasper ? 'grasper' : 'probe'}</td><td>${i.owner ? `client ${i.owner}` : '<span class="dim">free</span>'}</td>` +
-    `<td>${tools.get(i.id) ? tools.get(i.id).force.toFixed(2) + ' N' : '–'}</td></tr>`).join('');
+  const me = state.settings.client_id;
+  $('instruments').tBodies[0].innerHTML = state.scene.instruments.map((i) => {
+    const mine = i.owner === me && state.held.includes(i.id);
+    const button = mine ? `<button data-hand-back="${i.id}" title="Give the instrument back to the trainee it was taken from">Hand back</button>`
+      : `<button data-take-over="${i.id}" title="Take the instrument from its owner (no moment without one) and drive it from here">Take over</button>`;
+    return `<tr><td>${i.id}</td><td>${i.grasper ? 'grasper' : 'probe'}</td><td>${i.owner === me ? 'this console' : i.owner ? `client ${i.owner}` : '<span class="dim">free</span>'}</td>` +
+      `<td>${tools.get(i.id) ? tools.get(i.id).force.toFixed(2) + ' N' : '–'}</td><td>${button}</td></tr>`;
+  }).join('');
+  $('drive').hidden = state.held.length === 0;
+  $('drive-id').textContent = state.held.join(', ');
 }
+$('instruments').onclick = async (e) => {
+  const take = e.target.dataset.takeOver, back = e.target.dataset.handBack;
+  if (take) {
+    const r = await send({ type: 'take_over', instrument: Number(take) });
+    if (r && r.ok && !state.held.includes(Number(take))) state.held.push(Number(take));
+  } else if (back) {
+    const r = await send({ type: 'hand_back', instrument: Number(back) });
+    if (r && r.ok) state.held = state.held.filter((x) => x !== Number(back));
+  }
+  renderInstruments();
+};
+// Driving a taken-over instrument: steps add up and go to the bridge ten times a second.
+const stepM = 0.002, pendingMove = [0, 0, 0];
+function nudge(d) { for (let k = 0; k < 3; k++) pendingMove[k] += d[k] * stepM; }
+setInterval(() => {
+  if (!state.held.length || pendingMove.every((x) => x === 0)) return;
+  const delta = pendingMove.map((x) => Math.max(-0.01, Math.min(0.01, x)));
+  pendingMove.fill(0);
+  socket.send(JSON.stringify({ type: 'move', instrument: state.held[0], delta_m: delta }));
+}, 100);
+window.addEventListener('keydown', (e) => {
+  if (!state.held.length || e.target.tagName === 'INPUT') return;
+  const keys = { ArrowLeft: [-1, 0, 0], ArrowRight: [1, 0, 0], ArrowUp: [0, 1, 0], ArrowDown: [0, -1, 0], PageUp: [0, 0, 1], PageDown: [0, 0, -1] };
+  if (keys[e.key]) { nudge(keys[e.key]); e.preventDefault(); }
+});
+document.querySelector('#drive .pad').onclick = (e) => { if (e.target.dataset.d) nudge(e.target.dataset.d.split(',').map(Number)); };
 
 function onScene(s) {
   const first = !state.scene || state.scene.generation !== s.generation;
@@ -224,6 +257,8 @@ function onScene(s) {
   badge.textContent = s.paused ? 'paused' : 'live';
   badge.className = 'badge ' + (s.paused ? 'paused' : 'live');
   for (const i of s.instruments) toolFor(i.id, i.tip_radius_m, i.grasper);
+  // An instrument no longer this console's (its lease lost, a scene loaded) is no longer driven.
+  state.held = state.held.filter((id) => s.instruments.some((i) => i.id === id && i.owner === state.settings.client_id));
   if (first) {
     const list = $('scene-list');
     list.innerHTML = s.available_scenes.map((n) => `<option${n === s.name ? ' selected' : ''}>${esc(n)}</option>`).join('');

@@ -18,7 +18,13 @@ namespace viscera::runtime {
 enum class ClaimResult { claimed, already_owner, taken, unknown_instrument };
 enum class ReleaseResult { released, not_owner, unknown_instrument };
 enum class CommandResult { accepted, stale, not_owner, unknown_instrument };
-enum class HandoverResult { handed_over, not_owner, unknown_instrument };
+enum class HandoverResult { handed_over, not_owner, unknown_instrument, already_owner, not_taken_over };
+
+/// What a take-over or a hand-back did: the result and the client the instrument went from.
+struct Handover {
+  HandoverResult result = HandoverResult::unknown_instrument;
+  std::uint32_t from = 0;  ///< the previous owner (0: it was free)
+};
 
 /// An instrument and its owner (0: none).
 struct Ownership {
@@ -48,6 +54,11 @@ class InstrumentTable {
   /// owns it; the new owner's commands count from now, so until it sends one the tool stays where
   /// the last command left it.
   HandoverResult hand_over(std::uint32_t instrument_id, std::uint32_t from, std::uint32_t to, std::int64_t now_ns);
+  /// `to` takes the instrument from whoever owns it (hand_over, remembering whom from), or claims
+  /// it if it is free.
+  Handover take_over(std::uint32_t instrument_id, std::uint32_t to, std::int64_t now_ns);
+  /// `by`, who took the instrument over, hands it back to the client it took it from (hand_over).
+  Handover hand_back(std::uint32_t instrument_id, std::uint32_t by, std::int64_t now_ns);
   /// A command from `command.client_id`: accepted (the newest) if it owns the instrument and the
   /// sequence is newer; renews the owner's lease either way.
   CommandResult command(const protocol::Command& command, std::int64_t now_ns);
@@ -68,7 +79,9 @@ class InstrumentTable {
     bool has_command = false;
     std::int64_t last_heard_ns = 0;  ///< the owner's last claim or command
     protocol::Command last;
+    std::uint32_t taken_from = 0;  ///< the owner before a take-over (0: not taken over)
   };
+  HandoverResult hand_over_locked(Entry& e, std::uint32_t from, std::uint32_t to, std::int64_t now_ns);
   std::vector<InstrumentSpec> specs_;
   std::map<std::uint32_t, Entry> entries_;
   mutable std::mutex mutex_;

@@ -15,7 +15,7 @@ namespace viscera::console {
 /// The longest request a browser may send [bytes]; longer WebSocket messages close the connection.
 inline constexpr std::size_t kMaxRequestBytes = 16 * 1024;
 
-enum class RequestType { pause, resume, reset, load_scene, material, annotate, bookmark, watch };
+enum class RequestType { pause, resume, reset, load_scene, material, annotate, bookmark, watch, take_over, hand_back, move };
 const char* request_type_name(RequestType t);
 
 struct BrowserRequest {
@@ -24,7 +24,12 @@ struct BrowserRequest {
   std::string text;  ///< annotate: the text; bookmark: its label (may be empty); load_scene: the scene; watch: the station
   protocol::MaterialChange change;  ///< material
   std::optional<std::uint64_t> seed;  ///< load_scene: the drawn regions' seed
+  std::uint32_t instrument = 0;  ///< take_over, hand_back, move
+  protocol::Vector3 delta_m{};  ///< move: the step of the held instrument's tip [m], each component within +-kMaxMoveStepM
 };
+
+/// The largest step of one move request, per axis [m].
+inline constexpr double kMaxMoveStepM = 0.01;
 
 /// The request in `message`, or nothing and why (one line: field and value).
 std::optional<BrowserRequest> parse_browser_request(std::string_view message, std::string* why);
