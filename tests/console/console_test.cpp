@@ -14,6 +14,7 @@
 #include "viscera/console/browser_request.hpp"
 #include "viscera/console/console_wire.hpp"
 #include "viscera/console/force_decimator.hpp"
+#include "viscera/console/foxglove_protocol.hpp"
 #include "viscera/console/outbox.hpp"
 #include "viscera/console/rate_limit.hpp"
 
@@ -209,4 +210,44 @@ TEST(ConsoleWire, BinaryMessagesDecodeAsThePageReadsThem) {
   std::memcpy(&p, fr.data() + vc::kFrameHeaderBytes + 8, 4);
   EXPECT_EQ(p, 0.5f);
   EXPECT_EQ(vc::kFrameHeaderBytes % 4, 0u);  // the page's Float32Array view must be aligned
+}
+
+TEST(Foxglove, Base64MatchesTheRfc4648Vectors) {
+  const auto b64 = [](std::string s) { return vc::base64({reinterpret_cast<const std::uint8_t*>(s.data()), s.size()}); };
+  EXPECT_EQ(b64(""), "");
+  EXPECT_EQ(b64("f"), "Zg==");
+  EXPECT_EQ(b64("fo"), "Zm8=");
+  EXPECT_EQ(b64("foo"), "Zm9v");
+  EXPECT_EQ(b64("foob"), "Zm9vYg==");
+  EXPECT_EQ(b64("fooba"), "Zm9vYmE=");
+  EXPECT_EQ(b64("foobar"), "Zm9vYmFy");
+}
+
+TEST(Foxglove, MessageDataIsOpcodeSubscriptionTimeAndPayload) {
+  const std::vector<std::uint8_t> payload = {9, 8, 7};
+  const std::string m = vc::foxglove_message_data(0x01020304, 0x1122334455667788ULL, payload);
+  ASSERT_EQ(m.size(), 16u);
+  EXPECT_EQ(m[0], 1);
+  EXPECT_EQ(static_cast<std::uint8_t>(m[1]), 0x04);  // little-endian
+  EXPECT_EQ(static_cast<std::uint8_t>(m[5]), 0x88);
+  EXPECT_EQ(static_cast<std::uint8_t>(m[12]), 0x11);
+  EXPECT_EQ(m[13], 9);
+  EXPECT_EQ(m[15], 7);
+}
+
+TEST(Foxglove, SubscriptionsAreCheckedAndRouted) {
+  vc::FoxgloveSubscriptions s;
+  const auto force = vc::foxglove_channel(viscera::protocol::Stream::force_feedback);
+  EXPECT_FALSE(s.apply(R"({"op":"subscribe","subscriptions":[{"id":5,"channelId":)" + std::to_string(force) + "}]}"));
+  EXPECT_EQ(s.to(force), std::vector<std::uint32_t>{5});
+  EXPECT_EQ(*s.apply(R"({"op":"subscribe","subscriptions":[{"id":5,"channelId":1}]})"), "subscribe: subscription id 5 is in use");
+  EXPECT_EQ(*s.apply(R"({"op":"subscribe","subscriptions":[{"id":6,"channelId":999}]})"), "subscribe: no channel 999");
+  EXPECT_EQ(*s.apply(R"({"op":"advertise"})"), "op 'advertise' is not supported (subscribe, unsubscribe)");
+  EXPECT_TRUE(s.apply("nonsense"));
+  EXPECT_FALSE(s.apply(R"({"op":"unsubscribe","subscriptionIds":[5]})"));
+  EXPECT_FALSE(s.any());
+  // Every advertised channel carries its stream's topic and a schema.
+  const auto adv = vc::foxglove_advertise();
+  EXPECT_EQ(adv["channels"].size(), vc::foxglove_streams().size());
+  for (const auto& c : adv["channels"]) EXPECT_GT(c["schema"].get<std::string>().size(), 100u) << c["topic"];
 }

@@ -5,7 +5,8 @@
 # mesh moves, the force plot rises, Pause pauses the server as its scene state says, a bookmark
 # reaches the events, the material form changes the tissue), then misbehaving browsers against
 # the bridge (tests/node/console_robustness.mjs: a slow one, malformed messages, an oversized one,
-# a flood, a wrong token) while a well-behaved one keeps receiving frames. Also the console's
+# a flood, a wrong token) while a well-behaved one keeps receiving frames; and the reference client
+# of the Foxglove WebSocket protocol (tests/node/foxglove_client.mjs). Also the console's
 # refusals of a bad command line and token file.
 # Usage: console_test.sh BUILD_DIR SOURCE_DIR    (SHOTS=DIR keeps the page's screenshots)
 set -u
@@ -41,6 +42,8 @@ sleep 1
 shots="${SHOTS:-$tmp}"; mkdir -p "$shots"
 node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
 check "the page in Chromium (console_page.mjs)" '[ $rc_page -eq 0 ]'
+node "$node_dir/foxglove_client.mjs" "$url" > "$tmp/foxglove.json"; rc_foxglove=$?
+check "a Foxglove client on the live session (foxglove_client.mjs)" '[ $rc_foxglove -eq 0 ]'
 node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?
 check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'

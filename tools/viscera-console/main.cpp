@@ -105,12 +105,20 @@ int main(int argc, char** argv) {
     std::vector<viscera::console::Station*> station_list;
     const auto partitions = split(cl.text("stations"), ',');
     for (std::size_t k = 0; k < partitions.size(); ++k) {
-      viscera::console::StationSink sink{[&web, k](std::shared_ptr<const std::string> f) {
-                                           if (auto* w = web.load()) w->post_frame(k, std::move(f));
-                                         },
-                                         [&web, k](viscera::console::OutMessage m) {
-                                           if (auto* w = web.load()) w->post_message(k, std::move(m));
-                                         }};
+      viscera::console::StationSink sink{
+          [&web, k](std::shared_ptr<const std::string> f) {
+            if (auto* w = web.load()) w->post_frame(k, std::move(f));
+          },
+          [&web, k](viscera::console::OutMessage m) {
+            if (auto* w = web.load()) w->post_message(k, std::move(m));
+          },
+          [&web, k](viscera::protocol::Stream s, std::int64_t stamp, std::shared_ptr<const std::vector<std::uint8_t>> p) {
+            if (auto* w = web.load()) w->post_raw(k, s, stamp, std::move(p));
+          },
+          [&web] {
+            auto* w = web.load();
+            return w != nullptr && w->wants_raw();
+          }};
       stations.push_back(std::make_unique<viscera::console::Station>(domain, partitions[k], client_id, force_period_s, std::move(sink)));
       station_list.push_back(stations.back().get());
     }

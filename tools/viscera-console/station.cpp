@@ -8,6 +8,7 @@
 #include "viscera/client/stream_tap.hpp"
 #include "viscera/console/console_wire.hpp"
 #include "viscera/console/force_decimator.hpp"
+#include "viscera/console/foxglove_protocol.hpp"
 
 namespace viscera::console {
 
@@ -45,9 +46,8 @@ StationSnapshot Station::snapshot() const {
 }
 
 void Station::stream_loop() {
-  const std::vector<proto::Stream> streams = {
-      proto::Stream::instrument_command, proto::Stream::force_feedback, proto::Stream::scene_state, proto::Stream::telemetry,
-      proto::Stream::surface_topology,   proto::Stream::mesh_frame,     proto::Stream::event};
+  // The page's streams, and every stream a session has for Foxglove clients.
+  const std::vector<proto::Stream>& streams = foxglove_streams();
   client::StreamTap tap(domain_, partition_, streams, 256);
   ForceDecimator forces(force_period_s_);
   std::map<std::uint32_t, proto::Vector3> tips;
@@ -55,7 +55,12 @@ void Station::stream_loop() {
   const auto now_s = [] { return 1e-9 * static_cast<double>(client::now_ns()); };
   while (!stop_) {
     tap.wait(std::chrono::milliseconds(5));
+    const bool raw = sink_.wants_raw && sink_.wants_raw();
     tap.take([&](const client::TapSample& s) {
+      // The state streams always (the bridge keeps their newest for Foxglove clients that come later).
+      const bool state =
+          s.stream == proto::Stream::scene_state || s.stream == proto::Stream::surface_topology || s.stream == proto::Stream::scene_files;
+      if (raw || state) sink_.raw(s.stream, s.stamp_ns, std::make_shared<const std::vector<std::uint8_t>>(s.payload.begin(), s.payload.end()));
       std::string why;
       switch (s.stream) {
         case proto::Stream::instrument_command:

@@ -20,6 +20,7 @@
 
 #include "viscera/console/browser_request.hpp"
 #include "viscera/console/outbox.hpp"
+#include "viscera/protocol/dds.hpp"
 
 namespace viscera::console {
 
@@ -27,6 +28,9 @@ namespace viscera::console {
 struct StationSink {
   std::function<void(std::shared_ptr<const std::string> frame)> frame;
   std::function<void(OutMessage m)> message;
+  /// Every payload as it came off the domain, for Foxglove clients; called only while `wants_raw`.
+  std::function<void(protocol::Stream stream, std::int64_t stamp_ns, std::shared_ptr<const std::vector<std::uint8_t>> payload)> raw;
+  std::function<bool()> wants_raw;
 };
 
 /// What a browser that starts watching gets at once.

@@ -1,5 +1,6 @@
 #include "web_server.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <map>
 
@@ -10,6 +11,7 @@
 
 #include "viscera/console/access_token.hpp"
 #include "viscera/console/browser_request.hpp"
+#include "viscera/console/foxglove_protocol.hpp"
 #include "viscera/console/rate_limit.hpp"
 
 #include "station.hpp"
@@ -70,9 +72,13 @@ struct WebServer::Impl : std::enable_shared_from_this<WebServer::Impl> {
   std::uint64_t next_id = 1;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   bool stopped = false;
+  std::atomic<int> foxglove_browsers{0};
+  /// Per station, the newest payload of each stream whose newest sample is its state (scene,
+  /// surface topology, scene files): a Foxglove client that subscribes gets it at once.
+  std::vector<std::map<protocol::Stream, std::pair<std::int64_t, std::shared_ptr<const std::vector<std::uint8_t>>>>> latched;
 
   Impl(asio::io_context& io_, const tcp::endpoint& ep, WebOptions o, std::vector<Station*> s)
-      : io(io_), acceptor(io_, ep), opt(std::move(o)), stations(std::move(s)) {}
+      : io(io_), acceptor(io_, ep), opt(std::move(o)), stations(std::move(s)), latched(stations.size()) {}
   void accept();
   void handle_http(tcp::socket socket);
   bool authorised(const http::request<http::string_body>& req, bool* from_query) const;
@@ -98,17 +104,29 @@ class Browser : public std::enable_shared_from_this<Browser> {
     beast::get_lowest_layer(ws_).socket().set_option(asio::socket_base::send_buffer_size(128 * 1024), ec);
   }
 
-  void start(http::request<http::string_body>&& req) {
+  ~Browser() {
+    if (foxglove_ && accepted_) --server_->foxglove_browsers;
+  }
+
+  /// `station`: which station it watches; `foxglove`: it speaks the Foxglove protocol.
+  void start(http::request<http::string_body>&& req, std::size_t station, bool foxglove) {
     upgrade_ = std::move(req);  // kept until the handshake completes
+    station_ = station;
+    foxglove_ = foxglove;
     auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
     timeouts.idle_timeout = std::chrono::seconds(30);  // a browser that answers no ping for 30 s is gone
     ws_.set_option(timeouts);
     ws_.read_message_max(kMaxRequestBytes);
-    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& r) { r.set(http::field::server, "viscera-console"); }));
+    ws_.set_option(websocket::stream_base::decorator([foxglove](websocket::response_type& r) {
+      r.set(http::field::server, "viscera-console");
+      if (foxglove) r.set(http::field::sec_websocket_protocol, kFoxgloveSubprotocol);
+    }));
     ws_.async_accept(upgrade_, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
       self->server_->browsers[self->id_] = self;
       ++self->server_->counters.browsers_opened;
+      self->accepted_ = true;
+      if (self->foxglove_) ++self->server_->foxglove_browsers;
       self->hello();
       self->read();
     });
@@ -131,6 +149,16 @@ class Browser : public std::enable_shared_from_this<Browser> {
     pump();
   }
   void send_json(const nlohmann::json& j) { send({std::make_shared<const std::string>(j.dump()), false, false}); }
+
+  /// A payload for each of this Foxglove client's subscriptions to its stream.
+  void send_raw(protocol::Stream stream, std::int64_t stamp_ns, const std::vector<std::uint8_t>& payload) {
+    if (!foxglove_) return;
+    // The 1 kHz streams may be dropped for a slow client; state and events may not.
+    const bool droppable = stream == protocol::Stream::instrument_command || stream == protocol::Stream::force_feedback ||
+                           stream == protocol::Stream::telemetry || stream == protocol::Stream::mesh_frame;
+    for (const std::uint32_t id : subscriptions_.to(foxglove_channel(stream)))
+      send({std::make_shared<const std::string>(foxglove_message_data(id, static_cast<std::uint64_t>(stamp_ns), payload)), true, droppable});
+  }
 
   nlohmann::json stats() const {
     const double age = seconds_since(opened_);
@@ -158,6 +186,11 @@ class Browser : public std::enable_shared_from_this<Browser> {
 
  private:
   void hello() {
+    if (foxglove_) {
+      send_json(foxglove_server_info("viscera-console: " + server_->stations[station_]->name()));
+      send_json(foxglove_advertise());
+      return;
+    }
     nlohmann::json names = nlohmann::json::array();
     for (const Station* s : server_->stations) names.push_back(s->name());
     send_json({{"type", "hello"},
@@ -214,6 +247,19 @@ class Browser : public std::enable_shared_from_this<Browser> {
   }
 
   void handle(const std::string& message) {
+    if (foxglove_) {
+      const auto before = subscriptions_;
+      if (const auto why = subscriptions_.apply(message)) {
+        ++server_->counters.malformed;
+        send_json(foxglove_status(2, *why));
+        return;
+      }
+      // A new subscription to a state stream gets the state at once.
+      for (const auto& [stream, latest] : server_->latched[station_])
+        if (before.to(foxglove_channel(stream)).size() < subscriptions_.to(foxglove_channel(stream)).size())
+          send_raw(stream, latest.first, *latest.second);
+      return;
+    }
     std::string why;
     const auto r = parse_browser_request(message, &why);
     if (!r) {
@@ -279,7 +325,8 @@ class Browser : public std::enable_shared_from_this<Browser> {
   beast::flat_buffer in_;
   std::shared_ptr<const std::string> current_;
   std::size_t station_ = 0;
-  bool writing_ = false, closing_ = false;
+  bool writing_ = false, closing_ = false, foxglove_ = false, accepted_ = false;
+  FoxgloveSubscriptions subscriptions_;
   std::uint64_t bytes_sent_ = 0, messages_sent_ = 0, errors_sent_ = 0, refused_in_a_row_ = 0;
   std::string address_;
   std::chrono::steady_clock::time_point opened_ = std::chrono::steady_clock::now();
@@ -308,12 +355,23 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (websocket::is_upgrade(req)) {
       const std::string target(req.target());
       if (!ok) return respond(req, http::status::unauthorized, "text/plain", "the console's token is missing or wrong\n", false);
-      if (target.substr(0, target.find('?')) != "/ws") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
+      const std::string path = target.substr(0, target.find('?'));
+      if (path != "/ws" && path != "/") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
       if (server_->browsers.size() >= server_->opt.max_browsers)
         return respond(req, http::status::service_unavailable, "text/plain", "too many browsers\n", false);
       stream_.expires_never();
+      // A Foxglove client asks for its subprotocol; ?station=NAME picks the station (default: the first).
+      const auto protocols = req.find(http::field::sec_websocket_protocol);
+      const bool foxglove = protocols != req.end() && protocols->value().find(kFoxgloveSubprotocol) != beast::string_view::npos;
+      const std::string query = target.find('?') == std::string::npos ? std::string() : target.substr(target.find('?') + 1);
+      const std::string wanted = field_value(query, "station", '&');
+      std::size_t station = 0;
+      for (std::size_t k = 0; k < server_->stations.size(); ++k)
+        if (server_->stations[k]->name() == wanted) station = k;
+      if (!wanted.empty() && server_->stations[station]->name() != wanted)
+        return respond(req, http::status::not_found, "text/plain", "no station '" + wanted.substr(0, 64) + "'\n", false);
       auto b = std::make_shared<Browser>(stream_.release_socket(), server_, server_->next_id++);
-      b->start(std::move(req));
+      b->start(std::move(req), station, foxglove);
       return;
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
@@ -434,5 +492,17 @@ void WebServer::post_message(std::size_t station, OutMessage m) {
 }
 
 nlohmann::json WebServer::stats() const { return impl_->stats(); }
+
+bool WebServer::wants_raw() const { return impl_->foxglove_browsers > 0; }
+
+void WebServer::post_raw(std::size_t station, protocol::Stream stream, std::int64_t stamp_ns,
+                         std::shared_ptr<const std::vector<std::uint8_t>> payload) {
+  asio::post(impl_->io, [impl = impl_, station, stream, stamp_ns, payload = std::move(payload)] {
+    if (stream == protocol::Stream::scene_state || stream == protocol::Stream::surface_topology || stream == protocol::Stream::scene_files)
+      impl->latched[station][stream] = {stamp_ns, payload};
+    for (auto& [id, b] : std::map(impl->browsers))
+      if (b->station() == station) b->send_raw(stream, stamp_ns, *payload);
+  });
+}
 
 }  // namespace viscera::console

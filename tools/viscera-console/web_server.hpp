@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/console/outbox.hpp"
+#include "viscera/protocol/dds.hpp"
 
 namespace viscera::console {
 
@@ -38,6 +39,10 @@ class WebServer {
   /// Thread-safe: hand a station's newest frame / a message to every browser watching it.
   void post_frame(std::size_t station, std::shared_ptr<const std::string> frame);
   void post_message(std::size_t station, OutMessage m);
+  /// Thread-safe: a payload as it came off the domain, for the Foxglove clients subscribed to its
+  /// stream; wants_raw() says whether any is connected (else the station need not copy them).
+  void post_raw(std::size_t station, protocol::Stream stream, std::int64_t stamp_ns, std::shared_ptr<const std::vector<std::uint8_t>> payload);
+  bool wants_raw() const;
   /// Counters, per browser and in all (the io thread's view; call on it, or from /stats).
   nlohmann::json stats() const;
 
