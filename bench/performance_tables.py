@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates the tables of docs/PERFORMANCE.md from the benchmarks' results in bench/results:
 tissue.json (bench/run.sh), tick.json (bench/tick.sh), haptics.json (bench/haptics.sh),
-soak.json (bench/soak.sh) and record.json (bench/record.sh). Each table goes between its markers <!-- begin NAME --> and
+soak.json (bench/soak.sh), record.json (bench/record.sh) and console.json (bench/console.sh). Each table goes between its markers <!-- begin NAME --> and
 <!-- end NAME -->, with the machine and the date of the run it comes from; the prose around the
 markers is left as it is. Usage: performance_tables.py [ROOT]"""
 import contextlib
@@ -98,11 +98,24 @@ def record(path):
     return f"Run of {r['date_utc']} UTC (`bench/record.sh {r['seconds']:g}`), {r['machine']}:\n\n" + "\n".join(rows) + "\n"
 
 
+def console(path):
+    r = json.load(open(path))
+    rows = ["| clients | frames | server -> client p50 / p99 [ms] | the DDS leg alone, server -> bridge, p50 / p99 [ms] | bytes/s per client | bridge CPU [% of one core] |",
+            "|---|---|---|---|---|---|"]
+    for k in ("one", "four"):
+        x = r[k]
+        rows.append(f"| {x['clients']} WebSocket client{'s' if x['clients'] > 1 else ''} | {x['frames']} | {x['delay_ms']['p50']:.2f} / {x['delay_ms']['p99']:.2f} | "
+                    f"{x['dds_leg_ms']['p50']:.2f} / {x['dds_leg_ms']['p99']:.2f} | {x['bytes_per_s_per_client'] / 1000:.0f} kB/s | {100 * x['bridge_cpu_fraction_of_one_core']:.1f} |")
+    p = r["page"]
+    rows.append(f"| the page in headless Chromium (software WebGL) | {p['frames']} | {p['delay_ms']['p50']:.1f} / {p['delay_ms']['p99']:.1f} | | | |")
+    return f"Run of {r['date_utc']} UTC (`bench/console.sh {r['seconds']:g}`), {r['machine']}:\n\n" + "\n".join(rows) + "\n"
+
+
 def main(root):
     doc_path = os.path.join(root, "docs", "PERFORMANCE.md")
     doc = open(doc_path).read()
     results = os.path.join(root, "bench", "results")
-    for name, fn in [("tissue", tissue), ("tick", tick), ("haptics", haptics), ("soak", soak), ("record", record)]:
+    for name, fn in [("tissue", tissue), ("tick", tick), ("haptics", haptics), ("soak", soak), ("record", record), ("console", console)]:
         path = os.path.join(results, f"{name}.json")
         if not os.path.exists(path):
             continue

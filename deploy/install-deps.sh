@@ -22,6 +22,7 @@ packages=(
   libssl-dev               # SHA-256 of the files a scene was built from (recordings name them)
   libboost-dev             # Boost.Beast: the console's HTTP and WebSocket server (header-only)
   chromium                 # the browser tests of the console page (headless, driven by playwright-core)
+  openssl                  # the console's access token (openssl rand)
 )
 # Node.js and npm: the official MCAP reader (@mcap/core) that judges recordings in the tests. Debian's
 # packages, unless a node and an npm are on the PATH already (a NodeSource install bundles npm).

@@ -9,8 +9,12 @@
 # receives; the console what the server did, and the server's health reports while the probe presses again.
 # viscera-record records the whole session to out/demo.mcap; at the end the demo prints the
 # recording's summary and re-runs the session on a fresh server in lockstep, bit for bit.
+# The instructor's console (viscera-console) runs beside it all: open the address it prints in a
+# browser to watch the liver deform, the forces rise, and to pause, bookmark or take over.
 #   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene
 #   DURATION=20 ./deploy/run.sh                           a longer press (seconds)
+#   KEEP=1 ./deploy/run.sh                                leave the server and the console running after the demo (Ctrl-C ends them)
+#   LISTEN=0.0.0.0:8080 ./deploy/run.sh                   the console reachable from other hosts (default: this one only)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/deploy/build.sh" "$root/build"
@@ -25,7 +29,13 @@ recording="$root/out/demo.mcap"
 recorder=$!
 "$bin/server/runtime/viscera-server" --scene "$scene" > >(sed -u 's/^/[server] /') 2>&1 &
 server=$!
-trap 'kill -INT "$server" "$recorder" 2>/dev/null || true; wait "$server" "$recorder" 2>/dev/null || true; sleep 0.2' EXIT
+# The console's access token: made once, readable by this user only.
+token="$root/out/console-token"
+[ -s "$token" ] || (umask 077 && openssl rand -hex 16 > "$token")
+"$bin/tools/viscera-console/viscera-console" --domain "$domain" --token-file "$token" --listen "${LISTEN:-127.0.0.1:8080}" \
+  > >(sed -u 's/^/[console] /') 2>&1 &
+console_pid=$!
+trap 'kill -INT "$server" "$recorder" "$console_pid" 2>/dev/null || true; wait "$server" "$recorder" "$console_pid" 2>/dev/null || true; sleep 0.2' EXIT
 sleep 1  # the recorder discovers the server before the first command
 echo "[demo] probe 1 presses 3 cm into the liver and comes back (${duration} s)"
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
@@ -41,8 +51,12 @@ console=$!
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
   --duration "$duration" 2>&1 | sed -u 's/^/[haptic] /'
 wait "$console" || true
-echo "[demo] done; the server and the recorder stop"
-kill -INT "$server" "$recorder"; wait "$server" "$recorder" || true
+if [ -n "${KEEP:-}" ]; then
+  echo "[demo] done; the server and the console keep running (KEEP=1): open the console's address above; Ctrl-C ends them"
+  wait "$server" || true
+fi
+echo "[demo] done; the server, the console and the recorder stop"
+kill -INT "$server" "$recorder" "$console_pid" 2>/dev/null; wait "$server" "$recorder" "$console_pid" || true
 trap - EXIT
 sleep 0.2
 echo "[demo] the recording ($recording):"

@@ -126,6 +126,8 @@ void Station::stream_loop() {
             {
               const std::lock_guard lock(mutex_);
               snapshot_.frame = m;
+              frame_delays_ms_.push_back(1e-6 * static_cast<double>(client::now_ns() - f->server_stamp_ns));
+              if (frame_delays_ms_.size() > 1000) frame_delays_ms_.pop_front();
             }
             sink_.frame(m);
           }
@@ -159,6 +161,17 @@ bool Station::request(const BrowserRequest& r, std::function<void(nlohmann::json
   }
   requests_cv_.notify_one();
   return true;
+}
+
+std::pair<double, double> Station::frame_delay_ms() const {
+  std::vector<double> d;
+  {
+    const std::lock_guard lock(mutex_);
+    d.assign(frame_delays_ms_.begin(), frame_delays_ms_.end());
+  }
+  if (d.empty()) return {0, 0};
+  std::sort(d.begin(), d.end());
+  return {d[d.size() / 2], d[std::min(d.size() - 1, d.size() * 99 / 100)]};
 }
 
 bool Station::move(std::uint32_t instrument, const proto::Vector3& delta, std::string* why) {

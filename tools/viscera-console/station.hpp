@@ -57,6 +57,9 @@ class Station {
   bool move(std::uint32_t instrument, const protocol::Vector3& delta, std::string* why);
   /// Payloads that failed verification and were dropped.
   std::uint64_t rejected() const { return rejected_; }
+  /// The delay from the server's surface frames to the bridge [ms]: p50 and p99 of the last 1000
+  /// (the DDS leg of the page's delay; the same clock on one host, synchronised clocks across).
+  std::pair<double, double> frame_delay_ms() const;
 
  private:
   void stream_loop();
@@ -73,7 +76,8 @@ class Station {
   StationSnapshot snapshot_;
   std::map<std::uint32_t, protocol::Vector3> tips_;  ///< each instrument's newest commanded tip [m]
   protocol::Vector3 bounds_min_{}, bounds_max_{};  ///< the organ's, from the scene state [m]
-  std::map<std::uint32_t, protocol::Vector3> held_;  ///< instruments the console drives, at these tips
+  std::map<std::uint32_t, protocol::Vector3> held_;
+  std::deque<double> frame_delays_ms_;  ///< instruments the console drives, at these tips
   std::deque<std::pair<BrowserRequest, std::function<void(nlohmann::json)>>> requests_;
   std::condition_variable requests_cv_;
   std::atomic<bool> stop_{false};

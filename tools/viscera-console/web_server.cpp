@@ -447,7 +447,10 @@ nlohmann::json WebServer::Impl::stats() const {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [id, b] : browsers) list.push_back(b->stats());
   nlohmann::json st = nlohmann::json::array();
-  for (const Station* s : stations) st.push_back({{"name", s->name()}, {"rejected_payloads", s->rejected()}});
+  for (const Station* s : stations) {
+    const auto [p50, p99] = s->frame_delay_ms();
+    st.push_back({{"name", s->name()}, {"rejected_payloads", s->rejected()}, {"frame_delay_ms", {{"p50", p50}, {"p99", p99}}}});
+  }
   return {{"uptime_s", seconds_since(start)},
           {"browsers", list},
           {"stations", st},

@@ -279,7 +279,8 @@ function onEvent(e) {
   const bookmark = e.kind === 'annotation' && e.text.startsWith('bookmark');
   li.className = bookmark ? 'bookmark' : e.kind === 'annotation' ? 'annotation' : e.kind === 'request_refused' ? 'refused' : '';
   const who = e.source_client_id ? `client ${e.source_client_id}` : 'server';
-  li.textContent = `${e.sim_time_s.toFixed(2)} s  ${bookmark ? '★ ' : ''}${e.kind.replace(/_/g, ' ')}${e.instrument_id ? ` (instrument ${e.instrument_id})` : ''}` +
+  // Clients' annotations carry no simulated time (the server's events do).
+  li.textContent = `${e.source_client_id ? '' : `${e.sim_time_s.toFixed(2)} s  `}${bookmark ? '★ ' : ''}${e.kind.replace(/_/g, ' ')}${e.instrument_id ? ` (instrument ${e.instrument_id})` : ''}` +
     `${e.text ? ': ' + e.text : ''} — ${who}`;
   const list = $('events');
   list.append(li);
