@@ -32,7 +32,7 @@ server=$!
 # The console's access token: made once, readable by this user only.
 token="$root/out/console-token"
 [ -s "$token" ] || (umask 077 && openssl rand -hex 16 > "$token")
-"$bin/tools/viscera-console/viscera-console" --domain "$domain" --token-file "$token" --listen "${LISTEN:-127.0.0.1:8080}" \
+"$bin/tools/viscera-console/viscera-console" --domain "$domain" --token-file "$token" --listen "${LISTEN:-127.0.0.1:8080}" --recordings "$root/out" \
   > >(sed -u 's/^/[console] /') 2>&1 &
 console_pid=$!
 trap 'kill -INT "$server" "$recorder" "$console_pid" 2>/dev/null || true; wait "$server" "$recorder" "$console_pid" 2>/dev/null || true; sleep 0.2' EXIT

@@ -17,6 +17,7 @@
 #include "viscera/console/foxglove_protocol.hpp"
 #include "viscera/console/outbox.hpp"
 #include "viscera/console/rate_limit.hpp"
+#include "viscera/console/recordings.hpp"
 
 namespace vc = viscera::console;
 
@@ -250,4 +251,25 @@ TEST(Foxglove, SubscriptionsAreCheckedAndRouted) {
   const auto adv = vc::foxglove_advertise();
   EXPECT_EQ(adv["channels"].size(), vc::foxglove_streams().size());
   for (const auto& c : adv["channels"]) EXPECT_GT(c["schema"].get<std::string>().size(), 100u) << c["topic"];
+}
+
+TEST(Recordings, OnlyPlainMcapNamesOfTheFolderAreOffered) {
+  EXPECT_TRUE(vc::is_recording_name("session-1.mcap"));
+  EXPECT_FALSE(vc::is_recording_name("../session.mcap"));
+  EXPECT_FALSE(vc::is_recording_name(".hidden.mcap"));
+  EXPECT_FALSE(vc::is_recording_name("session.json"));
+  EXPECT_FALSE(vc::is_recording_name(".mcap"));
+  const auto dir = std::filesystem::temp_directory_path() / "viscera_console_recordings";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "sub.mcap");  // a folder, not a recording
+  for (const char* name : {"b.mcap", "a.mcap", "notes.txt", "with space.mcap"}) std::ofstream(dir / name) << "x";
+  EXPECT_EQ(vc::list_recordings(dir.string()), (std::vector<std::string>{"a.mcap", "b.mcap"}));
+  EXPECT_TRUE(vc::list_recordings("").empty());
+  EXPECT_TRUE(vc::list_recordings((dir / "absent").string()).empty());
+  std::string why;
+  EXPECT_FALSE(vc::parse_browser_request(R"({"type":"open_recording","file":"../x.mcap"})", &why));
+  EXPECT_EQ(why, "file: \"../x.mcap\" is not a recording's name (letters, digits, '.', '_', '-', ending in .mcap; no path)");
+  const auto ok = vc::parse_browser_request(R"({"type":"open_recording","file":"a.mcap"})", &why);
+  ASSERT_TRUE(ok) << why;
+  EXPECT_EQ(ok->text, "a.mcap");
 }

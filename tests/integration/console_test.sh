@@ -6,7 +6,8 @@
 # reaches the events, the material form changes the tissue), then misbehaving browsers against
 # the bridge (tests/node/console_robustness.mjs: a slow one, malformed messages, an oversized one,
 # a flood, a wrong token) while a well-behaved one keeps receiving frames; and the reference client
-# of the Foxglove WebSocket protocol (tests/node/foxglove_client.mjs). Also the console's
+# of the Foxglove WebSocket protocol (tests/node/foxglove_client.mjs); and the session's recording
+# opened for replay from the console (tests/node/console_replay.mjs). Also the console's
 # refusals of a bad command line and token file.
 # Usage: console_test.sh BUILD_DIR SOURCE_DIR    (SHOTS=DIR keeps the page's screenshots)
 set -u
@@ -33,15 +34,21 @@ check "a bad --listen is refused" '[ $rc -eq 2 ] && grep -q "port is not in" "$t
 cat "$tmp/e1.txt" "$tmp/e2.txt" "$tmp/e3.txt"
 
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 & pids+=($!)
-"$console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 > "$tmp/console.log" 2>&1 & bridge=$!; pids+=($bridge)
+# The session is recorded while the page is tested; the recording is then opened for replay.
+mkdir -p "$tmp/recordings"
+"$build/tools/viscera-record/viscera-record" --out "$tmp/recordings/session.mcap" --domain "$domain" --quiet > "$tmp/record.log" 2>&1 & recorder=$!; pids+=($recorder)
+"$console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 --recordings "$tmp/recordings" > "$tmp/console.log" 2>&1 & bridge=$!; pids+=($bridge)
 wait_for "open http" "$tmp/console.log" || exit 1
 url=$(grep -o "http://[^ ]*" "$tmp/console.log")
 sleep 1
-"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 --duration 40 --quiet \
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script hold --force 1.2 --duration 150 --quiet \
   > "$tmp/haptic.log" 2>&1 & pids+=($!)
 shots="${SHOTS:-$tmp}"; mkdir -p "$shots"
 node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
 check "the page in Chromium (console_page.mjs)" '[ $rc_page -eq 0 ]'
+kill -INT "$recorder"; wait "$recorder"
+node "$node_dir/console_replay.mjs" "$url" session.mcap > "$tmp/replay.json"; rc_replay=$?
+check "a recording opened for replay from the console (console_replay.mjs)" '[ $rc_replay -eq 0 ]'
 node "$node_dir/foxglove_client.mjs" "$url" > "$tmp/foxglove.json"; rc_foxglove=$?
 check "a Foxglove client on the live session (foxglove_client.mjs)" '[ $rc_foxglove -eq 0 ]'
 node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?

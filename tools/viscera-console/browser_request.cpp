@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/client/session_limits.hpp"
+#include "viscera/console/recordings.hpp"
 
 namespace viscera::console {
 
@@ -18,8 +19,8 @@ struct TypeInfo {
   std::set<std::string> fields;  ///< besides "type" and "id"
 };
 
-const std::array<TypeInfo, 11>& types() {
-  static const std::array<TypeInfo, 11> t = {{
+const std::array<TypeInfo, 13>& types() {
+  static const std::array<TypeInfo, 13> t = {{
       {RequestType::pause, "pause", {}},
       {RequestType::resume, "resume", {}},
       {RequestType::reset, "reset", {}},
@@ -31,6 +32,8 @@ const std::array<TypeInfo, 11>& types() {
       {RequestType::take_over, "take_over", {"instrument"}},
       {RequestType::hand_back, "hand_back", {"instrument"}},
       {RequestType::move, "move", {"instrument", "delta_m"}},
+      {RequestType::open_recording, "open_recording", {"file"}},
+      {RequestType::recordings, "recordings", {}},
   }};
   return t;
 }
@@ -112,6 +115,11 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
           return fail("delta_m: " + shown(value) + ": each step within +-" + std::to_string(kMaxMoveStepM).substr(0, 4) + " m");
         r.delta_m[k] = value[k].get<double>();
       }
+    } else if (key == "file") {
+      const auto s = text(128);
+      if (!s || !is_recording_name(*s))
+        return fail("file: " + shown(value) + " is not a recording's name (letters, digits, '.', '_', '-', ending in .mcap; no path)");
+      r.text = *s;
     } else if (key == "station") {
       const auto s = text(64);
       if (!s) return fail("station: " + shown(value) + " is not a station name");
@@ -128,6 +136,7 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
   if (r.type == RequestType::load_scene && r.text.empty()) return fail("load_scene: scene missing");
   if ((r.type == RequestType::take_over || r.type == RequestType::hand_back || r.type == RequestType::move) && r.instrument == 0)
     return fail(std::string(info->name) + ": instrument missing");
+  if (r.type == RequestType::open_recording && r.text.empty()) return fail("open_recording: file missing");
   if (r.type == RequestType::annotate && r.text.empty()) return fail("annotate: text missing or empty");
   if (r.type == RequestType::material && r.change.empty())
     return fail("material: needs at least one of youngs-modulus-pa, poisson-ratio, density-kg-m3, shear-q, damping-per-s");

@@ -15,6 +15,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/console/access_token.hpp"
+#include "viscera/process/child_process.hpp"
 
 #include "station.hpp"
 #include "web_server.hpp"
@@ -82,6 +83,8 @@ int main(int argc, char** argv) {
   cl.flag("force-rate-hz", "HZ", "force summaries per second and instrument sent to browsers (the peak of each period kept)", "30");
   cl.flag("outbox-kib", "KIB", "what may wait for one browser before its oldest forces and telemetry are dropped [KiB]", "4096");
   cl.flag("requests-per-s", "R", "requests a browser may send a second (bursts of twice that)", "20");
+  cl.flag("recordings", "DIR", "session recordings (viscera-record) a browser may open for replay, each as a station of its own (none: no replays)");
+  cl.flag("replayer", "PATH", "the viscera-replay program (default: the one beside this program)");
   cl.flag("stats-every-s", "S", "print the browsers' traffic every S seconds (0: never)", "0");
   try {
     if (!cl.parse(argc, argv)) return 0;
@@ -103,9 +106,9 @@ int main(int argc, char** argv) {
     std::atomic<viscera::console::WebServer*> web{nullptr};
     std::vector<std::unique_ptr<viscera::console::Station>> stations;
     std::vector<viscera::console::Station*> station_list;
-    const auto partitions = split(cl.text("stations"), ',');
-    for (std::size_t k = 0; k < partitions.size(); ++k) {
-      viscera::console::StationSink sink{
+    // Where a station's messages go: the web server, once it exists.
+    const auto make_sink = [&web](std::size_t k) {
+      return viscera::console::StationSink{
           [&web, k](std::shared_ptr<const std::string> f) {
             if (auto* w = web.load()) w->post_frame(k, std::move(f));
           },
@@ -119,8 +122,43 @@ int main(int argc, char** argv) {
             auto* w = web.load();
             return w != nullptr && w->wants_raw();
           }};
-      stations.push_back(std::make_unique<viscera::console::Station>(domain, partitions[k], client_id, force_period_s, std::move(sink)));
+    };
+    const auto partitions = split(cl.text("stations"), ',');
+    for (std::size_t k = 0; k < partitions.size(); ++k) {
+      stations.push_back(std::make_unique<viscera::console::Station>(domain, partitions[k], client_id, force_period_s, make_sink(k)));
       station_list.push_back(stations.back().get());
+    }
+    // Replays opened from the page: viscera-replay play in a partition of its own each, stopped
+    // with the console. Called on the web server's thread.
+    std::vector<std::unique_ptr<viscera::process::ChildProcess>> replays;
+    const std::string replayer = cl.has("replayer") ? cl.text("replayer") : viscera::process::find_program("viscera-replay", "tools/viscera-replay");
+    const std::string recordings_dir = cl.has("recordings") ? cl.text("recordings") : std::string();
+    if (!recordings_dir.empty()) {
+      options.recordings_dir = recordings_dir;
+      if (!std::filesystem::is_directory(options.recordings_dir))
+        throw viscera::common::InputError(options.recordings_dir, 0, "--recordings", "is not a folder");
+      options.open_replay = [&, domain, client_id, force_period_s](const std::string& file, std::string* why) -> viscera::console::Station* {
+        if (replays.size() >= 4) {
+          *why = "4 replays are open already (restart the console to close them)";
+          return nullptr;
+        }
+        const std::string partition = "viscera-replay-" + std::to_string(replays.size() + 1);
+        const std::string log = std::filesystem::temp_directory_path() / ("viscera-console-" + partition + ".log");
+        try {
+          replays.push_back(std::make_unique<viscera::process::ChildProcess>(
+              std::vector<std::string>{replayer, "play", recordings_dir + "/" + file, "--partition", partition, "--domain", std::to_string(domain),
+                                       "--no-keys", "--quiet"},
+              log));
+        } catch (const std::exception& e) {
+          *why = e.what();
+          return nullptr;
+        }
+        const std::size_t k = stations.size();
+        stations.push_back(std::make_unique<viscera::console::Station>(domain, partition, client_id, force_period_s, make_sink(k)));
+        std::printf("viscera-console: replaying %s as station %s (log %s)\n", file.c_str(), partition.c_str(), log.c_str());
+        std::fflush(stdout);
+        return stations.back().get();
+      };
     }
     auto server = std::make_unique<viscera::console::WebServer>(io, listen, std::move(options), station_list);
     web = server.get();

@@ -14,11 +14,10 @@ namespace viscera::console {
 
 namespace proto = viscera::protocol;
 
-namespace {
-
-std::shared_ptr<const std::string> text(const nlohmann::json& j) { return std::make_shared<const std::string>(j.dump()); }
-
-}  // namespace
+std::shared_ptr<const std::string> Station::tagged(nlohmann::json j) const {
+  j["station"] = name_;
+  return std::make_shared<const std::string>(j.dump());
+}
 
 Station::Station(std::uint32_t domain, std::string partition, std::uint32_t client_id, double force_period_s, StationSink sink)
     : domain_(domain),
@@ -75,9 +74,7 @@ void Station::stream_loop() {
           break;
         case proto::Stream::scene_state:
           if (const auto sc = proto::decode_scene(s.payload, &why)) {
-            auto j = to_json(*sc);
-            j["station"] = name_;
-            auto m = text(j);
+            auto m = tagged(to_json(*sc));
             {
               const std::lock_guard lock(mutex_);
               snapshot_.scene = m;
@@ -95,9 +92,7 @@ void Station::stream_loop() {
           break;
         case proto::Stream::telemetry:
           if (const auto t = proto::decode_telemetry(s.payload, &why)) {
-            auto j = to_json(*t);
-            j["station"] = name_;
-            auto m = text(j);
+            auto m = tagged(to_json(*t));
             {
               const std::lock_guard lock(mutex_);
               snapshot_.telemetry = m;
@@ -133,23 +128,14 @@ void Station::stream_loop() {
           }
           break;
         case proto::Stream::event:
-          if (const auto e = proto::decode_event(s.payload, &why)) {
-            auto j = to_json(*e);
-            j["station"] = name_;
-            sink_.message({text(j), false, false});
-          }
+          if (const auto e = proto::decode_event(s.payload, &why)) sink_.message({tagged(to_json(*e)), false, false});
           break;
         default: break;
       }
       if (!why.empty()) ++rejected_;
     });
     const auto summaries = forces.flush(now_s());
-    if (!summaries.empty()) {
-      std::vector<std::pair<std::uint32_t, proto::Vector3>> tip_list(tips.begin(), tips.end());
-      auto j = forces_json(summaries, tip_list);
-      j["station"] = name_;
-      sink_.message({text(j), false, true});
-    }
+    if (!summaries.empty()) sink_.message({tagged(forces_json(summaries, {tips.begin(), tips.end()})), false, true});
   }
 }
 

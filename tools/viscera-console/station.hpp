@@ -65,7 +65,8 @@ class Station {
   void stream_loop();
   void request_loop();
   void drive_loop();
-  nlohmann::json carry_out(const BrowserRequest& r);
+  /// The message as the page gets it: with the station's name, encoded once for every browser.
+  std::shared_ptr<const std::string> tagged(nlohmann::json j) const;
 
   std::uint32_t domain_;
   std::string partition_, name_;

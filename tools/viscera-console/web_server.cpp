@@ -1,5 +1,6 @@
 #include "web_server.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <map>
@@ -13,6 +14,7 @@
 #include "viscera/console/browser_request.hpp"
 #include "viscera/console/foxglove_protocol.hpp"
 #include "viscera/console/rate_limit.hpp"
+#include "viscera/console/recordings.hpp"
 
 #include "station.hpp"
 
@@ -195,6 +197,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
     for (const Station* s : server_->stations) names.push_back(s->name());
     send_json({{"type", "hello"},
                {"stations", names},
+               {"recordings", list_recordings(server_->opt.recordings_dir)},
                {"settings", server_->opt.page_settings},
                {"limits", {{"requests_per_s", server_->opt.requests_per_s}, {"max_request_bytes", kMaxRequestBytes}}}});
     send_snapshot();
@@ -264,7 +267,10 @@ class Browser : public std::enable_shared_from_this<Browser> {
     const auto r = parse_browser_request(message, &why);
     if (!r) {
       ++server_->counters.malformed;
-      error(0, why);
+      // The reply names the request if its id can be read at all.
+      const auto j = nlohmann::json::parse(message, nullptr, false);
+      const bool has_id = j.is_object() && j.contains("id") && j["id"].is_number_unsigned();
+      error(has_id ? j["id"].get<std::uint64_t>() : 0, why);
       return;
     }
     if (r->type == RequestType::move) {
@@ -282,6 +288,11 @@ class Browser : public std::enable_shared_from_this<Browser> {
       error(r->id, "watch: no station '" + r->text + "'");
       return;
     }
+    if (r->type == RequestType::recordings) {
+      send_json({{"type", "recordings"}, {"id", r->id}, {"files", list_recordings(server_->opt.recordings_dir)}});
+      return;
+    }
+    if (r->type == RequestType::open_recording) return open_recording(*r);
     std::weak_ptr<Browser> weak = shared_from_this();
     asio::io_context& io = server_->io;
     const bool queued = server_->stations[station_]->request(*r, [weak, &io](nlohmann::json reply) {
@@ -293,6 +304,31 @@ class Browser : public std::enable_shared_from_this<Browser> {
       ++server_->counters.busy;
       error(r->id, "busy: 32 requests are waiting for the server");
     }
+  }
+
+  /// A recording of the folder replayed as a new station, which this browser then watches; every
+  /// browser gets the new list of stations.
+  void open_recording(const BrowserRequest& r) {
+    if (!server_->opt.open_replay || server_->opt.recordings_dir.empty())
+      return error(r.id, "open_recording: this console was started without --recordings");
+    const auto files = list_recordings(server_->opt.recordings_dir);
+    if (std::find(files.begin(), files.end(), r.text) == files.end()) return error(r.id, "open_recording: no recording '" + r.text + "'");
+    std::string why;
+    Station* s = server_->opt.open_replay(r.text, &why);
+    if (!s) return error(r.id, "open_recording: " + why);
+    server_->stations.push_back(s);
+    server_->latched.resize(server_->stations.size());
+    station_ = server_->stations.size() - 1;
+    nlohmann::json names = nlohmann::json::array();
+    for (const Station* x : server_->stations) names.push_back(x->name());
+    for (auto& [id, b] : std::map(server_->browsers)) b->send_json({{"type", "stations"}, {"stations", names}});
+    send_json({{"type", "reply"},
+               {"id", r.id},
+               {"request", "open_recording"},
+               {"ok", true},
+               {"station", s->name()},
+               {"message", "replaying " + r.text + " as station " + s->name()}});
+    send_snapshot();
   }
 
   void pump() {

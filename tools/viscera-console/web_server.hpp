@@ -5,6 +5,7 @@
 // outbox (outbox.hpp), a rate limit on its requests and a size limit on its messages; everything
 // runs on one thread (the io_context's), stations hand their messages over by posting to it.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -28,6 +29,9 @@ struct WebOptions {  // NOLINT(bugprone-exception-escape): its defaults do not t
   double requests_per_s = 20, request_burst = 40;
   std::uint32_t max_browsers = 32;
   nlohmann::json page_settings;  ///< sent to each browser in its hello (force limit, ...)
+  std::string recordings_dir;  ///< the recordings a browser may open for replay ("" : none)
+  /// Starts a replay of `file` (in recordings_dir) as a new station: its Station, or nullptr and why.
+  std::function<Station*(const std::string& file, std::string* why)> open_replay;
 };
 
 class WebServer {

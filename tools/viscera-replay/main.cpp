@@ -6,11 +6,11 @@
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/process/child_process.hpp"
 #include "viscera/protocol/dds.hpp"
 
 #include "play.hpp"
 #include "resimulate.hpp"
-#include "server_process.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     o.recording = args[1];
     if (cl.has("scene")) o.scene = cl.text("scene");
     if (cl.has("report")) o.report = cl.text("report");
-    o.server = cl.has("server") ? cl.text("server") : viscera::replay::find_server_program();
+    o.server = cl.has("server") ? cl.text("server") : viscera::process::find_program("viscera-server", "server/runtime");
     o.domain = domain;
     o.quiet = cl.has("quiet");
     return viscera::replay::resimulate(o);

@@ -10,12 +10,11 @@
 
 #include "viscera/client/lockstep_driver.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/process/child_process.hpp"
 #include "viscera/recording/lockstep_plan.hpp"
 #include "viscera/recording/recording.hpp"
 #include "viscera/recording/resimulation_check.hpp"
 #include "viscera/recording/scene_extraction.hpp"
-
-#include "server_process.hpp"
 
 namespace viscera::replay {
 
@@ -61,8 +60,9 @@ int resimulate(const ResimulateOptions& o) {
   }
 
   client::LockstepDriver driver(domain, partition);
-  ServerProcess server({o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--partition", partition, "--quiet"},
-                       (dir.path / "server.log").string());
+  process::ChildProcess server(
+      {o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--partition", partition, "--quiet"},
+      (dir.path / "server.log").string());
   const auto fail = [&](const std::string& what) -> int {
     const std::string tail = server.log_tail();
     throw std::runtime_error(what + (tail.empty() ? "" : "; the lockstep server said:\n" + tail));

@@ -208,16 +208,24 @@ setInterval(() => {
 
 function warn(text) { const w = $('warning'); w.hidden = !text; w.textContent = text; }
 
+// The rows are rebuilt only when an owner changes (a button under the pointer stays put); the
+// force cells are updated in place.
+let instrumentRows = '';
 function renderInstruments() {
   if (!state.scene) return;
   const me = state.settings.client_id;
-  $('instruments').tBodies[0].innerHTML = state.scene.instruments.map((i) => {
+  const html = state.scene.instruments.map((i) => {
     const mine = i.owner === me && state.held.includes(i.id);
     const button = mine ? `<button data-hand-back="${i.id}" title="Give the instrument back to the trainee it was taken from">Hand back</button>`
       : `<button data-take-over="${i.id}" title="Take the instrument from its owner (no moment without one) and drive it from here">Take over</button>`;
     return `<tr><td>${i.id}</td><td>${i.grasper ? 'grasper' : 'probe'}</td><td>${i.owner === me ? 'this console' : i.owner ? `client ${i.owner}` : '<span class="dim">free</span>'}</td>` +
-      `<td>${tools.get(i.id) ? tools.get(i.id).force.toFixed(2) + ' N' : '–'}</td><td>${button}</td></tr>`;
+      `<td data-force="${i.id}"></td><td>${button}</td></tr>`;
   }).join('');
+  if (html !== instrumentRows) { $('instruments').tBodies[0].innerHTML = html; instrumentRows = html; }
+  for (const cell of $('instruments').querySelectorAll('td[data-force]')) {
+    const t = tools.get(Number(cell.dataset.force));
+    cell.textContent = t ? `${t.force.toFixed(2)} N` : '–';
+  }
   $('drive').hidden = state.held.length === 0;
   $('drive-id').textContent = state.held.join(', ');
 }
@@ -320,11 +328,19 @@ function connect(delayMs = 500) {
     const m = JSON.parse(msg.data);
     switch (m.type) {
       case 'hello':
-        state.stations = m.stations; state.settings = { ...state.settings, ...m.settings };
-        if (!state.station) state.station = m.stations[0];
-        $('station').innerHTML = m.stations.map((n) => `<option${n === state.station ? ' selected' : ''}>${esc(n)}</option>`).join('');
+        state.stations = m.stations; state.settings = { ...state.settings, ...m.settings }; state.recordings = m.recordings;
+        if (!state.station || !m.stations.includes(state.station)) state.station = m.stations[0];
+        renderStations();
         if (state.station !== m.stations[0]) send({ type: 'watch', station: state.station });
         break;
+      case 'stations': state.stations = m.stations; renderStations(); break;
+      case 'recordings': {
+        state.recordings = m.files; renderStations();
+        const resolve = pending.get(m.id);
+        if (resolve) { pending.delete(m.id); resolve(m); }
+        status('');
+        break;
+      }
       case 'scene': onScene(m); break;
       case 'telemetry': onTelemetry(m); break;
       case 'forces': onForces(m); break;
@@ -357,9 +373,26 @@ $('bookmark').onclick = () => {
   const t = state.simTimeS !== undefined ? state.simTimeS.toFixed(2) : '?';
   send({ type: 'bookmark', label: `at ${t} s` });
 };
-$('station').onchange = (e) => {
-  state.station = e.target.value;
-  plotData[0].length = plotData[1].length = plotData[2].length = 0;
+// The station menu: the stations, then the recordings that can be opened for replay.
+function renderStations() {
+  const recordings = state.recordings || [];
+  $('station').innerHTML = state.stations.map((n) => `<option value="${esc(n)}"${n === state.station ? ' selected' : ''}>${esc(n)}</option>`).join('') +
+    (recordings.length ? `<optgroup label="Open a recording for replay">${recordings.map((f) => `<option value="recording:${esc(f)}">▶ ${esc(f)}</option>`).join('')}</optgroup>` : '');
+}
+function clearPlot() { plotData[0].length = plotData[1].length = plotData[2].length = 0; }
+$('station').onfocus = () => send({ type: 'recordings' });
+$('station').onchange = async (e) => {
+  const v = e.target.value;
+  if (v.startsWith('recording:')) {
+    const file = v.slice('recording:'.length);
+    renderStations();  // back to the station watched until the replay is there
+    if (!confirm(`Open a replay of ${file}? It plays as a station of its own (the live stations go on).`)) return;
+    const r = await send({ type: 'open_recording', file });
+    if (r && r.ok) { state.station = r.station; clearPlot(); renderStations(); }
+    return;
+  }
+  state.station = v;
+  clearPlot();
   send({ type: 'watch', station: state.station });
 };
 $('material').onsubmit = (e) => {

@@ -15,13 +15,27 @@ namespace viscera::console {
 /// The longest request a browser may send [bytes]; longer WebSocket messages close the connection.
 inline constexpr std::size_t kMaxRequestBytes = 16 * 1024;
 
-enum class RequestType { pause, resume, reset, load_scene, material, annotate, bookmark, watch, take_over, hand_back, move };
+enum class RequestType {
+  pause,
+  resume,
+  reset,
+  load_scene,
+  material,
+  annotate,
+  bookmark,
+  watch,
+  take_over,
+  hand_back,
+  move,
+  open_recording,
+  recordings
+};
 const char* request_type_name(RequestType t);
 
 struct BrowserRequest {
   RequestType type = RequestType::pause;
   std::uint64_t id = 0;  ///< the browser's number for the request, echoed in the reply (0: none)
-  std::string text;  ///< annotate: the text; bookmark: its label (may be empty); load_scene: the scene; watch: the station
+  std::string text;  ///< annotate: the text; bookmark: its label (may be empty); load_scene: the scene; watch: the station; open_recording: the file
   protocol::MaterialChange change;  ///< material
   std::optional<std::uint64_t> seed;  ///< load_scene: the drawn regions' seed
   std::uint32_t instrument = 0;  ///< take_over, hand_back, move

@@ -1,4 +1,4 @@
-#include "server_process.hpp"
+#include "viscera/process/child_process.hpp"
 
 #include <chrono>
 #include <csignal>
@@ -17,9 +17,9 @@
 
 extern char** environ;
 
-namespace viscera::replay {
+namespace viscera::process {
 
-ServerProcess::ServerProcess(const std::vector<std::string>& argv, const std::string& log_path) : log_(log_path) {
+ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::string& log_path) : log_(log_path) {
   std::vector<char*> args;
   args.reserve(argv.size() + 1);
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
@@ -34,11 +34,11 @@ ServerProcess::ServerProcess(const std::vector<std::string>& argv, const std::st
   if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
 }
 
-ServerProcess::~ServerProcess() {
+ChildProcess::~ChildProcess() {
   if (pid_ > 0 && status_ < 0) stop();
 }
 
-bool ServerProcess::alive() {
+bool ChildProcess::alive() {
   if (status_ >= 0) return false;
   int st = 0;
   if (waitpid(pid_, &st, WNOHANG) == pid_) {
@@ -48,7 +48,7 @@ bool ServerProcess::alive() {
   return true;
 }
 
-int ServerProcess::stop() {
+int ChildProcess::stop() {
   if (!alive()) return status_;
   kill(pid_, SIGTERM);
   for (int k = 0; k < 500 && alive(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -61,7 +61,7 @@ int ServerProcess::stop() {
   return status_;
 }
 
-std::string ServerProcess::log_tail(int lines) const {
+std::string ChildProcess::log_tail(int lines) const {
   std::ifstream in(log_);
   std::deque<std::string> last;
   for (std::string line; std::getline(in, line);) {
@@ -73,12 +73,13 @@ std::string ServerProcess::log_tail(int lines) const {
   return out;
 }
 
-std::string find_server_program() {
+std::string find_program(const std::string& name, const std::string& tree_dir) {
   namespace fs = std::filesystem;
+  // This program is at BUILD/tools/<its folder>/ in the build tree.
   const fs::path self = fs::read_symlink("/proc/self/exe").parent_path();
-  for (const fs::path& p : {self / "viscera-server", self / ".." / ".." / "server" / "runtime" / "viscera-server"})
+  for (const fs::path& p : {self / name, self / ".." / ".." / tree_dir / name})
     if (fs::exists(p)) return fs::canonical(p).string();
-  return "viscera-server";  // on the PATH
+  return name;  // on the PATH
 }
 
-}  // namespace viscera::replay
+}  // namespace viscera::process
