@@ -6,8 +6,6 @@
 #include <map>
 
 #include <boost/asio/post.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
 #include "viscera/console/access_token.hpp"
@@ -16,17 +14,11 @@
 #include "viscera/console/rate_limit.hpp"
 #include "viscera/console/recordings.hpp"
 
-#include "station.hpp"
+#include "web_server_impl.hpp"
 
 namespace viscera::console {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace http = beast::http;
 namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
-
-namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); }
 
@@ -42,52 +34,6 @@ std::string field_value(std::string_view list, std::string_view key, char separa
   }
   return {};
 }
-
-const char* content_type(const std::string& path) {
-  const auto ends = [&](const char* e) {
-    return path.size() >= std::strlen(e) && path.compare(path.size() - std::strlen(e), std::string::npos, e) == 0;
-  };
-  if (ends(".html")) return "text/html; charset=utf-8";
-  if (ends(".js")) return "text/javascript; charset=utf-8";
-  if (ends(".css")) return "text/css; charset=utf-8";
-  if (ends(".png")) return "image/png";
-  if (ends(".svg")) return "image/svg+xml";
-  return "application/octet-stream";
-}
-
-struct Counters {
-  std::uint64_t http_requests = 0, refused = 0, not_found = 0, browsers_opened = 0, malformed = 0, rate_limited = 0, oversized = 0, closed_slow = 0,
-                closed_flood = 0, busy = 0;
-};
-
-class Browser;
-
-}  // namespace
-
-struct WebServer::Impl : std::enable_shared_from_this<WebServer::Impl> {
-  asio::io_context& io;
-  tcp::acceptor acceptor;
-  WebOptions opt;
-  std::vector<Station*> stations;
-  Counters counters;
-  std::map<std::uint64_t, std::shared_ptr<Browser>> browsers;
-  std::uint64_t next_id = 1;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  bool stopped = false;
-  std::atomic<int> foxglove_browsers{0};
-  /// Per station, the newest payload of each stream whose newest sample is its state (scene,
-  /// surface topology, scene files): a Foxglove client that subscribes gets it at once.
-  std::vector<std::map<protocol::Stream, std::pair<std::int64_t, std::shared_ptr<const std::vector<std::uint8_t>>>>> latched;
-
-  Impl(asio::io_context& io_, const tcp::endpoint& ep, WebOptions o, std::vector<Station*> s)
-      : io(io_), acceptor(io_, ep), opt(std::move(o)), stations(std::move(s)), latched(stations.size()) {}
-  void accept();
-  void handle_http(tcp::socket socket);
-  bool authorised(const http::request<http::string_body>& req, bool* from_query) const;
-  nlohmann::json stats() const;
-};
-
-namespace {
 
 /// One browser's WebSocket.
 class Browser : public std::enable_shared_from_this<Browser> {
@@ -368,99 +314,16 @@ class Browser : public std::enable_shared_from_this<Browser> {
   std::chrono::steady_clock::time_point opened_ = std::chrono::steady_clock::now();
 };
 
-/// One HTTP connection: requests for the page's files, /stats, or the upgrade to a WebSocket.
-class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
- public:
-  HttpConnection(tcp::socket socket, std::shared_ptr<WebServer::Impl> server) : stream_(std::move(socket)), server_(std::move(server)) {}
-
-  void read() {
-    parser_.emplace();
-    parser_->header_limit(8 * 1024);
-    parser_->body_limit(16 * 1024);
-    stream_.expires_after(std::chrono::seconds(30));
-    http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
-  }
-
- private:
-  void on_read(beast::error_code ec) {
-    if (ec) return;  // closed, timed out, or a request over the limits: the connection ends
-    auto req = parser_->release();
-    ++server_->counters.http_requests;
-    bool from_query = false;
-    const bool ok = server_->authorised(req, &from_query);
-    if (websocket::is_upgrade(req)) {
-      const std::string target(req.target());
-      if (!ok) return respond(req, http::status::unauthorized, "text/plain", "the console's token is missing or wrong\n", false);
-      const std::string path = target.substr(0, target.find('?'));
-      if (path != "/ws" && path != "/") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
-      if (server_->browsers.size() >= server_->opt.max_browsers)
-        return respond(req, http::status::service_unavailable, "text/plain", "too many browsers\n", false);
-      stream_.expires_never();
-      // A Foxglove client asks for its subprotocol; ?station=NAME picks the station (default: the first).
-      const auto protocols = req.find(http::field::sec_websocket_protocol);
-      const bool foxglove = protocols != req.end() && protocols->value().find(kFoxgloveSubprotocol) != beast::string_view::npos;
-      const std::string query = target.find('?') == std::string::npos ? std::string() : target.substr(target.find('?') + 1);
-      const std::string wanted = field_value(query, "station", '&');
-      std::size_t station = 0;
-      for (std::size_t k = 0; k < server_->stations.size(); ++k)
-        if (server_->stations[k]->name() == wanted) station = k;
-      if (!wanted.empty() && server_->stations[station]->name() != wanted)
-        return respond(req, http::status::not_found, "text/plain", "no station '" + wanted.substr(0, 64) + "'\n", false);
-      auto b = std::make_shared<Browser>(stream_.release_socket(), server_, server_->next_id++);
-      b->start(std::move(req), station, foxglove);
-      return;
-    }
-    if (req.method() != http::verb::get && req.method() != http::verb::head)
-      return respond(req, http::status::method_not_allowed, "text/plain", "only GET\n", false);
-    if (!ok)
-      return respond(req, http::status::unauthorized, "text/html; charset=utf-8",
-                     "<!doctype html><title>viscera console</title><p>This console needs its access token: open the address the console "
-                     "printed when it started (it ends in <code>?token=...</code>).</p>\n",
-                     false);
-    std::string path(req.target().substr(0, req.target().find('?')));
-    if (path == "/") path = "/index.html";
-    if (path == "/stats") return respond(req, http::status::ok, "application/json", server_->stats().dump(1) + "\n", from_query);
-    const auto f = server_->opt.files.find(path);
-    if (f == server_->opt.files.end()) {
-      ++server_->counters.not_found;
-      return respond(req, http::status::not_found, "text/plain", "not found\n", from_query);
-    }
-    respond(req, http::status::ok, content_type(path), f->second, from_query);
-  }
-
-  void respond(const http::request<http::string_body>& req, http::status status, const char* type, std::string body, bool set_cookie) {
-    if (status == http::status::unauthorized) ++server_->counters.refused;
-    auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
-    res->set(http::field::server, "viscera-console");
-    res->set(http::field::content_type, type);
-    res->set(http::field::cache_control, "no-store");
-    res->set("X-Content-Type-Options", "nosniff");
-    if (set_cookie) res->set(http::field::set_cookie, "viscera_token=" + server_->opt.token + "; HttpOnly; SameSite=Strict; Path=/");
-    res->keep_alive(req.keep_alive() && status == http::status::ok);
-    res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
-    res->prepare_payload();
-    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
-      if (ec || !res->keep_alive()) {
-        beast::error_code ignored;
-        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-        return;
-      }
-      self->read();
-    });
-  }
-
-  beast::tcp_stream stream_;
-  beast::flat_buffer buffer_;
-  std::optional<http::request_parser<http::string_body>> parser_;
-  std::shared_ptr<WebServer::Impl> server_;
-};
-
-}  // namespace
+void open_browser(tcp::socket socket, std::shared_ptr<WebServer::Impl> server, http::request<http::string_body>&& upgrade, std::size_t station,
+                  bool foxglove) {
+  const std::uint64_t id = server->next_id++;
+  std::make_shared<Browser>(std::move(socket), std::move(server), id)->start(std::move(upgrade), station, foxglove);
+}
 
 void WebServer::Impl::accept() {
   acceptor.async_accept([self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
     if (self->stopped) return;
-    if (!ec) std::make_shared<HttpConnection>(std::move(socket), self)->read();
+    if (!ec) serve_http(std::move(socket), self);
     self->accept();
   });
 }

@@ -1,0 +1,119 @@
+#include <cstring>
+
+#include <boost/beast/websocket.hpp>
+
+#include "viscera/console/foxglove_protocol.hpp"
+
+#include "web_server_impl.hpp"
+
+namespace viscera::console {
+
+namespace websocket = beast::websocket;
+
+namespace {
+
+const char* content_type(const std::string& path) {
+  const auto ends = [&](const char* e) {
+    return path.size() >= std::strlen(e) && path.compare(path.size() - std::strlen(e), std::string::npos, e) == 0;
+  };
+  if (ends(".html")) return "text/html; charset=utf-8";
+  if (ends(".js")) return "text/javascript; charset=utf-8";
+  if (ends(".css")) return "text/css; charset=utf-8";
+  if (ends(".png")) return "image/png";
+  if (ends(".svg")) return "image/svg+xml";
+  return "application/octet-stream";
+}
+
+/// One HTTP connection: requests for the page's files, /stats, or the upgrade to a WebSocket.
+class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
+ public:
+  HttpConnection(tcp::socket socket, std::shared_ptr<WebServer::Impl> server) : stream_(std::move(socket)), server_(std::move(server)) {}
+
+  void read() {
+    parser_.emplace();
+    parser_->header_limit(8 * 1024);
+    parser_->body_limit(16 * 1024);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+  }
+
+ private:
+  void on_read(beast::error_code ec) {
+    if (ec) return;  // closed, timed out, or a request over the limits: the connection ends
+    auto req = parser_->release();
+    ++server_->counters.http_requests;
+    bool from_query = false;
+    const bool ok = server_->authorised(req, &from_query);
+    if (websocket::is_upgrade(req)) {
+      const std::string target(req.target());
+      if (!ok) return respond(req, http::status::unauthorized, "text/plain", "the console's token is missing or wrong\n", false);
+      const std::string path = target.substr(0, target.find('?'));
+      if (path != "/ws" && path != "/") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
+      if (server_->browsers.size() >= server_->opt.max_browsers)
+        return respond(req, http::status::service_unavailable, "text/plain", "too many browsers\n", false);
+      stream_.expires_never();
+      // A Foxglove client asks for its subprotocol; ?station=NAME picks the station (default: the first).
+      const auto protocols = req.find(http::field::sec_websocket_protocol);
+      const bool foxglove = protocols != req.end() && protocols->value().find(kFoxgloveSubprotocol) != beast::string_view::npos;
+      const std::string query = target.find('?') == std::string::npos ? std::string() : target.substr(target.find('?') + 1);
+      const std::string wanted = field_value(query, "station", '&');
+      std::size_t station = 0;
+      for (std::size_t k = 0; k < server_->stations.size(); ++k)
+        if (server_->stations[k]->name() == wanted) station = k;
+      if (!wanted.empty() && server_->stations[station]->name() != wanted)
+        return respond(req, http::status::not_found, "text/plain", "no station '" + wanted.substr(0, 64) + "'\n", false);
+      open_browser(stream_.release_socket(), server_, std::move(req), station, foxglove);
+      return;
+    }
+    if (req.method() != http::verb::get && req.method() != http::verb::head)
+      return respond(req, http::status::method_not_allowed, "text/plain", "only GET\n", false);
+    if (!ok)
+      return respond(req, http::status::unauthorized, "text/html; charset=utf-8",
+                     "<!doctype html><title>viscera console</title><p>This console needs its access token: open the address the console "
+                     "printed when it started (it ends in <code>?token=...</code>).</p>\n",
+                     false);
+    std::string path(req.target().substr(0, req.target().find('?')));
+    if (path == "/") path = "/index.html";
+    if (path == "/stats") return respond(req, http::status::ok, "application/json", server_->stats().dump(1) + "\n", from_query);
+    const auto f = server_->opt.files.find(path);
+    if (f == server_->opt.files.end()) {
+      ++server_->counters.not_found;
+      return respond(req, http::status::not_found, "text/plain", "not found\n", from_query);
+    }
+    respond(req, http::status::ok, content_type(path), f->second, from_query);
+  }
+
+  void respond(const http::request<http::string_body>& req, http::status status, const char* type, std::string body, bool set_cookie) {
+    if (status == http::status::unauthorized) ++server_->counters.refused;
+    auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
+    res->set(http::field::server, "viscera-console");
+    res->set(http::field::content_type, type);
+    res->set(http::field::cache_control, "no-store");
+    res->set("X-Content-Type-Options", "nosniff");
+    if (set_cookie) res->set(http::field::set_cookie, "viscera_token=" + server_->opt.token + "; HttpOnly; SameSite=Strict; Path=/");
+    res->keep_alive(req.keep_alive() && status == http::status::ok);
+    res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
+    res->prepare_payload();
+    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+      if (ec || !res->keep_alive()) {
+        beast::error_code ignored;
+        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+        return;
+      }
+      self->read();
+    });
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  std::shared_ptr<WebServer::Impl> server_;
+};
+
+}  // namespace
+
+void serve_http(tcp::socket socket, std::shared_ptr<WebServer::Impl> server) {
+  std::make_shared<HttpConnection>(std::move(socket), std::move(server))->read();
+}
+
+}  // namespace viscera::console
