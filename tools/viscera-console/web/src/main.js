@@ -244,7 +244,7 @@ $('instruments').onclick = async (e) => {
 const stepM = 0.002, pendingMove = [0, 0, 0];
 function nudge(d) { for (let k = 0; k < 3; k++) pendingMove[k] += d[k] * stepM; }
 setInterval(() => {
-  if (!state.held.length || pendingMove.every((x) => x === 0)) return;
+  if (!state.held.length || pendingMove.every((x) => x === 0) || !socket || socket.readyState !== WebSocket.OPEN) return;
   const delta = pendingMove.map((x) => Math.max(-0.01, Math.min(0.01, x)));
   pendingMove.fill(0);
   socket.send(JSON.stringify({ type: 'move', instrument: state.held[0], delta_m: delta }));
