@@ -97,9 +97,8 @@ std::vector<std::uint8_t> encode(const Scene& s) {
   std::vector<flatbuffers::Offset<fb::RegionState>> region_list;
   for (const auto& r : s.regions) {
     const fb::Vec3 c = to_fb(r.center), bmin = to_fb(r.box_min), bmax = to_fb(r.box_max);
-    region_list.push_back(fb::CreateRegionState(b, b.CreateString(r.name), r.box ? fb::RegionShape::box : fb::RegionShape::sphere, &c, r.radius_m,
-                                                &bmin, &bmax, r.depth_m, r.elements, r.volume_m3, b.CreateString(r.material_name),
-                                                r.youngs_modulus_pa));
+    region_list.push_back(fb::CreateRegionState(b, b.CreateString(r.name), static_cast<fb::RegionShape>(r.shape), &c, r.radius_m, &bmin, &bmax,
+                                                r.depth_m, r.elements, r.volume_m3, b.CreateString(r.material_name), r.youngs_modulus_pa));
   }
   const auto regions = b.CreateVector(region_list);
   return finish(b, fb::CreateSceneState(b, name, s.physics_rate_hz, s.paused, list, &lo, &hi, s.generation, material, scenes, preparing, recent,
@@ -343,7 +342,7 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
   if (m->regions())
     for (const auto* r : *m->regions()) {
       RegionInfo i{r->name() ? r->name()->str() : "",
-                   r->shape() == fb::RegionShape::box,
+                   static_cast<RegionShape>(r->shape()),
                    from_fb(r->center()),
                    r->radius_m(),
                    from_fb(r->box_min()),
@@ -353,6 +352,10 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
                    r->volume_m3(),
                    r->material_name() ? r->material_name()->str() : "",
                    r->youngs_modulus_pa()};
+      if (r->shape() > fb::RegionShape::MAX) {
+        *why = "region '" + i.name.substr(0, 64) + "': unknown shape " + std::to_string(static_cast<int>(r->shape()));
+        return std::nullopt;
+      }
       if (!finite(i.center) || !finite(i.box_min) || !finite(i.box_max) ||
           !std::isfinite(i.radius_m + i.depth_m + i.volume_m3 + i.youngs_modulus_pa) || i.radius_m < 0) {
         *why = "region '" + i.name.substr(0, 64) + "': numbers not finite";

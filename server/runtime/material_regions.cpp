@@ -72,6 +72,47 @@ PlacedRegion draw_sphere(const RegionSpec& spec, std::size_t k, const tissue::Te
                        std::to_string(kDraws) + " centres tried)");
 }
 
+const char* shape_field(RegionSpec::Shape shape) {
+  switch (shape) {
+    case RegionSpec::Shape::box: return ".box";
+    case RegionSpec::Shape::elements: return ".elements";
+    case RegionSpec::Shape::sphere: break;
+  }
+  return ".sphere";
+}
+
+/// A tagged element set's region: its elements take the region's material; it is described by
+/// the bounding box of their nodes and their volume-weighted centroid.
+PlacedRegion tagged_region(const RegionSpec& spec, std::size_t k, const tissue::TetMesh& mesh, std::vector<std::uint16_t>& material_of_tet,
+                           const std::string& source) {
+  const tissue::ElementSet* set = tissue::find_element_set(mesh, spec.element_set);
+  if (!set) {
+    std::string known;
+    for (const tissue::ElementSet& s : mesh.element_sets)
+      known += (known.empty() ? "" : ", ") + std::to_string(s.tag) + (s.name.empty() ? "" : " '" + s.name + "'");
+    throw InputError(source, 0, field(k, ".elements"),
+                     "'" + common::printable(spec.element_set) + "' is not a physical group of the organ's mesh (" +
+                         (known.empty() ? "it tags no volume elements" : "its volume groups: " + known) + ")");
+  }
+  PlacedRegion r;
+  r.box = {Vec3::Constant(std::numeric_limits<double>::infinity()), Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  Vec3 weighted = Vec3::Zero();
+  double volume = 0;
+  for (const std::int32_t e : set->tets) {
+    material_of_tet[e] = static_cast<std::uint16_t>(k + 1);
+    const auto& t = mesh.tets[e];
+    for (const std::int32_t n : t) {
+      r.box.lo = r.box.lo.cwiseMin(mesh.nodes[n]);
+      r.box.hi = r.box.hi.cwiseMax(mesh.nodes[n]);
+    }
+    const double v = tissue::signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+    weighted += v * centroid(mesh, e);
+    volume += v;
+  }
+  r.center_m = volume > 0 ? Vec3(weighted / volume) : Vec3(0.5 * (r.box.lo + r.box.hi));
+  return r;
+}
+
 }  // namespace
 
 double distance_to_surface(const Vec3& p, const tissue::TetMesh& mesh, const tissue::BoundarySurface& boundary, Vec3* normal) {
@@ -97,7 +138,9 @@ RegionLayout lay_out_regions(const std::vector<RegionSpec>& specs, const tissue:
   for (std::size_t k = 0; k < specs.size(); ++k) {
     const RegionSpec& spec = specs[k];
     PlacedRegion r;
-    if (spec.shape == RegionSpec::Shape::box) {
+    if (spec.shape == RegionSpec::Shape::elements) {
+      r = tagged_region(spec, k, mesh, out.material_of_tet, source);
+    } else if (spec.shape == RegionSpec::Shape::box) {
       r.box = {vec(spec.lo_m), vec(spec.hi_m)};
     } else if (spec.random_center) {
       r = draw_sphere(spec, k, mesh, boundary, keep_out, source);
@@ -109,7 +152,7 @@ RegionLayout lay_out_regions(const std::vector<RegionSpec>& specs, const tissue:
     r.shape = spec.shape;
     r.radius_m = spec.radius_m;
     const double r2 = spec.radius_m * spec.radius_m;
-    for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    for (std::size_t e = 0; e < mesh.tet_count() && spec.shape != RegionSpec::Shape::elements; ++e) {
       const Vec3 c = centroid(mesh, e);
       if (spec.shape == RegionSpec::Shape::box ? r.box.contains(c) : (c - r.center_m).squaredNorm() <= r2)
         out.material_of_tet[e] = static_cast<std::uint16_t>(k + 1);
@@ -125,8 +168,9 @@ RegionLayout lay_out_regions(const std::vector<RegionSpec>& specs, const tissue:
     }
   for (std::size_t k = 0; k < out.regions.size(); ++k)
     if (out.regions[k].elements == 0)
-      throw InputError(source, 0, field(k, specs[k].shape == RegionSpec::Shape::box ? ".box" : ".sphere"),
-                       "'" + specs[k].name + "' holds no element of the organ (no element's centroid lies inside it" +
+      throw InputError(source, 0, field(k, shape_field(specs[k].shape)),
+                       "'" + specs[k].name + "' holds no element of the organ (" +
+                           (specs[k].shape == RegionSpec::Shape::elements ? "its set is empty" : "no element's centroid lies inside it") +
                            (k + 1 < specs.size() ? ", or later regions took them all)" : ")"));
   return out;
 }

@@ -130,7 +130,9 @@ std::vector<protocol::RegionInfo> Organ::region_info() const {
     const PlacedRegion& r = regions.regions[k];
     protocol::RegionInfo i;
     i.name = r.name;
-    i.box = r.shape == RegionSpec::Shape::box;
+    i.shape = r.shape == RegionSpec::Shape::box        ? protocol::RegionShape::box
+              : r.shape == RegionSpec::Shape::elements ? protocol::RegionShape::elements
+                                                       : protocol::RegionShape::sphere;
     i.center = {r.center_m.x(), r.center_m.y(), r.center_m.z()};
     i.radius_m = r.radius_m;
     i.box_min = {r.box.lo.x(), r.box.lo.y(), r.box.lo.z()};
@@ -153,6 +155,9 @@ std::string Organ::describe_regions() const {
     if (r.shape == RegionSpec::Shape::sphere)
       std::snprintf(b, sizeof b, "\nregion %s: sphere of radius %.4g m at (%.4g, %.4g, %.4g) m, its top %.3g m deep", r.name.c_str(), r.radius_m,
                     r.center_m.x(), r.center_m.y(), r.center_m.z(), r.depth_m);
+    else if (r.shape == RegionSpec::Shape::elements)
+      std::snprintf(b, sizeof b, "\nregion %s: tagged elements '%s' around (%.4g, %.4g, %.4g) m", r.name.c_str(),
+                    scene.regions[k].element_set.c_str(), r.center_m.x(), r.center_m.y(), r.center_m.z());
     else
       std::snprintf(b, sizeof b, "\nregion %s: box (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", r.name.c_str(), r.box.lo.x(), r.box.lo.y(), r.box.lo.z(),
                     r.box.hi.x(), r.box.hi.y(), r.box.hi.z());

@@ -26,13 +26,26 @@ std::array<double, 3> point(const JsonObject& o, const char* key) {
 }
 
 RegionSpec read_region(const JsonObject& r, const std::filesystem::path& dir, std::set<std::string>& names) {
-  r.require_known({"name", "material", "sphere", "box"});
+  r.require_known({"name", "material", "sphere", "box", "elements"});
   RegionSpec region;
   region.name = r.text("name");
   if (region.name.empty() || region.name.size() > 64) r.fail("name", "must have 1 to 64 characters");
   if (!names.insert(region.name).second) r.fail("name", "'" + common::printable(region.name) + "' is used twice");
   region.material = (dir / r.text("material")).string();
-  if (r.has("sphere") == r.has("box")) r.fail("sphere", "a region is either a \"sphere\" or a \"box\"");
+  if (int(r.has("sphere")) + int(r.has("box")) + int(r.has("elements")) != 1)
+    r.fail("sphere", "a region is one of a \"sphere\", a \"box\" or \"elements\" (a tagged element set of the mesh)");
+  if (r.has("elements")) {
+    const json& set = r.value()["elements"];
+    region.shape = RegionSpec::Shape::elements;
+    if (set.is_string() && !set.get<std::string>().empty() && set.get<std::string>().size() <= 128)
+      region.element_set = set.get<std::string>();
+    else if (set.is_number_integer() && set.get<long long>() > 0 && set.get<long long>() <= 2'147'483'647)
+      region.element_set = std::to_string(set.get<long long>());
+    else
+      r.fail("elements",
+             "'" + common::printable(set.dump()) + "' is neither the name (1-128 characters) nor the positive tag of a physical group of the mesh");
+    return region;
+  }
   if (r.has("box")) {
     const JsonObject b = r.object("box");
     b.require_known({"lo_m", "hi_m"});

@@ -127,6 +127,96 @@ TEST(MaterialRegions, ABarOfTwoMaterialsInSeriesStretchesAsTheClosedForm) {
   }
 }
 
+namespace {
+
+/// The mesh as a Gmsh 4.1 file whose tetrahedra with their centroid beyond x = x_split are volume
+/// entity 2, in the physical group 7 named "far end"; the others entity 1, group 3 (unnamed).
+std::string gmsh_with_groups(const TetMesh& mesh, double x_split) {
+  std::string s = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 7 \"far end\"\n$EndPhysicalNames\n";
+  s += "$Entities\n0 0 0 2\n1 0 0 0 1 1 1 1 3 0\n2 0 0 0 1 1 1 1 7 0\n$EndEntities\n";
+  const std::size_t n = mesh.node_count();
+  s += "$Nodes\n1 " + std::to_string(n) + " 1 " + std::to_string(n) + "\n3 1 0 " + std::to_string(n) + "\n";
+  for (std::size_t i = 0; i < n; ++i) s += std::to_string(i + 1) + "\n";
+  char b[200];
+  for (const Vec3& p : mesh.nodes) {
+    std::snprintf(b, sizeof b, "%.17g %.17g %.17g\n", p.x(), p.y(), p.z());
+    s += b;
+  }
+  std::vector<std::size_t> block[2];
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    const auto& t = mesh.tets[e];
+    block[(mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]).x() / 4 > x_split ? 1 : 0].push_back(e);
+  }
+  s += "$EndNodes\n$Elements\n2 " + std::to_string(mesh.tet_count()) + " 1 " + std::to_string(mesh.tet_count()) + "\n";
+  for (int k = 0; k < 2; ++k) {
+    s += "3 " + std::to_string(k + 1) + " 4 " + std::to_string(block[k].size()) + "\n";
+    for (const std::size_t e : block[k]) {
+      s += std::to_string(e + 1);
+      for (const auto v : mesh.tets[e]) s += " " + std::to_string(v + 1);
+      s += "\n";
+    }
+  }
+  return s + "$EndElements\n";
+}
+
+}  // namespace
+
+// A tagged element set as a region: the same elements as the box that holds them (another code
+// path: centroids in a box), described by their exact centroid and bounding box; kept through the
+// scene's refinement (8 children each, the same volume); an unknown set names the field and the
+// groups the mesh has.
+TEST(MaterialRegions, ATaggedElementSetIsTheRegionOfTheElementsTheFileTagged) {
+  const TetMesh box = make_box_mesh(Vec3(0, 0, 0), Vec3(0.1, 0.02, 0.02), 10, 2, 2);
+  const std::string mesh_file = write("bar-groups.msh", gmsh_with_groups(box, 0.07));
+  const auto mesh = std::make_shared<TetMesh>(read_tet_mesh(mesh_file));
+  const BoundarySurface boundary = extract_boundary(*mesh);
+  const Box nowhere{Vec3::Constant(-9), Vec3::Constant(-8)};
+  const RegionLayout by_box = lay_out_regions({box_region("end", Vec3(0.07, -1, -1), Vec3(1, 1, 1))}, *mesh, boundary, nowhere, "bar");
+  for (const std::string set : {"far end", "7"}) {
+    RegionSpec tagged;
+    tagged.name = "end";
+    tagged.shape = RegionSpec::Shape::elements;
+    tagged.element_set = set;
+    const RegionLayout by_tag = lay_out_regions({tagged}, *mesh, boundary, nowhere, "bar");
+    EXPECT_EQ(by_tag.material_of_tet, by_box.material_of_tet) << set;
+    ASSERT_EQ(by_tag.regions.size(), 1u);
+    EXPECT_EQ(by_tag.regions[0].elements, mesh->tet_count() * 3 / 10);
+    EXPECT_NEAR(by_tag.regions[0].volume_m3, 0.03 * 0.02 * 0.02, 1e-15);
+    EXPECT_LT((by_tag.regions[0].center_m - Vec3(0.085, 0.01, 0.01)).norm(), 1e-12);
+    EXPECT_LT((by_tag.regions[0].box.lo - Vec3(0.07, 0, 0)).norm(), 1e-12);
+    EXPECT_LT((by_tag.regions[0].box.hi - Vec3(0.1, 0.02, 0.02)).norm(), 1e-12);
+  }
+  // Through a scene, refined once: the region holds the children of the tagged elements.
+  const std::string stiff = isotropic("stiff-tag", 40e3, 1100), soft = isotropic("soft-tag", 5e3, 1060);
+  const auto scene = [&](const std::string& name, const std::string& set) {
+    return write(name + ".json", R"({"name": ")" + name + R"(", "organ": {"mesh": ")" + mesh_file + R"(", "material": ")" + soft +
+                                     R"(", "refine": 1, "fix_slab": ["x", "min", 0.1], "regions": [{"name": "end", "material": ")" + stiff +
+                                     R"(", "elements": )" + set + "}]}, \"instruments\": [{\"id\": 1}]}");
+  };
+  const auto organ = build_organ(read_scene_file(scene("tagged", R"("far end")")));
+  ASSERT_EQ(organ->regions.regions.size(), 1u);
+  EXPECT_EQ(organ->regions.regions[0].elements, 8 * mesh->tet_count() * 3 / 10);
+  EXPECT_NEAR(organ->regions.regions[0].volume_m3, 0.03 * 0.02 * 0.02, 1e-15);
+  const auto info = organ->region_info();
+  ASSERT_EQ(info.size(), 1u);
+  EXPECT_EQ(info[0].shape, viscera::protocol::RegionShape::elements);
+  EXPECT_NEAR(info[0].center[0], 0.085, 1e-12);
+  const auto error = [&](const std::string& name, const std::string& set) {
+    try {
+      build_organ(read_scene_file(scene(name, set)));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("untagged", R"("tumour")")
+                .find("organ.regions[0].elements: 'tumour' is not a physical group of the organ's mesh (its volume groups: 3, 7 'far end')"),
+            std::string::npos)
+      << error("untagged", R"("tumour")");
+  EXPECT_NE(error("zero", "0").find("organ.regions[0].elements: '0' is neither the name"), std::string::npos) << error("zero", "0");
+  EXPECT_NE(error("list", "[7]").find("organ.regions[0].elements"), std::string::npos);
+}
+
 // A region over the whole organ gives the organ made of the region's material, through the
 // server's own building path (the region's unrelaxed elasticity from the organ's relaxation);
 // a nodule changes the forces of its own elements only.
@@ -236,7 +326,7 @@ TEST(MaterialRegions, ScenesNameTheRegionFieldThatIsWrong) {
   };
   const std::string m = R"("name": "n", "material": ")" + stiff + R"(", )";
   EXPECT_NE(message(R"([{)" + m + R"("sphere": {"radius_m": 0.01, "center_m": [0, 0, 0]}, "box": {"lo_m": [0,0,0], "hi_m": [1,1,1]}}])")
-                .find("organ.regions[0].sphere: a region is either"),
+                .find("organ.regions[0].sphere: a region is one of"),
             std::string::npos);
   EXPECT_NE(message(R"([{)" + m + R"("cylinder": {}}])").find("organ.regions[0].cylinder: unknown field"), std::string::npos);
   EXPECT_NE(message(R"([{)" + m + R"("sphere": {"radius_m": 0.01}}])").find("organ.regions[0].sphere.center_m"), std::string::npos);

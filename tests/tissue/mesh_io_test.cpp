@@ -80,6 +80,57 @@ TEST(MeshIo, GmshV1V2V4AndVtkFormatsGiveTheSameMesh) {
   }
 }
 
+// Physical groups of dimension 3 become element sets, the same in v1 (physical region), v2 (first
+// tag) and v4.1 (the volume entity's physical tags in $Entities), named from $PhysicalNames (quoted,
+// spaces kept); groups of other dimensions are not element sets.
+TEST(MeshIo, GmshPhysicalGroupsBecomeTheSameElementSetsInEveryVersion) {
+  const std::string names = "$PhysicalNames\n3\n2 9 \"capsule\"\n3 5 \"soft tissue\"\n3 7 \"nodule\"\n$EndPhysicalNames\n";
+  // v1 and v2 give an element one physical group: tet 1 in 5, tet 2 in 7.
+  std::string v1 = "$NOD\n5\n";
+  for (int i = 0; i < 5; ++i) v1 += std::to_string(i + 1) + " " + kNodes[i] + "\n";
+  v1 += "$ENDNOD\n$ELM\n3\n1 2 9 1 3 1 2 3\n2 4 5 1 4 1 2 3 4\n3 4 7 2 4 2 3 4 5\n$ENDELM\n";
+  std::string v2 = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n" + names + "$Nodes\n5\n";
+  for (int i = 0; i < 5; ++i) v2 += std::to_string(i + 1) + " " + kNodes[i] + "\n";
+  v2 += "$EndNodes\n$Elements\n3\n1 2 2 9 1 1 2 3\n2 4 2 5 1 1 2 3 4\n3 4 3 7 2 0 2 3 4 5\n$EndElements\n";
+  // v4.1: volume entity 1 in group 5, volume entity 2 in groups 5 and 7, surface 3 in group 9.
+  std::string v4 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n" + names + "$Entities\n1 0 1 2\n4 0 0 0 0\n";
+  v4 += "3 0 0 0 1 1 0 1 9 0\n1 0 0 0 1 1 1 1 5 1 3\n2 0 0 0 1 1 1 2 7 -5 1 -3\n$EndEntities\n";
+  v4 += "$Nodes\n1 5 1 5\n3 1 0 5\n1\n2\n3\n4\n5\n";
+  for (const char* n : kNodes) v4 += std::string(n) + "\n";
+  v4 += "$EndNodes\n$Elements\n3 3 1 3\n2 3 2 1\n1 1 2 3\n3 1 4 1\n2 1 2 3 4\n3 2 4 1\n3 2 3 4 5\n$EndElements\n";
+  const TetMesh m1 = read_tet_mesh(test::write_file("groups_v1.msh", v1)), m2 = read_tet_mesh(test::write_file("groups_v2.msh", v2)),
+                m4 = read_tet_mesh(test::write_file("groups_v4.msh", v4));
+  for (const TetMesh* m : {&m1, &m2}) {
+    ASSERT_EQ(m->element_sets.size(), 2u) << m->source;
+    EXPECT_EQ(m->element_sets[0].tag, 5);
+    EXPECT_EQ(m->element_sets[0].tets, std::vector<std::int32_t>{0});
+    EXPECT_EQ(m->element_sets[1].tag, 7);
+    EXPECT_EQ(m->element_sets[1].tets, std::vector<std::int32_t>{1});
+  }
+  EXPECT_EQ(m1.element_sets[0].name, "");  // v1 has no names
+  EXPECT_EQ(m2.element_sets[0].name, "soft tissue");
+  EXPECT_EQ(m2.element_sets[1].name, "nodule");
+  ASSERT_EQ(m4.element_sets.size(), 2u);
+  EXPECT_EQ(m4.element_sets[0].name, "soft tissue");
+  EXPECT_EQ(m4.element_sets[0].tets, (std::vector<std::int32_t>{0, 1}));
+  EXPECT_EQ(m4.element_sets[1].name, "nodule");
+  EXPECT_EQ(m4.element_sets[1].tets, std::vector<std::int32_t>{1});
+  EXPECT_EQ(find_element_set(m4, "nodule"), &m4.element_sets[1]);
+  EXPECT_EQ(find_element_set(m4, "5"), &m4.element_sets[0]);
+  EXPECT_EQ(find_element_set(m4, "capsule"), nullptr);  // a surface group
+  EXPECT_EQ(find_element_set(m4, "9"), nullptr);
+  // Malformed groups name the field.
+  std::string unquoted = v2;
+  unquoted.replace(unquoted.find("\"nodule\""), 8, "nodule");
+  EXPECT_NE(expect_error(test::write_file("unquoted.msh", unquoted)).find("physical name: 'nodule' is not a quoted name"), std::string::npos);
+  std::string short_entities = v4;
+  short_entities.replace(short_entities.find("1 5 1 3\n"), 8, "1 5 1\n");
+  EXPECT_NE(expect_error(test::write_file("entities.msh", short_entities)).find("entity"), std::string::npos);
+  std::string negative = v2;
+  negative.replace(negative.find("3 4 3 7 2 0"), 11, "3 4 3 -7 2 0");
+  EXPECT_NE(expect_error(test::write_file("negative.msh", negative)).find("element 3 physical tag: -7 is out of range"), std::string::npos);
+}
+
 TEST(MeshIo, VtuRoundTripKeepsTheMeshAndCarriesFields) {
   const auto liver = test::liver2();
   std::vector<Vec3> x = liver->nodes, v(liver->nodes.size(), Vec3(0.1, 0, 0));

@@ -86,3 +86,35 @@ TEST(BoxMesh, IsConformingAndFillsTheBox) {
   const auto s = extract_boundary(m);
   EXPECT_EQ(s.triangles.size(), 4u * (5 * 2 + 2 * 3 + 5 * 3));  // conforming: no interior faces left
 }
+
+// Element sets survive refinement: each tetrahedron's eight children keep its sets, fill exactly
+// its volume and lie inside it (their centroids, by barycentric coordinates in the parent).
+TEST(Refinement, ChildrenKeepTheirParentsElementSets) {
+  TetMesh l0 = make_box_mesh(Vec3(0, 0, 0), Vec3(0.03, 0.02, 0.01), 3, 2, 1);
+  l0.element_sets = {{4, "end", {}}, {9, "", {0, 5}}};
+  for (std::int32_t e = 0; e < static_cast<std::int32_t>(l0.tet_count()); ++e)
+    if (e % 3 == 1) l0.element_sets[0].tets.push_back(e);
+  const TetMesh l2 = refine_uniform(refine_uniform(l0));
+  ASSERT_EQ(l2.element_sets.size(), 2u);
+  const auto volume = [](const TetMesh& m, const std::vector<std::int32_t>& tets) {
+    double v = 0;
+    for (const auto e : tets) v += signed_volume(m.nodes[m.tets[e][0]], m.nodes[m.tets[e][1]], m.nodes[m.tets[e][2]], m.nodes[m.tets[e][3]]);
+    return v;
+  };
+  for (std::size_t k = 0; k < 2; ++k) {
+    const ElementSet &parent = l0.element_sets[k], &child = l2.element_sets[k];
+    EXPECT_EQ(child.tag, parent.tag);
+    EXPECT_EQ(child.name, parent.name);
+    ASSERT_EQ(child.tets.size(), 64 * parent.tets.size());
+    EXPECT_NEAR(volume(l2, child.tets), volume(l0, parent.tets), 1e-15);
+    for (const auto c : child.tets) {
+      const auto& ct = l2.tets[c];
+      const Vec3 centroid = 0.25 * (l2.nodes[ct[0]] + l2.nodes[ct[1]] + l2.nodes[ct[2]] + l2.nodes[ct[3]]);
+      const auto& pt = l0.tets[c / 64];
+      Eigen::Matrix3d M;
+      M << l0.nodes[pt[1]] - l0.nodes[pt[0]], l0.nodes[pt[2]] - l0.nodes[pt[0]], l0.nodes[pt[3]] - l0.nodes[pt[0]];
+      const Vec3 w = M.partialPivLu().solve(centroid - l0.nodes[pt[0]]);
+      EXPECT_TRUE(w.minCoeff() > 0 && w.sum() < 1) << "child " << c << " lies outside its parent " << c / 64;
+    }
+  }
+}

@@ -21,7 +21,8 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0) {
 
 /// From a point to a region's surface (0 inside it) [m].
 double distance_to_region(const proto::Vector3& p, const proto::RegionInfo& r) {
-  if (!r.box) return std::max(0.0, distance(p, r.center) - r.radius_m);
+  if (r.shape == proto::RegionShape::sphere) return std::max(0.0, distance(p, r.center) - r.radius_m);
+  // A box, or a tagged element set by its bounding box (the trainer has no mesh; docs/TRAINING.md).
   double d2 = 0;
   for (int a = 0; a < 3; ++a) {
     const double d = std::max({r.box_min[a] - p[a], 0.0, p[a] - r.box_max[a]});

@@ -187,7 +187,10 @@ void print_scene(const viscera::protocol::Scene& scene) {
               scene.preparing.c_str());
   for (const auto& u : scene.unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
   for (const auto& g : scene.regions) {
-    if (g.box)
+    if (g.shape == viscera::protocol::RegionShape::elements)
+      std::printf("  region %s: tagged elements around (%.4g, %.4g, %.4g) m, within (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", g.name.c_str(),
+                  g.center[0], g.center[1], g.center[2], g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0], g.box_max[1], g.box_max[2]);
+    else if (g.shape == viscera::protocol::RegionShape::box)
       std::printf("  region %s: box (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", g.name.c_str(), g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0],
                   g.box_max[1], g.box_max[2]);
     else

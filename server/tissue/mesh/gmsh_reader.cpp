@@ -1,5 +1,11 @@
-// Gmsh .msh readers: legacy v1 ($NOD/$ELM), ASCII v2 ($MeshFormat 2.x) and ASCII v4.1.
+// Gmsh .msh readers: legacy v1 ($NOD/$ELM), ASCII v2 ($MeshFormat 2.x) and ASCII v4.1. The
+// tetrahedra's physical groups become the mesh's element sets: v1's physical region, v2's first
+// tag, v4.1's volume entity's physical tags (from $Entities); names from $PhysicalNames.
+#include <cstdlib>
+#include <map>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/mesh/mesh_builder.hpp"
@@ -14,6 +20,7 @@ using common::printable;
 namespace {
 
 constexpr long long kTet4 = 4;
+constexpr long long kMaxTag = 2'147'483'647;
 
 // Number of nodes of a Gmsh element type; -1 if unknown.
 // NOLINTBEGIN(bugprone-branch-clone): a table of node counts, equal for some types
@@ -74,22 +81,30 @@ void read_elements_v1v2(TextCursor& in, MeshBuilder& b, bool v1, std::string_vie
     const long long type = in.integer("element type");
     check_type(in, type, id);
     int nodes = gmsh_node_count(type);
+    int physical = 0;  // 0: in no physical group
     if (v1) {
-      in.integer("element physical region");
+      physical = static_cast<int>(in.integer_in("element physical region", 0, kMaxTag));
       in.integer("element elementary region");
       const long long count = in.integer("element node count");
       if (count != nodes)
         in.fail("element " + std::to_string(id) + " node count", std::to_string(count) + " does not match type " + std::to_string(type));
     } else {
       const long long tags = in.integer_in("element tag count", 0, 64);
-      for (long long k = 0; k < tags; ++k) in.integer("element tag");
+      for (long long k = 0; k < tags; ++k) {
+        const long long tag = in.integer("element tag");
+        if (k == 0) {  // the physical group
+          if (tag < 0 || tag > kMaxTag)
+            in.fail("element " + std::to_string(id) + " physical tag", std::to_string(tag) + " is out of range [0, " + std::to_string(kMaxTag) + "]");
+          physical = static_cast<int>(tag);
+        }
+      }
     }
     std::array<long long, 4> ids{};
     for (int k = 0; k < nodes; ++k) {
       const long long v = in.integer("element node id");
       if (k < 4) ids[k] = v;
     }
-    if (type == kTet4) b.add_tet(ids, id, line);
+    if (type == kTet4) b.add_tet(ids, id, line, physical > 0 ? std::span<const int>(&physical, 1) : std::span<const int>());
   }
   expect(in, end);
 }
@@ -120,14 +135,63 @@ void read_nodes_v4(TextCursor& in, MeshBuilder& b) {
   expect(in, "$EndNodes");
 }
 
-void read_elements_v4(TextCursor& in, MeshBuilder& b) {
+/// v4.1 $Entities: the physical tags of each volume entity (points, curves and surfaces skipped).
+using PhysicalsOfVolume = std::map<long long, std::vector<int>>;
+
+std::vector<int> read_physical_tags(TextCursor& in) {
+  const long long n = in.integer_in("entity physical tag count", 0, 1'000'000);
+  std::vector<int> tags;
+  for (long long k = 0; k < n; ++k) tags.push_back(static_cast<int>(in.integer_in("entity physical tag", -kMaxTag, kMaxTag)));
+  return tags;
+}
+
+PhysicalsOfVolume read_entities_v4(TextCursor& in) {
+  long long count[4];
+  for (long long& c : count) c = in.integer_in("entity count", 0, 1'000'000'000);
+  PhysicalsOfVolume out;
+  for (int dim = 0; dim < 4; ++dim)
+    for (long long k = 0; k < count[dim]; ++k) {
+      const long long tag = in.integer("entity tag");
+      for (int c = 0; c < (dim == 0 ? 3 : 6); ++c) in.real("entity coordinate");
+      std::vector<int> physicals = read_physical_tags(in);
+      if (dim > 0) {
+        const long long bounding = in.integer_in("entity bounding count", 0, 1'000'000'000);
+        for (long long j = 0; j < bounding; ++j) in.integer("entity bounding tag");
+      }
+      if (dim == 3) {
+        for (int& p : physicals) p = std::abs(p);
+        out[tag] = std::move(physicals);
+      }
+    }
+  expect(in, "$EndEntities");
+  return out;
+}
+
+/// $PhysicalNames: the names of the volume groups (dimension 3); a name is quoted and may hold spaces.
+void read_physical_names(TextCursor& in, MeshBuilder& b) {
+  const long long n = in.integer_in("physical name count", 0, 1'000'000);
+  for (long long k = 0; k < n; ++k) {
+    const long long dim = in.integer_in("physical name dimension", 0, 3);
+    const long long tag = in.integer_in("physical name tag", 1, kMaxTag);
+    std::string name = in.rest_of_line();
+    const auto first = name.find_first_not_of(" \t\r"), last = name.find_last_not_of(" \t\r");
+    name = first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
+    if (name.size() < 2 || name.front() != '"' || name.back() != '"') in.fail("physical name", "'" + printable(name) + "' is not a quoted name");
+    if (dim == 3) b.name_group(static_cast<int>(tag), name.substr(1, name.size() - 2));
+  }
+  expect(in, "$EndPhysicalNames");
+}
+
+void read_elements_v4(TextCursor& in, MeshBuilder& b, const PhysicalsOfVolume& physicals) {
   const long long blocks = in.integer_in("element block count", 0, 100'000'000);
   in.integer_in("element count", 0, 1'000'000'000);
   in.integer("min element tag");
   in.integer("max element tag");
   for (long long blk = 0; blk < blocks; ++blk) {
-    in.integer("entity dimension");
-    in.integer("entity tag");
+    const long long dim = in.integer("entity dimension");
+    const long long entity = in.integer("entity tag");
+    const auto found = physicals.find(entity);
+    const std::span<const int> groups = dim == 3 && found != physicals.end() ? std::span<const int>(found->second) : std::span<const int>();
     const long long type = in.integer("element type");
     check_type(in, type, -1);
     const long long count = in.integer_in("elements in block", 0, 1'000'000'000);
@@ -140,7 +204,7 @@ void read_elements_v4(TextCursor& in, MeshBuilder& b) {
         const long long v = in.integer("element node tag");
         if (j < 4) ids[j] = v;
       }
-      if (type == kTet4) b.add_tet(ids, id, line);
+      if (type == kTet4) b.add_tet(ids, id, line, groups);
     }
   }
   expect(in, "$EndElements");
@@ -153,6 +217,7 @@ TetMesh read_gmsh(const std::string& path) {
   MeshBuilder b(path);
   int version = 0;  // 1, 2 or 4
   bool nodes = false, elements = false;
+  PhysicalsOfVolume physicals;  // v4.1
   while (!in.at_end()) {
     const std::string section(in.token("section"));
     if (section == "$NOD") {
@@ -189,10 +254,14 @@ TetMesh read_gmsh(const std::string& path) {
       if (version == 2)
         read_elements_v1v2(in, b, false, "$EndElements");
       else
-        read_elements_v4(in, b);
+        read_elements_v4(in, b, physicals);
       elements = true;
+    } else if (section == "$Entities" && version == 4) {
+      physicals = read_entities_v4(in);
+    } else if (section == "$PhysicalNames") {
+      read_physical_names(in, b);
     } else if (section.starts_with("$")) {
-      // Any other section ($PhysicalNames, $Entities, $NodeData...): skip to its end marker.
+      // Any other section ($NodeData, $Periodic...): skip to its end marker.
       const std::string end = "$End" + section.substr(1);
       if (!in.skip_past(end)) in.fail(printable(section), "section is not closed by " + printable(end));
     } else {

@@ -1,5 +1,7 @@
 #include "viscera/tissue/mesh/mesh_builder.hpp"
 
+#include <algorithm>
+
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/mesh/mesh_validation.hpp"
 
@@ -16,13 +18,17 @@ void MeshBuilder::add_node(long long id, const Vec3& p, long line) {
   node_lines_.push_back(line);
 }
 
-void MeshBuilder::add_tet(const std::array<long long, 4>& ids, long long element, long line) { tets_.push_back({ids, element, line}); }
+void MeshBuilder::add_tet(const std::array<long long, 4>& ids, long long element, long line, std::span<const int> groups) {
+  tets_.push_back({ids, element, line, groups_.size(), groups.size()});
+  groups_.insert(groups_.end(), groups.begin(), groups.end());
+}
 
 TetMesh MeshBuilder::build() {
   TetMesh mesh;
   mesh.source = source_;
   mesh.nodes = std::move(nodes_);
   mesh.tets.reserve(tets_.size());
+  std::map<int, std::vector<std::int32_t>> sets;  // by tag
   MeshOrigin origin;
   origin.node_ids = std::move(node_ids_);
   origin.node_lines = std::move(node_lines_);
@@ -37,7 +43,14 @@ TetMesh MeshBuilder::build() {
                          "references node " + std::to_string(p.ids[k]) + ", which does not exist");
       t[k] = it->second;
     }
+    for (std::size_t g = p.first_group; g < p.first_group + p.group_count; ++g)
+      sets[groups_[g]].push_back(static_cast<std::int32_t>(mesh.tets.size()));
     mesh.tets.push_back(t);
+  }
+  for (auto& [tag, tets] : sets) {
+    tets.erase(std::unique(tets.begin(), tets.end()), tets.end());  // a group listed twice for one element
+    const auto name = group_names_.find(tag);
+    mesh.element_sets.push_back({tag, name == group_names_.end() ? std::string() : name->second, std::move(tets)});
   }
   if (mesh.tets.empty()) throw InputError(source_, 0, "", "contains no tetrahedra");
   validate_mesh(mesh, &origin);

@@ -43,6 +43,13 @@ TetMesh refine_uniform(const TetMesh& mesh) {
     }
     for (int k = 0; k < 4; ++k) add({diag[best][0], diag[best][1], ring[best][k], ring[best][(k + 1) % 4]});
   }
+  // Tetrahedron e's eight children are 8e..8e+7: each keeps its parent's element sets.
+  for (const ElementSet& set : mesh.element_sets) {
+    ElementSet& child = out.element_sets.emplace_back(ElementSet{set.tag, set.name, {}});
+    child.tets.reserve(8 * set.tets.size());
+    for (const std::int32_t e : set.tets)
+      for (std::int32_t c = 0; c < 8; ++c) child.tets.push_back(8 * e + c);
+  }
   return out;
 }
 

@@ -4,6 +4,12 @@
 
 namespace viscera::tissue {
 
+const ElementSet* find_element_set(const TetMesh& mesh, const std::string& name) {
+  for (const ElementSet& set : mesh.element_sets)
+    if (set.name == name || (!name.empty() && name == std::to_string(set.tag))) return &set;
+  return nullptr;
+}
+
 void scale_mesh(TetMesh& mesh, double factor) {
   for (auto& p : mesh.nodes) p *= factor;
 }

@@ -101,9 +101,13 @@ struct RequestOutcome {
 };
 
 /// A material region as laid out (schema 9); positions in the organ's frame [m].
+/// elements (schema 11): a set of elements the mesh file tagged, described by their volume-weighted
+/// centroid (center) and the bounding box of their nodes (box_min, box_max).
+enum class RegionShape : std::uint8_t { sphere, box, elements };
+
 struct RegionInfo {
   std::string name;
-  bool box = false;  ///< else a sphere
+  RegionShape shape = RegionShape::sphere;
   Vector3 center{};
   double radius_m = 0;
   Vector3 box_min{}, box_max{};
@@ -229,7 +233,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 10;
+inline constexpr int kSchemaVersion = 11;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -1,10 +1,9 @@
 #pragma once
 // Material regions laid out on an organ's mesh (docs/SCENE.md, "Material regions"): each element
-// whose centroid lies inside a region's sphere or box takes the region's material (a later region
-// over an earlier one). A sphere whose centre is drawn from a seed lands where it lies wholly
-// inside the organ, its top between the stated depths below the surface (a surface facing the
-// stated way, if one is stated), and clear of the fixed slab; the draw is a fixed function of the seed, the mesh and the scene (the same on any
-// machine).
+// whose centroid lies inside a region's sphere or box, or that the mesh file tagged into the
+// region's element set, takes the region's material (a later region over an earlier one). A sphere whose centre is drawn from a seed lands where it
+// lies wholly inside the organ, its top between the stated depths below the surface (a surface facing the stated way, if one is stated), and clear of
+// the fixed slab; the draw is a fixed function of the seed, the mesh and the scene (the same on any machine).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,9 +16,9 @@ namespace viscera::runtime {
 struct PlacedRegion {
   std::string name;
   RegionSpec::Shape shape = RegionSpec::Shape::sphere;
-  tissue::Vec3 center_m = tissue::Vec3::Zero();  ///< sphere
+  tissue::Vec3 center_m = tissue::Vec3::Zero();  ///< sphere; element set: its elements' volume-weighted centroid
   double radius_m = 0;
-  tissue::Box box{tissue::Vec3::Zero(), tissue::Vec3::Zero()};  ///< box
+  tissue::Box box{tissue::Vec3::Zero(), tissue::Vec3::Zero()};  ///< box; element set: its nodes' bounding box
   double depth_m = 0;  ///< sphere: its top's depth below the organ's surface (distance to the surface minus radius)
   std::size_t elements = 0;
   double volume_m3 = 0;  ///< of its elements

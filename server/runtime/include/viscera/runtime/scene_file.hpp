@@ -21,11 +21,13 @@ struct InstrumentSpec {
 
 /// Part of the organ made of its own material (docs/SCENE.md, "Material regions"): the elements
 /// whose centroid lies inside a sphere or a box, in metres in the organ's frame (the mesh as
-/// scaled). A sphere's centre may be drawn from a seed, at a depth below the surface.
+/// scaled), or an element set the mesh file tagged (a Gmsh physical group, by name or tag). A
+/// sphere's centre may be drawn from a seed, at a depth below the surface.
 struct RegionSpec {
   std::string name;
   std::string material;  ///< material file (resolved against the scene's folder)
-  enum class Shape { sphere, box } shape = Shape::sphere;
+  enum class Shape { sphere, box, elements } shape = Shape::sphere;
+  std::string element_set;  ///< elements: the set's name, or its tag in decimal
   std::array<double, 3> center_m{}, lo_m{}, hi_m{};
   double radius_m = 0;
   bool random_center = false;  ///< sphere: centre drawn from `seed`
