@@ -1,0 +1,188 @@
+#pragma once
+// The simulation server's state and the work of its threads (private to server/runtime): the
+// organ and the tick (simulation_server.cpp), what the server publishes (server_publishing.cpp),
+// the commands the command thread answers (command_handling.cpp), and the session requests the
+// physics thread takes between ticks (session_requests.cpp).
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "viscera/protocol/messages.hpp"
+#include "viscera/runtime/command_responder.hpp"
+#include "viscera/runtime/instrument_table.hpp"
+#include "viscera/runtime/mesh_publisher.hpp"
+#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/session_control.hpp"
+#include "viscera/runtime/simulated_tool.hpp"
+#include "viscera/runtime/simulation_server.hpp"
+#include "viscera/tissue/integrator/boundary_conditions.hpp"
+#include "viscera/tissue/integrator/state.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
+
+namespace viscera::runtime {
+
+namespace proto = viscera::protocol;
+
+struct SimulationServer::Impl {
+  using Status = std::function<void(const std::string&)>;
+
+  // Two threads: the physics thread (run()) steps the organ at the fixed rate; the command thread
+  // answers every command the moment it arrives (CommandResponder), so the round trip never waits
+  // for a step. The organ is the physics thread's; session control replaces it between ticks, and
+  // the command thread reads it (compliance, contact queries) only while holding organ_mutex,
+  // which the physics thread takes to swap it.
+  SceneSpec scene;  // physics thread: the running scene (its rate may change at run time)
+  ServerEndpoints& endpoints;
+  TickBudget budget;
+  const std::atomic<bool>* stop = nullptr;  // run()'s stop flag: a long tick checks it between sub-steps
+  std::shared_ptr<Organ> organ;  // shared with a material change being prepared from it
+  std::mutex organ_mutex;
+  tissue::State state;
+  double sim_time_s = 0;
+  std::uint64_t ticks_run = 0;  // physics thread; the tick in progress (or the next) is ticks_run + 1
+  std::uint32_t generation = 1;  // +1 per scene loaded: the surface's mesh_id
+  bool paused = false;
+  // What the scene was loaded with and changed by since (SceneFiles, for recordings).
+  std::uint64_t scene_first_tick = 1;
+  double scene_sim_time_s = 0;
+  nlohmann::json scene_changes = nlohmann::json::array();
+  // Lockstep (run_lockstep): no wall clock, no lease, builds waited for; forces and events of the
+  // tick go into its result.
+  bool lockstep = false;
+  proto::LockstepResult* capture = nullptr;
+
+  InstrumentTable instruments;  // both threads (thread-safe)
+  struct Tool {  // physics thread only
+    SimulatedTool tool;
+    std::unique_ptr<ProbeContact> contact;
+    ContactResult result;
+  };
+  std::map<std::uint32_t, Tool> tools;
+  CommandResponder responder;
+  SessionControl session;
+  std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread
+  std::uint64_t mesh_frames_before = 0, mesh_skipped_before = 0;  // of the publishers of earlier scenes
+  std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, forces_sent{0};
+  ServerStats stats;  // physics thread
+
+  Impl(const SceneSpec& s, ServerEndpoints& e, std::string dir, const TickBudget& b, bool lockstep_mode);
+
+  /// The tick in progress, or between ticks the next one.
+  std::uint64_t current_tick() const { return ticks_run + 1; }
+
+  // --- The organ
+  /// Physics thread, between ticks: `next` becomes the organ. A new scene starts at rest with its
+  /// own instruments (owners lose theirs and must claim again) and a new surface; a new material
+  /// on the same mesh keeps the organ's deformation, its owners and its tools.
+  void adopt(std::shared_ptr<Organ> next, bool new_scene);
+
+  /// The organ back at rest (memory variables relaxed); graspers let go.
+  void reset_organ();
+
+  /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
+  /// contact of each active tool, and the springs holding grasped nodes to the jaws.
+  void apply_instruments(const tissue::BoundaryConditions::FieldEvaluation& e);
+
+  /// The boundary surface with its vertices numbered in the order of boundary.nodes.
+  proto::SurfaceTopology surface_topology(const tissue::BoundarySurface& boundary) const;
+
+  // --- What the server publishes
+  void publish_scene();
+
+  /// What it takes to re-run the scene (recordings): its files, the server's build and settings,
+  /// the material and rate changes since it was loaded, its first tick.
+  void publish_scene_files();
+
+  /// A session event for recorders, trainers and consoles (physics thread), stamped with the tick
+  /// in progress (the request it concludes, if any).
+  void event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text = {}, std::uint64_t request_seq = 0);
+
+  /// After tick `tick` (physics thread): the command thread answers from this state from now on.
+  void publish_snapshot(std::uint64_t tick);
+
+  /// `tick`: the tick that stepped with the command, or whose state answered it; `strain`: the
+  /// organ's largest edge strain that tick.
+  void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns,
+                     std::uint64_t tick, double strain);
+
+  /// After a tick: every active tool's force, and its contact and grasp events.
+  void publish_forces(std::int64_t step_time_ns);
+
+  // --- Commands (command thread)
+  /// A command's payload decoded, or counted as malformed.
+  std::optional<proto::Command> decode_counted(std::span<const std::uint8_t> payload);
+
+  /// A command offered to its instrument, a refusal counted; whether it became the newest.
+  bool offer_counted(const proto::Command& c, std::int64_t now_ns);
+
+  /// Each valid command from an instrument's owner becomes the instrument's newest command and is
+  /// answered at once with the reaction at the commanded pose on the newest snapshot (contact
+  /// query, no step). The next tick steps the tissue with it.
+  void answer_new_commands();
+
+  /// Lockstep: the step's answers, on the state the previous tick left (as the command thread
+  /// answers them live); they do not become the instruments' commands. Ownership is not checked
+  /// again: the live server answered them, so their client owned the instrument then, and a claim
+  /// or release in the same step may have come before or after them live (the order of the two
+  /// within one tick's interval is not recorded).
+  void answer_in_lockstep(const std::vector<std::vector<std::uint8_t>>& answers);
+
+  /// Lockstep: the step's commands become their instruments' newest (the live command thread's
+  /// other half).
+  void command_in_lockstep(const std::vector<std::vector<std::uint8_t>>& commands);
+
+  // --- Session requests (physics thread)
+  /// Claim and release an instrument (its owner only); pause, resume and reset the organ, load a
+  /// scene, change the material or the physics rate (any client: an instructor's console or a
+  /// trainer).
+  void take_sessions(const Status& status, const proto::LockstepStep* step);
+
+  /// Run-time control: a new physics rate at once; a scene or material is prepared in the
+  /// background (finish_preparing() swaps it in). Every request gets an outcome in the scene state
+  /// and an event; a refusal says why.
+  void control(const proto::SessionRequest& req, const Status& status);
+
+  /// Physics thread, between ticks: a prepared scene or material that is ready replaces the organ
+  /// (in lockstep, once it is ready: the tick that asked for it uses it).
+  void finish_preparing(const Status& status);
+
+  /// An instructor takes an instrument over from its owner, or hands it back: ownership moves in
+  /// one step (never free in between), with an event naming both clients and an outcome.
+  void hand_over(const proto::SessionRequest& req, const Status& status);
+
+  /// A control request's outcome: in the scene state (the last 8), as an event, on the console.
+  void conclude(const proto::SessionRequest& req, bool accepted, const std::string& message, const Status& status);
+
+  /// A client that died or went silent for longer than the lease loses its instrument, which is
+  /// released safely (no force on the tissue from it any more).
+  void release_silent(const Status& status);
+
+  // --- One tick (physics thread)
+  /// Session requests, a finished build, the lease; then the organ stepped by 1/rate with each
+  /// owned instrument's newest command; then the snapshot, the forces and a surface frame.
+  /// Returns the step's duration [ns].
+  /// In lockstep (`step`), the requests and commands are the step's, and no lease runs out.
+  std::int64_t tick(const Status& status, const proto::LockstepStep* step = nullptr);
+
+  /// The surface after the last tick, as the mesh publisher sends it.
+  std::vector<std::uint8_t> surface_frame() const;
+
+  /// Lockstep: one step from the driver, and its result.
+  proto::LockstepResult lockstep_tick(const proto::LockstepStep& step, bool first, const Status& status);
+
+  /// The counters the other threads keep, into stats.
+  void collect_counts();
+
+  std::string status_now() const;
+};
+
+}  // namespace viscera::runtime
