@@ -10,6 +10,7 @@ namespace {
 constexpr double kTravelSpeed = 0.2, kDescendSpeed = 0.1, kPressSpeed = 0.05, kLiftSpeed = 0.2;  // [m/s]
 constexpr double kDwellS = 0.05;  // at DEPTH before the force is noted [s]
 constexpr double kCoarse = 0.02, kFine = 0.01;  // grid spacings [m]
+constexpr double kCentreRadius = 1.5 * kFine;  // the stiff area's centre is weighed over the points this close to the stiffest [m]
 constexpr double kMargin = 0.15;  // of the organ's extent kept clear at its sides
 constexpr double kSafeForceN = 2.0;  // a press stops here
 constexpr double kMinVerticalShare = 0.8;  // F_z / |F| of a press that counts
@@ -35,6 +36,22 @@ void PalpatingDevice::add_neighbours(double x, double y, double spacing) {
       if (i != 0 || j != 0) probes_.push_back({x + i * spacing, y + j * spacing});
 }
 
+std::pair<double, double> PalpatingDevice::stiff_centre(const Probe& best) const {
+  std::vector<double> felt;
+  for (const Probe& p : probes_)
+    if (p.force_n >= 0) felt.push_back(p.force_n);
+  std::nth_element(felt.begin(), felt.begin() + static_cast<std::ptrdiff_t>(felt.size() / 2), felt.end());
+  const double median = felt[felt.size() / 2];
+  double w = 0, x = 0, y = 0;
+  for (const Probe& p : probes_)
+    if (p.force_n > median && std::hypot(p.x - best.x, p.y - best.y) <= kCentreRadius) {
+      w += p.force_n - median;
+      x += (p.force_n - median) * p.x;
+      y += (p.force_n - median) * p.y;
+    }
+  return w > 0 ? std::pair{x / w, y / w} : std::pair{best.x, best.y};
+}
+
 void PalpatingDevice::next_point() {
   phase_ = Phase::travel;
   if (++current_ < probes_.size()) return;
@@ -54,9 +71,11 @@ void PalpatingDevice::next_point() {
   }
   if (!marking_) {
     marking_ = true;
-    std::printf("palpate: stiffest of %zu points at (%.3f, %.3f) m with %.3f N: marking it\n", probes_.size(), best->x, best->y, best->force_n);
+    const auto [x, y] = stiff_centre(*best);
+    std::printf("palpate: stiffest of %zu points at (%.3f, %.3f) m with %.3f N; the stiff area's centre at (%.3f, %.3f) m: marking it\n",
+                probes_.size(), best->x, best->y, best->force_n, x, y);
     std::fflush(stdout);
-    probes_.push_back({best->x, best->y});
+    probes_.push_back({x, y});
     return;
   }
   phase_ = Phase::done;
@@ -99,7 +118,21 @@ client::DeviceSample PalpatingDevice::read(double t) {
       break;
     case Phase::press: {
       if (magnitude(force_) > kSafeForceN && !marking_) {
-        phase_ = Phase::lift;  // too stiff or too steep to press further: left out
+        // The tissue pushes back hard enough to stop the press: judged by the force half way if
+        // the tip got there, else by the force that stopped it (a lump this hard so near the
+        // surface is the stiffest place there is); still left out if it leans (a slope).
+        if (z_ > contact_z_ - 0.5 * depth_) {
+          p.half_force_n = magnitude(force_);
+          p.half_vertical = force_[2] >= kMinVerticalShare * p.half_force_n;
+        }
+        p.force_n = p.half_vertical ? p.half_force_n : -1.0;
+        if (verbose_) {
+          std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.1f mm, stopped at %.3f N before %.0f mm%s\n", p.x, p.y, contact_z_,
+                      p.half_force_n, 1e3 * std::min(contact_z_ - z_, 0.5 * depth_), magnitude(force_), 1000 * depth_,
+                      p.force_n < 0 ? " (steep: left out)" : "");
+          std::fflush(stdout);
+        }
+        phase_ = Phase::lift;
         break;
       }
       if (z_ > contact_z_ - 0.5 * depth_) {

@@ -3,12 +3,14 @@
 // trainee's hand would: at each point of a grid over the organ's top (2 cm apart, then 1 cm apart
 // around the stiffest), it comes down until it touches, presses DEPTH further, notes the force it
 // feels half way (deeper, the tip slips off a stiff spot on a coarse mesh) and lifts off; then it
-// presses at the stiffest point and marks it (button 1). It
+// presses at the centre of the stiff area around the stiffest point and marks it (button 1). It
 // never reads the scene's regions: only the forces tell it where the nodule is. Where the surface
-// slopes steeply (the force it feels half way leans more than about 37 degrees from the vertical) or the
-// force passes a safe 2 N before DEPTH, the point is left out: a hand presses along the surface's
-// normal, and a vertical press into a slope measures the slope, not the tissue.
+// slopes steeply (the force it feels half way leans more than about 37 degrees from the vertical),
+// the point is left out: a hand presses along the surface's normal, and a vertical press into a
+// slope measures the slope, not the tissue. A press stops at a safe 2 N; the point is then judged
+// by the force half way, or by the 2 N that stopped it before half way (a hard lump).
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "viscera/client/device.hpp"
@@ -32,6 +34,10 @@ class PalpatingDevice : public client::Device {
     bool half_vertical = false;  ///< ... and mostly vertical there
   };
   void next_point();
+  /// The centre of the stiff area around `best`: the points within 1.5 cm of it, each weighted by
+  /// how much more force it felt than the median point (a hand marks the middle of the lump it
+  /// felt, not the one spot it pressed hardest).
+  std::pair<double, double> stiff_centre(const Probe& best) const;
   void add_neighbours(double x, double y, double spacing);
 
   std::vector<Probe> probes_;
