@@ -55,6 +55,13 @@ node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; r
 check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'
 check "the server found nothing malformed" 'grep "Hz physics" "$tmp/server.log" | tail -1 | grep -q "malformed 0,"'
+# The trainee's client stood by while the console had its instrument: it noticed both ways, and
+# the server refused at most the commands sent before it noticed (0.1 s at 1 kHz, with margin).
+grep -E "taken over by|handed back" "$tmp/haptic.log"
+not_owner=$(grep "Hz physics" "$tmp/server.log" | tail -1 | grep -o "not owner [0-9]*" | grep -o "[0-9]*")
+echo "commands refused as not the owner's: $not_owner"
+check "the trainee's client stood by while taken over, and drove again after the hand-back" \
+  'grep -q "taken over by client" "$tmp/haptic.log" && grep -q "handed back" "$tmp/haptic.log" && [ "${not_owner:-99999}" -le 400 ]'
 python3 - "$tmp/page.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

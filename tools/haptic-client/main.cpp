@@ -169,6 +169,7 @@ struct RunResult {
   double faded_t_s = -1;  // when the rendered force had faded to zero after that
   int server_returns = 0;  // --reconnect: servers claimed again after a loss
   bool lost = false;  // ended because the server was gone
+  int taken_over = 0;  // times another client (an instructor's console) took the instrument over
 };
 
 void print_live(const Options& o, viscera::client::Client& client, double t, const Vector3& tip, const viscera::protocol::Force& f,
@@ -203,7 +204,8 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
   std::optional<viscera::client::TickPhase> phase;
   if (o.tick_phase_us >= 0) phase.emplace(period, std::chrono::nanoseconds(std::llround(o.tick_phase_us * 1e3)));
   const auto rate_matches = [&](const viscera::protocol::Scene& s) { return std::abs(s.physics_rate_hz - o.rate_hz) <= 0.01 * o.rate_hz; };
-  bool in_phase_possible = true;
+  bool in_phase_possible = true, standing_by = false;
+  Vector3 last_tip{};
   double last_print = -1, last_scene_check = 0;
   for (;;) {
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -239,8 +241,26 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
       last_scene_check = t;
       const auto now = client.scene();
       if (now) in_phase_possible = rate_matches(*now);  // the physics rate may change at run time
+      // An instructor may take the instrument over (and hand it back): meanwhile this client sends
+      // nothing (its commands would be refused) and the force it renders fades out.
+      if (now && now->generation == generation) {
+        const auto it = std::find_if(now->instruments.begin(), now->instruments.end(),
+                                     [&](const viscera::protocol::InstrumentInfo& i) { return i.instrument_id == o.instrument; });
+        const std::uint32_t owner = it == now->instruments.end() ? 0 : it->owner_client_id;
+        const bool taken = owner != 0 && owner != client.id();
+        if (taken != standing_by) {
+          standing_by = taken;
+          run.taken_over += taken;
+          if (taken) renderer.server_lost(t);
+          std::printf(taken ? "t = %5.2f s  instrument %u taken over by client %u: this device stands by until it is handed back\n"
+                            : "t = %5.2f s  instrument %u handed back (owner client %u): driving it again\n",
+                      t, o.instrument, owner);
+          std::fflush(stdout);
+        }
+      }
       if (now && now->generation != generation) {
         generation = now->generation;
+        standing_by = false;
         const auto again = client.claim(o.instrument, std::chrono::seconds(2));
         std::printf("t = %5.2f s  the server loaded scene %s: instrument %u %s\n", t, now->name.c_str(), o.instrument,
                     again ? "claimed again" : ("could not be claimed again: " + again.why).c_str());
@@ -249,8 +269,15 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
         continue;
       }
     }
+    if (standing_by) {  // nothing is sent and the device is not read; the force it renders fades out
+      device.render(renderer.render(last_tip, t).force, false);
+      next += period;
+      std::this_thread::sleep_until(next);
+      continue;
+    }
     const auto in = device.read(t);
     if (in.finished) break;
+    last_tip = in.tip_m;
     client.send_tip(o.instrument, in.tip_m, in.jaw_rad, in.buttons);
     ++seq;
     sent[seq % sent.size()] = {seq, in.tip_m};
@@ -305,6 +332,7 @@ void write_report(const Options& o, const std::string& scene, const std::string&
                    {"tick_phase", {{"offset_us", o.tick_phase_us}, {"periods", run.phased}, {"within_50us", run.near_phase}}},
                    {"fade", {{"stale_after_s", o.fade.stale_after_s}, {"fade_s", o.fade.fade_s}}},
                    {"server_lost_t_s", run.server_lost_t_s},
+                   {"taken_over", run.taken_over},
                    {"faded_t_s", run.faded_t_s},
                    {"server_returns", run.server_returns},
                    {"samples", to_json(run.samples)}};
@@ -324,12 +352,14 @@ int main(int argc, char** argv) {
       "(with --hold: pulls up at 1 cm/s, holds HOLD seconds, then opens).\n"
       "Script 'hold': the probe presses until the force it feels is FORCE and holds it there (a force drill).\n"
       "Script 'palpate': the probe palpates the organ's top on a grid, pressing DEPTH beyond contact and judging each point\n"
-      "by the force half way (deeper, the tip slips off a stiff spot), and marks\n"
-      "the stiffest place with button 1 (a palpation exercise; it never reads where the nodule is).\n"
+      "by the force half way (deeper, the tip slips off a stiff spot), and marks the centre of the stiff area\n"
+      "around the stiffest place with button 1 (a palpation exercise; it never reads where the nodule is).\n"
       "--trajectory FILE.csv plays a recorded or designed trajectory instead (docs/PROTOCOL.md).\n"
       "Prints force and command-to-force round trip live; --report writes every sample as JSON.\n"
       "If the server goes away the rendered force fades to zero (--fade) and the client exits with status 4\n"
       "(--reconnect: it waits for a server to come back and claims the instrument again).\n"
+      "While another client (an instructor's console) has taken the instrument over, the client sends nothing,\n"
+      "its rendered force fades out and the device waits; it drives again once the instrument is handed back.\n"
       "Exit status: 0 done, 2 bad arguments, 3 no server or instrument not claimed, 4 the server went away, 1 other errors.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");
