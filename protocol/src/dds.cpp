@@ -194,6 +194,43 @@ int Reader::take(const std::function<void(const Received&)>& f) {
   return total;
 }
 
+PartitionDiscovery::PartitionDiscovery(Participant& p, Stream s)
+    : reader_(check(dds_create_reader(p.handle(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr), "create discovery reader")),
+      topic_(topic_name(s)) {}
+
+PartitionDiscovery::~PartitionDiscovery() { dds_delete(reader_); }
+
+std::vector<std::string> PartitionDiscovery::take_new() {
+  constexpr int kMax = 64;
+  std::vector<std::string> out;
+  void* samples[kMax] = {nullptr};
+  dds_sample_info_t infos[kMax];
+  for (;;) {
+    const int32_t n = dds_take(reader_, samples, infos, kMax, kMax);  // loaned samples
+    if (n <= 0) break;
+    for (int32_t k = 0; k < n; ++k) {
+      const auto* w = static_cast<const dds_builtintopic_endpoint_t*>(samples[k]);
+      if (!infos[k].valid_data || w->topic_name == nullptr || topic_ != w->topic_name) continue;
+      std::uint32_t count = 0;
+      char** names = nullptr;
+      std::vector<std::string> partitions;
+      if (w->qos != nullptr && dds_qget_partition(w->qos, &count, &names)) {
+        for (std::uint32_t j = 0; j < count; ++j) {
+          partitions.emplace_back(names[j]);
+          dds_free(names[j]);
+        }
+        dds_free(static_cast<void*>(names));
+      }
+      if (partitions.empty()) partitions.emplace_back();  // the default partition
+      for (auto& name : partitions)
+        if (seen_.insert(name).second) out.push_back(std::move(name));
+    }
+    dds_return_loan(reader_, samples, n);
+    if (n < kMax) break;
+  }
+  return out;
+}
+
 bool Reader::wait(std::chrono::nanoseconds timeout) { return dds_waitset_wait(waitset_, nullptr, 0, timeout.count()) > 0; }
 
 int Reader::alive_writers() const {

@@ -7,14 +7,14 @@
 # the bridge (tests/node/console_robustness.mjs: a slow one, malformed messages, an oversized one,
 # a flood, a wrong token) while a well-behaved one keeps receiving frames; and the reference client
 # of the Foxglove WebSocket protocol (tests/node/foxglove_client.mjs); and the session's recording
-# opened for replay from the console (tests/node/console_replay.mjs). Also the console's
-# refusals of a bad command line and token file.
+# opened for replay from the console (tests/node/console_replay.mjs); a second station's server
+# found on the domain (--discover). Also the console's refusals of a bad command line and token file.
 # Usage: console_test.sh BUILD_DIR SOURCE_DIR    (SHOTS=DIR keeps the page's screenshots)
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/console-test/; rm -rf "$tmp"' EXIT
 console="$build/tools/viscera-console/viscera-console"
 node_dir="$src/tests/node"
 [ -d "$node_dir/node_modules/playwright-core" ] || { echo "FAIL playwright-core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }
@@ -37,7 +37,7 @@ cat "$tmp/e1.txt" "$tmp/e2.txt" "$tmp/e3.txt"
 # The session is recorded while the page is tested; the recording is then opened for replay.
 mkdir -p "$tmp/recordings"
 "$build/tools/viscera-record/viscera-record" --out "$tmp/recordings/session.mcap" --domain "$domain" --quiet > "$tmp/record.log" 2>&1 & recorder=$!; pids+=($recorder)
-"$console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 --recordings "$tmp/recordings" > "$tmp/console.log" 2>&1 & bridge=$!; pids+=($bridge)
+"$console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 --recordings "$tmp/recordings" --discover > "$tmp/console.log" 2>&1 & bridge=$!; pids+=($bridge)
 wait_for "open http" "$tmp/console.log" || exit 1
 url=$(grep -o "http://[^ ]*" "$tmp/console.log")
 sleep 1
@@ -54,6 +54,27 @@ check "a Foxglove client on the live session (foxglove_client.mjs)" '[ $rc_foxgl
 node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?
 check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'
+# Another station's server appears on the domain (partition bay-2, at 200 Hz to spare the CPU): the
+# console (--discover) offers it as a station, once; the default station and the replay it opened
+# itself are not offered again.
+python3 - "$scene" "$tmp/bay2.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["physics_rate_hz"] = 200
+s["mesh_rate_hz"] = 10
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$build/server/runtime/viscera-server" --scene "$tmp/bay2.json" --partition bay-2 > "$tmp/bay2.log" 2>&1 & bay2=$!; pids+=($bay2)
+wait_for "offered as station bay-2" "$tmp/console.log" 150
+python3 -c "import sys, urllib.request; print(urllib.request.urlopen(sys.argv[1].replace('/?', '/stats?')).read().decode())" "$url" > "$tmp/stats.json"
+kill -INT $bay2; wait $bay2
+grep "offered as station" "$tmp/console.log"
+pycheck "$tmp/stats.json" <<'PY'
+import json, sys
+names = [s["name"] for s in json.load(open(sys.argv[1]))["stations"]]
+print(f"stations offered: {names}")
+sys.exit(0 if names.count("bay-2") == 1 and len(set(names)) == len(names) and "default" in names and "viscera-replay-1" in names else 1)
+PY
 check "the server found nothing malformed" 'grep "Hz physics" "$tmp/server.log" | tail -1 | grep -q "malformed 0,"'
 # The trainee's client stood by while the console had its instrument: it noticed both ways, and
 # the server refused at most the commands sent before it noticed (0.1 s at 1 kHz, with margin).

@@ -202,7 +202,9 @@ TEST(ExerciseScorer, PalpationScoresTheMarksDistanceToTheNodulesSurface) {
     EXPECT_NEAR(*r.mark_distance_m, expected, 1e-12);
     EXPECT_EQ(r.end_tick, 2100u);
     EXPECT_EQ(r.passed, expected <= 0.01) << "dx " << dx;
-    if (!r.passed) EXPECT_TRUE(has_failure(r, "the wrong place was marked"));
+    if (!r.passed) {
+      EXPECT_TRUE(has_failure(r, "the wrong place was marked"));
+    }
   }
   // No mark at all, and a session whose scene never loads.
   Session none("liver-nodule", {nodule});

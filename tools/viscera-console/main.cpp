@@ -2,9 +2,11 @@
 // the client SDK) that serves the console page and a WebSocket to browsers: the organ's surface
 // live, instruments, forces, health and events out; pause, resume, reset, load a scene, change the
 // material, annotate and bookmark in (docs/CONSOLE.md).
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include <boost/asio/io_context.hpp>
@@ -16,6 +18,7 @@
 #include "viscera/common/json_input.hpp"
 #include "viscera/console/access_token.hpp"
 #include "viscera/process/child_process.hpp"
+#include "viscera/protocol/dds.hpp"
 
 #include "station.hpp"
 #include "web_server.hpp"
@@ -74,6 +77,7 @@ int main(int argc, char** argv) {
                                   "material, annotate, bookmark). Open the address it prints; it carries the access token.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("stations", "P1,P2", "the stations to offer, as DDS partitions (a trainee station's server in each; empty: the default partition)", "");
+  cl.option_switch("discover", "also offer a station for every partition in which a viscera server appears on the domain (looked for every second)");
   cl.flag("listen", "ADDRESS:PORT", "where browsers connect (port 0: any free one); another address than loopback makes the console remote",
           "127.0.0.1:8080");
   cl.flag("token-file", "FILE", "the access token's file (one line, at least 32 characters: openssl rand -hex 16 > FILE)");
@@ -167,6 +171,32 @@ int main(int argc, char** argv) {
     std::printf("viscera-console: domain %u, %zu station(s); open http://%s:%u/?token=%s\n", domain, stations.size(), host.c_str(), ep.port(),
                 viscera::console::read_token_file(cl.text("token-file")).c_str());
     std::fflush(stdout);
+
+    // --discover: a station for every partition where a server's scene state appears (DDS
+    // discovery), unless one is offered already (given, a replay opened here, or found before).
+    std::optional<viscera::protocol::Participant> discovery_participant;
+    std::optional<viscera::protocol::PartitionDiscovery> discovery;
+    asio::steady_timer discovery_timer(io);
+    std::function<void()> discover = [&] {
+      for (const std::string& partition : discovery->take_new()) {
+        const std::string name = partition.empty() ? "default" : partition;
+        if (std::any_of(stations.begin(), stations.end(), [&](const auto& s) { return s->name() == name; })) continue;
+        const std::size_t k = stations.size();
+        stations.push_back(std::make_unique<viscera::console::Station>(domain, partition, client_id, force_period_s, make_sink(k)));
+        server->add_station(stations.back().get());
+        std::printf("viscera-console: a server appeared in partition %s: offered as station %s\n", name.c_str(), name.c_str());
+        std::fflush(stdout);
+      }
+      discovery_timer.expires_after(std::chrono::seconds(1));
+      discovery_timer.async_wait([&](const boost::system::error_code& e) {
+        if (!e) discover();
+      });
+    };
+    if (cl.has("discover")) {
+      discovery_participant.emplace(domain);
+      discovery.emplace(*discovery_participant, viscera::protocol::Stream::scene_state);
+      discover();
+    }
 
     asio::signal_set signals(io, SIGINT, SIGTERM);
     signals.async_wait([&](const boost::system::error_code&, int) { io.stop(); });

@@ -260,6 +260,8 @@ void Station::request_loop() {
       }
       case RequestType::move:  // carried out at once (move())
       case RequestType::watch: done(true, "watching " + name_); break;
+      case RequestType::recordings:
+      case RequestType::open_recording: done(false, "not a station's request (the web server answers it)"); break;
     }
     job.second(std::move(out));
   }

@@ -262,12 +262,8 @@ class Browser : public std::enable_shared_from_this<Browser> {
     std::string why;
     Station* s = server_->opt.open_replay(r.text, &why);
     if (!s) return error(r.id, "open_recording: " + why);
-    server_->stations.push_back(s);
-    server_->latched.resize(server_->stations.size());
+    server_->add_station(s);
     station_ = server_->stations.size() - 1;
-    nlohmann::json names = nlohmann::json::array();
-    for (const Station* x : server_->stations) names.push_back(x->name());
-    for (auto& [id, b] : std::map(server_->browsers)) b->send_json({{"type", "stations"}, {"stations", names}});
     send_json({{"type", "reply"},
                {"id", r.id},
                {"request", "open_recording"},
@@ -341,6 +337,16 @@ bool WebServer::Impl::authorised(const http::request<http::string_body>& req, bo
   return cookie != req.end() &&
          token_matches(field_value(std::string_view(cookie->value().data(), cookie->value().size()), "viscera_token", ';'), opt.token);
 }
+
+void WebServer::Impl::add_station(Station* s) {
+  stations.push_back(s);
+  latched.resize(stations.size());
+  nlohmann::json names = nlohmann::json::array();
+  for (const Station* x : stations) names.push_back(x->name());
+  for (auto& [id, b] : std::map(browsers)) b->send_json({{"type", "stations"}, {"stations", names}});
+}
+
+void WebServer::add_station(Station* station) { impl_->add_station(station); }
 
 nlohmann::json WebServer::Impl::stats() const {
   nlohmann::json list = nlohmann::json::array();

@@ -47,6 +47,9 @@ class WebServer {
   /// stream; wants_raw() says whether any is connected (else the station need not copy them).
   void post_raw(std::size_t station, protocol::Stream stream, std::int64_t stamp_ns, std::shared_ptr<const std::vector<std::uint8_t>> payload);
   bool wants_raw() const;
+  /// A station added at run time (a replay, a server found on the domain), as station number
+  /// stations().size(): every browser gets the new list. Call on the io thread.
+  void add_station(Station* station);
   /// Counters, per browser and in all (the io thread's view; call on it, or from /stats).
   nlohmann::json stats() const;
 

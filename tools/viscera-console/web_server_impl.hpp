@@ -54,6 +54,7 @@ struct WebServer::Impl : std::enable_shared_from_this<WebServer::Impl> {
   void accept();
   bool authorised(const http::request<http::string_body>& req, bool* from_query) const;
   nlohmann::json stats() const;
+  void add_station(Station* s);
 };
 
 /// Reads HTTP requests on a new connection (http_connection.cpp).

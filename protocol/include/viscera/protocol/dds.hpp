@@ -6,9 +6,11 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <set>
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace viscera::protocol {
 
@@ -123,6 +125,24 @@ class Reader {
   int32_t waitset_;
   int32_t condition_;
   std::function<void(int)> on_alive_;
+};
+
+/// The partitions in which writers of a stream have appeared on the domain (DDS discovery: the
+/// built-in publication topic), e.g. every partition that holds a viscera server (its scene state).
+class PartitionDiscovery {
+ public:
+  PartitionDiscovery(Participant& p, Stream s);
+  ~PartitionDiscovery();
+  PartitionDiscovery(const PartitionDiscovery&) = delete;
+  PartitionDiscovery& operator=(const PartitionDiscovery&) = delete;
+  /// The partitions seen for the first time since the last call, in the order seen ("" is the
+  /// default partition).
+  std::vector<std::string> take_new();
+
+ private:
+  int32_t reader_;
+  std::string topic_;
+  std::set<std::string> seen_;
 };
 
 /// The stamps of the protocol: wall-clock time in nanoseconds since the Unix epoch (dds_time).
