@@ -152,11 +152,12 @@ RegionLayout lay_out_regions(const std::vector<RegionSpec>& specs, const tissue:
     r.shape = spec.shape;
     r.radius_m = spec.radius_m;
     const double r2 = spec.radius_m * spec.radius_m;
-    for (std::size_t e = 0; e < mesh.tet_count() && spec.shape != RegionSpec::Shape::elements; ++e) {
-      const Vec3 c = centroid(mesh, e);
-      if (spec.shape == RegionSpec::Shape::box ? r.box.contains(c) : (c - r.center_m).squaredNorm() <= r2)
-        out.material_of_tet[e] = static_cast<std::uint16_t>(k + 1);
-    }
+    if (spec.shape != RegionSpec::Shape::elements)  // a tagged set took its elements above
+      for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+        const Vec3 c = centroid(mesh, e);
+        if (spec.shape == RegionSpec::Shape::box ? r.box.contains(c) : (c - r.center_m).squaredNorm() <= r2)
+          out.material_of_tet[e] = static_cast<std::uint16_t>(k + 1);
+      }
     out.regions.push_back(r);
   }
   for (std::size_t e = 0; e < mesh.tet_count(); ++e)
