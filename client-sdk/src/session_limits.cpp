@@ -4,6 +4,8 @@
 #include <cctype>
 #include <sstream>
 
+#include "viscera/common/plain_name.hpp"
+
 namespace viscera::client {
 
 const std::array<MaterialParameter, 5>& material_parameters() {
@@ -25,10 +27,7 @@ std::optional<std::string> outside_range(const std::string& name, double value, 
   return s.str();
 }
 
-bool is_scene_name(const std::string& n) {
-  return !n.empty() && n.size() <= 64 && n[0] != '.' &&
-         std::all_of(n.begin(), n.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
-}
+bool is_scene_name(const std::string& n) { return common::is_plain_name(n); }
 
 std::string not_a_scene_name(const std::string& n) { return "SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)"; }
 

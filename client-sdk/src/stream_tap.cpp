@@ -1,6 +1,7 @@
 #include "viscera/client/stream_tap.hpp"
 
 #include <map>
+#include <stdexcept>
 
 namespace viscera::client {
 
@@ -45,10 +46,28 @@ int StreamTap::take(const std::function<void(const TapSample&)>& f) {
 struct StreamPublisher::Impl {
   proto::Participant participant;
   std::map<proto::Stream, std::unique_ptr<proto::Writer>> writers;
-  Impl(std::uint32_t domain, const std::string& partition) : participant(domain, partition) {}
+  proto::PartitionDiscovery servers;
+  bool server_seen = false;
+  Impl(std::uint32_t domain, const std::string& partition)
+      : participant(domain, partition), servers(participant, proto::Stream::scene_state, proto::kServerRole) {}
 };
 
-StreamPublisher::StreamPublisher(std::uint32_t domain_id, const std::string& partition) : impl_(std::make_unique<Impl>(domain_id, partition)) {}
+namespace {
+const std::string& own_partition(const std::string& partition) {
+  if (partition.empty()) throw std::invalid_argument("a replay publishes in a partition of its own, not the default one where live servers are");
+  if (proto::has_partition_wildcard(partition))
+    throw std::invalid_argument("'" + partition + "' holds a DDS wildcard ('*' or '?'), which would reach other partitions, live servers' too");
+  return partition;
+}
+}  // namespace
+
+StreamPublisher::StreamPublisher(std::uint32_t domain_id, const std::string& partition)
+    : impl_(std::make_unique<Impl>(domain_id, own_partition(partition))) {}
+
+bool StreamPublisher::live_server() {
+  for (const auto& p : impl_->servers.take_new()) impl_->server_seen = impl_->server_seen || p == impl_->participant.partition();
+  return impl_->server_seen;
+}
 StreamPublisher::~StreamPublisher() = default;
 
 void StreamPublisher::open(proto::Stream stream) {

@@ -14,8 +14,9 @@ int32_t check(int32_t rc, const char* what) {
   return rc;
 }
 
-dds_qos_t* qos_for(Stream s, const std::string& partition) {
+dds_qos_t* qos_for(Stream s, const std::string& partition, const std::string& role = {}) {
   dds_qos_t* q = dds_create_qos();
+  if (!role.empty()) dds_qset_userdata(q, role.data(), role.size());
   if (!partition.empty()) {
     const char* names[] = {partition.c_str()};
     dds_qset_partition(q, 1, names);
@@ -89,8 +90,12 @@ bool parse_stream(const std::string& name, Stream* out) {
   return false;
 }
 
-Participant::Participant(std::uint32_t domain_id, std::string partition)
-    : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")), partition_(std::move(partition)) {}
+Participant::Participant(std::uint32_t domain_id, std::string partition, std::string role)
+    : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")),
+      partition_(std::move(partition)),
+      role_(std::move(role)) {}
+
+bool has_partition_wildcard(const std::string& partition) { return partition.find_first_of("*?") != std::string::npos; }
 
 Participant::~Participant() { dds_delete(handle_); }
 
@@ -101,7 +106,7 @@ int32_t Participant::topic(Stream s) {
 }
 
 Writer::Writer(Participant& p, Stream s) {
-  dds_qos_t* q = qos_for(s, p.partition());
+  dds_qos_t* q = qos_for(s, p.partition(), p.role());
   handle_ = dds_create_writer(p.handle(), p.topic(s), q, nullptr);
   dds_delete_qos(q);
   check(handle_, "create writer");
@@ -194,9 +199,10 @@ int Reader::take(const std::function<void(const Received&)>& f) {
   return total;
 }
 
-PartitionDiscovery::PartitionDiscovery(Participant& p, Stream s)
+PartitionDiscovery::PartitionDiscovery(Participant& p, Stream s, std::string role)
     : reader_(check(dds_create_reader(p.handle(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr), "create discovery reader")),
-      topic_(topic_name(s)) {}
+      topic_(topic_name(s)),
+      role_(std::move(role)) {}
 
 PartitionDiscovery::~PartitionDiscovery() { dds_delete(reader_); }
 
@@ -211,6 +217,14 @@ std::vector<std::string> PartitionDiscovery::take_new() {
     for (int32_t k = 0; k < n; ++k) {
       const auto* w = static_cast<const dds_builtintopic_endpoint_t*>(samples[k]);
       if (!infos[k].valid_data || w->topic_name == nullptr || topic_ != w->topic_name) continue;
+      if (!role_.empty()) {
+        void* data = nullptr;
+        size_t size = 0;
+        const bool has = w->qos != nullptr && dds_qget_userdata(w->qos, &data, &size);
+        const bool match = has && std::string(static_cast<const char*>(data), size) == role_;
+        dds_free(data);
+        if (!match) continue;
+      }
       std::uint32_t count = 0;
       char** names = nullptr;
       std::vector<std::string> partitions;

@@ -2,6 +2,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "viscera/common/plain_name.hpp"
 #include "viscera/protocol/messages.hpp"
 
 #include "event_generated.h"
@@ -262,9 +263,7 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
   if (r.action == Action::load_scene && m->scene_seed().has_value()) r.scene_seed = *m->scene_seed();
   if (r.action == Action::load_scene) {
     r.scene_name = m->scene_name() ? m->scene_name()->str() : "";
-    const bool plain = std::all_of(r.scene_name.begin(), r.scene_name.end(),
-                                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'; });
-    if (r.scene_name.empty() || r.scene_name.size() > 64 || r.scene_name[0] == '.' || !plain) {
+    if (!common::is_plain_name(r.scene_name)) {
       *why = "scene_name '" + r.scene_name.substr(0, 64) + "' is not a plain scene name ([A-Za-z0-9._-], 1-64 characters, no leading '.')";
       return std::nullopt;
     }

@@ -111,6 +111,14 @@ long CommandLine::integer(const std::string& name) const {
   return v;
 }
 
+std::uint64_t CommandLine::integer_in(const std::string& name, std::uint64_t lo, std::uint64_t hi) const {
+  const double v = number(name);
+  if (v != std::floor(v)) throw UsageError("--" + name + ": '" + text(name) + "' is not a whole number");
+  if (v < static_cast<double>(lo) || v > static_cast<double>(hi) || v > 9007199254740992.0)
+    throw UsageError("--" + name + ": " + text(name) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return static_cast<std::uint64_t>(v);
+}
+
 std::vector<double> CommandLine::numbers(const std::string& name, std::size_t count) const {
   std::vector<double> out;
   std::stringstream ss(text(name));

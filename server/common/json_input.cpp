@@ -49,7 +49,7 @@ class CheckedDomBuilder {
   bool string(std::string& v) { return value() && dom_.string(v); }
   bool binary(json::binary_t& v) { return value() && dom_.binary(v); }
   bool start_object(std::size_t n) {
-    if (!value()) return false;
+    if (!value() || !deeper()) return false;
     frames_.push_back({true, {}, {}, 0});
     return dom_.start_object(n);
   }
@@ -67,7 +67,7 @@ class CheckedDomBuilder {
     return dom_.end_object();
   }
   bool start_array(std::size_t n) {
-    if (!value()) return false;
+    if (!value() || !deeper()) return false;
     frames_.push_back({false, {}, {}, 0});
     return dom_.start_array(n);
   }
@@ -86,6 +86,7 @@ class CheckedDomBuilder {
   std::size_t error_position() const { return error_position_; }
   const std::string& error() const { return error_; }
   const std::string& duplicate() const { return duplicate_; }
+  bool too_deep() const { return too_deep_; }
 
  private:
   struct Frame {
@@ -94,6 +95,13 @@ class CheckedDomBuilder {
     std::string key;
     std::size_t index;
   };
+  /// An object or array may open only below kMaxJsonDepth: every later walk of the document
+  /// (printing a value in a message, nlohmann's dump) recurses once per level.
+  bool deeper() {
+    if (frames_.size() < kMaxJsonDepth) return true;
+    too_deep_ = true;
+    return false;
+  }
   /// A value starts: an element of the enclosing array takes the next index.
   bool value() {
     if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
@@ -115,6 +123,7 @@ class CheckedDomBuilder {
   std::vector<Frame> frames_;
   std::size_t error_position_ = 0;
   std::string error_, duplicate_;
+  bool too_deep_ = false;
 };
 
 }  // namespace
@@ -125,11 +134,21 @@ json parse_json(std::string_view text, const std::string& source) {
   CheckedDomBuilder builder(root);
   if (!json::sax_parse(text.begin(), text.end(), &builder)) {
     if (!builder.duplicate().empty()) throw InputError(source, 0, builder.duplicate(), "given twice (each field once)");
+    if (builder.too_deep()) throw InputError(source, 0, "JSON", "objects and arrays nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
     const std::size_t upto = std::min(builder.error_position(), text.size());
     const long line = 1 + static_cast<long>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(upto), '\n'));
     throw InputError(source, line, "JSON", printable(builder.error(), 200));
   }
   return root;
+}
+
+std::optional<json> try_parse_json(std::string_view text, std::string* why) {
+  try {
+    return parse_json(text, "JSON");
+  } catch (const InputError& e) {
+    if (why) *why = e.what();
+    return std::nullopt;
+  }
 }
 
 json read_json_file(const std::string& path) { return parse_json(read_text_file(path, std::size_t{16} << 20), path); }

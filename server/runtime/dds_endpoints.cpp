@@ -17,7 +17,7 @@ class DdsMeshStream final : public MeshStream {
 }  // namespace
 
 DdsEndpoints::DdsEndpoints(std::uint32_t domain_id, const std::string& partition, bool lockstep)
-    : participant_(domain_id, partition),
+    : participant_(domain_id, partition, proto::kServerRole),
       commands_(participant_, proto::Stream::instrument_command),
       sessions_(participant_, proto::Stream::session_request),
       forces_(participant_, proto::Stream::force_feedback),

@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
     quiet = cl.has("quiet");
     lockstep = cl.has("lockstep");
     partition = cl.text("partition");
+    if (viscera::protocol::has_partition_wildcard(partition))
+      throw viscera::common::UsageError("--partition: '" + partition +
+                                        "' holds a DDS wildcard ('*' or '?'): the server would take commands from other partitions' replays");
     if (lockstep && !cl.given("max-tick-ms")) budget.max_tick_s = 1e9;  // no real time to keep
   } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());

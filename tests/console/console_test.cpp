@@ -87,6 +87,7 @@ TEST(BrowserRequest, AcceptsEachTypeWithItsFields) {
 
 TEST(BrowserRequest, RefusesWithTheFieldAndTheValue) {
   EXPECT_EQ(error_of("{"), "not JSON");
+  EXPECT_EQ(error_of(std::string(4000, '[') + std::string(4000, ']')), "not JSON");  // nested deeper than the bound
   EXPECT_EQ(error_of("[]"), "not a JSON object");
   EXPECT_EQ(error_of(R"({"kind":"pause"})"), "type: missing, or not a string");
   EXPECT_EQ(error_of(R"({"type":"pause","scene":"x"})"), "pause: unknown field 'scene'");

@@ -9,11 +9,14 @@
 #include <fstream>
 #include <random>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/mcap/compression.hpp"
+#include "viscera/mcap/integrity.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/mcap/mcap_writer.hpp"
 
@@ -289,6 +292,137 @@ TEST(McapFile, NotAnMcapFileIsOneClearErrorNamingTheFile) {
   }
   EXPECT_THROW(McapReader(dir.path.string()), viscera::common::InputError);  // a directory
   EXPECT_THROW(McapReader(dir.file("missing.mcap")), viscera::common::InputError);
+}
+
+/// The messages of the original file's chunks, all but chunk `skip`, in file order (from the index,
+/// independent of the walk of the data section).
+std::string damage_list(const DataEnd& end) {
+  std::string out;
+  for (const auto& d : end.damaged) out += "\n  bytes " + std::to_string(d.offset) + " +" + std::to_string(d.length) + ": " + d.what;
+  return out;
+}
+
+std::vector<Message> all_but_chunk(const std::string& path, std::size_t skip) {
+  McapReader r(path);
+  const auto s = r.summary();
+  std::vector<Message> out;
+  for (std::size_t k = 0; k < s->chunks.size(); ++k)
+    if (k != skip)
+      for (auto& m : r.read_chunk(s->chunks[k])) out.push_back(std::move(m));
+  return out;
+}
+
+TEST(McapFile, RecoverKeepsEveryIntactChunkAroundADamagedOneAndSaysWhatWasLost) {
+  for (const std::string compression : {"", "zstd"}) {
+    TempDir dir;
+    const std::string path = dir.file("a.mcap");
+    write_file(path, compression, 300, 16 * 1024);
+    const auto bytes = viscera::common::read_file_bytes(path);
+    const auto summary = McapReader(path).summary();
+    ASSERT_TRUE(summary && summary->chunks.size() >= 6);
+    const auto& c1 = summary->chunks[1];
+    const std::vector<Message> want = all_but_chunk(path, 1);
+    // A byte inside the chunk's records, and a byte of the chunk's own length (its framing).
+    for (const std::uint64_t at : {c1.offset + c1.length / 2, c1.offset + 3}) {
+      auto damaged = bytes;
+      damaged[static_cast<std::size_t>(at)] ^= 0x40;
+      const std::string in = dir.file("damaged.mcap"), out = dir.file("recovered.mcap");
+      viscera::common::write_file_bytes(in, damaged);
+      const DataEnd end = recover(in, out);
+      EXPECT_FALSE(end.intact()) << at;
+      ASSERT_FALSE(end.damaged.empty()) << at;
+      EXPECT_EQ(end.damaged.front().offset, c1.offset) << at;
+      EXPECT_EQ(end.messages, want.size()) << compression << " byte " << at << damage_list(end);
+      const auto got = read_all(out);
+      ASSERT_EQ(got.size(), want.size());
+      expect_same(got, want, want.size());
+      // The one judgement of integrity sees it too.
+      McapReader r(in);
+      EXPECT_FALSE(check_integrity(r).intact()) << at;
+    }
+    McapReader whole(path);
+    const Integrity fine = check_integrity(whole);
+    EXPECT_TRUE(fine.intact()) << (fine.problems.empty() ? "" : fine.problems.front());
+  }
+}
+
+TEST(McapFile, AZeroFilledTailEndsTheWalkAtItsFirstByteAtOnce) {
+  TempDir dir;
+  const std::string path = dir.file("a.mcap");
+  write_file(path, "zstd", 300, 16 * 1024);
+  const auto summary = McapReader(path).summary();
+  ASSERT_TRUE(summary && summary->chunks.size() >= 3);
+  // Cut after the third chunk's message indexes (where the fourth chunk starts), then 8 MiB of
+  // zeros, as a file system leaves space a crash never wrote.
+  const std::uint64_t cut = summary->chunks[3].offset;
+  auto bytes = viscera::common::read_file_bytes(path);
+  bytes.resize(static_cast<std::size_t>(cut));
+  bytes.resize(bytes.size() + (8u << 20), 0);
+  const std::string in = dir.file("zeros.mcap");
+  viscera::common::write_file_bytes(in, bytes);
+  const auto t0 = std::chrono::steady_clock::now();
+  McapReader r(in);
+  const DataEnd end = r.salvage_data({});
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+  EXPECT_EQ(end.chunks, 3u);
+  EXPECT_EQ(end.offset, cut);
+  ASSERT_EQ(end.damaged.size(), 1u);
+  EXPECT_EQ(end.damaged[0].offset, cut);
+  EXPECT_EQ(end.damaged[0].length, 8u << 20);
+  EXPECT_NE(end.damaged[0].what.find("zero bytes"), std::string::npos) << end.damaged[0].what;
+  // The strict walk stops there too, naming opcode 0, instead of reading zeros as records.
+  DataEnd strict;
+  read_all(in, &strict);
+  EXPECT_EQ(strict.offset, cut);
+  EXPECT_NE(strict.error.find("opcode 0"), std::string::npos) << strict.error;
+}
+
+TEST(McapFile, ADamagedAttachmentOrOneClaimingATerabyteIsNotIntact) {
+  TempDir dir;
+  const std::string path = dir.file("a.mcap");
+  write_file(path, "zstd", 50, 16 * 1024);
+  const auto bytes = viscera::common::read_file_bytes(path);
+  const auto summary = McapReader(path).summary();
+  ASSERT_EQ(summary->attachments.size(), 1u);
+  const std::size_t at = static_cast<std::size_t>(summary->attachments[0].offset);
+  // The attachment: opcode, length, two times, name, media type, data length, data "{}", CRC.
+  const std::string name = "scene/liver.json", media = "application/json";
+  const std::size_t data_length_at = at + 9 + 16 + 4 + name.size() + 4 + media.size();
+  ASSERT_EQ(bytes[data_length_at], 2);
+  ASSERT_EQ(bytes[data_length_at + 8], '{');
+  auto flipped = bytes;
+  flipped[data_length_at + 9] ^= 0x01;  // '}' -> '|'
+  auto huge = bytes;
+  huge[data_length_at + 5] = 1;  // 2 + 2^40 bytes
+  for (const auto& [label, damaged] : {std::pair{"flipped", flipped}, std::pair{"2^40", huge}}) {
+    const std::string in = dir.file(std::string("attachment-") + (label[0] == 'f' ? "flipped" : "huge") + ".mcap");
+    viscera::common::write_file_bytes(in, damaged);
+    McapReader r(in);
+    const Integrity i = check_integrity(r);
+    ASSERT_FALSE(i.intact()) << label;
+    bool named = false;
+    for (const auto& p : i.problems) named = named || p.find("attachment") != std::string::npos || p.find(std::to_string(at)) != std::string::npos;
+    EXPECT_TRUE(named) << label << ": " << i.problems.front();
+    // Recover keeps every message and says the attachment was lost.
+    const DataEnd end = recover(in, dir.file("recovered.mcap"));
+    EXPECT_EQ(end.messages, 150u) << label << damage_list(end);
+    EXPECT_EQ(end.attachments, 0u) << label;
+    ASSERT_EQ(end.damaged.size(), 1u) << label;
+    EXPECT_EQ(end.damaged[0].offset, at) << label;
+  }
+}
+
+TEST(McapFile, RecoverRefusesToWriteOverItsInputByAnyName) {
+  TempDir dir;
+  const std::string path = dir.file("a.mcap");
+  write_file(path, "", 50, 16 * 1024);
+  const auto before = viscera::common::read_file_bytes(path);
+  fs::create_hard_link(path, dir.file("hard.mcap"));
+  fs::create_symlink(path, dir.file("soft.mcap"));
+  for (const std::string& out : {path, dir.file("hard.mcap"), dir.file("soft.mcap"), dir.path.string() + "/./a.mcap"}) {
+    EXPECT_THROW(recover(path, out), viscera::common::InputError) << out;
+    EXPECT_EQ(viscera::common::read_file_bytes(path), before) << out;
+  }
 }
 
 }  // namespace

@@ -45,6 +45,29 @@ TEST(JsonInput, AKeyGivenTwiceIsAnErrorNotTheLastOneSilently) {
   EXPECT_EQ(error_of([] { parse_json(R"([{"a": 1}, {"a": 2}])", "s.json"); }), "no error");
 }
 
+TEST(JsonInput, NestingIsBoundedSoNoInputCanExhaustTheStack) {
+  const auto nested = [](std::size_t depth, char open, char close) { return std::string(depth, open) + std::string(depth, close); };
+  // 100,000 levels (a printed message or a dump of it recursed once per level, and crashed).
+  for (const auto& [open, close] : {std::pair{'[', ']'}, std::pair{'{', '}'}}) {
+    std::string deep = nested(100000, open, close);
+    if (open == '{') {  // objects need keys: {"a":{"a":...}}
+      deep.clear();
+      for (int k = 0; k < 100000; ++k) deep += "{\"a\":";
+      deep += "1" + std::string(100000, '}');
+    }
+    EXPECT_EQ(error_of([&] { parse_json(deep, "deep.json"); }), "deep.json: JSON: objects and arrays nested deeper than 64 levels");
+    std::string why;
+    EXPECT_FALSE(try_parse_json(deep, &why));
+    EXPECT_NE(why.find("nested deeper than 64"), std::string::npos) << why;
+  }
+  // The bound itself: 64 levels read, 65 do not.
+  EXPECT_TRUE(parse_json(nested(kMaxJsonDepth, '[', ']'), "f.json").is_array());
+  EXPECT_NE(error_of([&] { parse_json(nested(kMaxJsonDepth + 1, '[', ']'), "f.json"); }).find("nested deeper"), std::string::npos);
+  // A deep value where an object is expected is named, not printed whole.
+  const nlohmann::json j = parse_json(nested(60, '[', ']'), "f.json");
+  EXPECT_NE(error_of([&] { JsonObject(j, "f.json"); }).find("is not an object"), std::string::npos);
+}
+
 TEST(JsonInput, AByteOrderMarkIsSkipped) { EXPECT_EQ(parse_json("\xEF\xBB\xBF{\"a\": 2}", "bom.json")["a"].get<int>(), 2); }
 
 TEST(JsonInput, FieldsAreCheckedForTypeRangeAndWholeness) {

@@ -235,8 +235,15 @@ TEST(ExerciseFile, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(message(head + R"("kind": "force_drill", "limits": {"peak_force_n": 1.0}, "force_drill": {"force_n": 1.0, "tolerance_n": 0.1}})")
                 .find("force_drill.force_n"),
             std::string::npos);
-  EXPECT_NE(message(R"({"name": "x", "kind": "palpation", "scene": "../etc"})").find("no error"),
-            std::string::npos);  // a name; the server refuses paths
+  // Names become paths (the report's files, the server's scene): plain names only, named at once.
+  EXPECT_NE(message(R"({"name": "x", "kind": "palpation", "scene": "../../etc/passwd"})").find("ex.json: scene: '../../etc/passwd' is not a scene"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"name": "../../escaped", "kind": "palpation", "scene": "liver"})").find("ex.json: name: '../../escaped' is not a plain name"),
+            std::string::npos);
+  EXPECT_NE(message("{\"name\": \"a\\u0000b\", \"kind\": \"palpation\", \"scene\": \"liver\"}").find("ex.json: name: 'a\\x00b'"), std::string::npos);
+  EXPECT_NE(message("{\"name\": \"\\u001b[2J\", \"kind\": \"palpation\", \"scene\": \"liver\"}").find("ex.json: name: '\\x1B[2J'"),
+            std::string::npos);
+  EXPECT_NE(message(std::string(100000, '[') + std::string(100000, ']')).find("nested deeper than 64 levels"), std::string::npos);
   for (const char* f : {"palpation.json", "retraction.json", "force-drill.json"})
     EXPECT_NO_THROW(read_exercise_file(std::string(VISCERA_DATA_DIR) + "/exercises/" + f)) << f;
 }

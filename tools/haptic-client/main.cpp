@@ -22,6 +22,8 @@
 #include "viscera/client/local_force_model.hpp"
 #include "viscera/client/tick_phase.hpp"
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/same_file.hpp"
 
 #include "palpating_device.hpp"
 #include "scripted_device.hpp"
@@ -116,9 +118,9 @@ struct Options {
 
 Options parse(viscera::common::CommandLine& cl) {
   Options o;
-  o.domain = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
-  o.client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
-  o.instrument = static_cast<std::uint32_t>(cl.number_in("instrument", 1, 1e6));
+  o.domain = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
+  o.client_id = static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000));
+  o.instrument = static_cast<std::uint32_t>(cl.integer_in("instrument", 1, 1000000));
   o.rate_hz = cl.number_in("rate", 1, 20000);
   o.depth_m = cl.number_in("depth", 0, 0.2);
   o.max_force_n = cl.number_in("max-force", 0.1, 1000);
@@ -147,6 +149,7 @@ Options parse(viscera::common::CommandLine& cl) {
   o.reconnect = cl.has("reconnect");
   o.tick_phase_us = cl.number_in("tick-phase", -1, 1e6);
   if (cl.has("report")) o.report = cl.text("report");
+  if (!o.report.empty() && !o.trajectory_file.empty()) viscera::common::refuse_overwrite(o.report, {o.trajectory_file}, "--report");
   return o;
 }
 
@@ -419,6 +422,9 @@ int main(int argc, char** argv) {
     }
     return 0;
   } catch (const viscera::common::UsageError& e) {
+    std::fprintf(stderr, "haptic-client: %s\n", e.what());
+    return 2;
+  } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "haptic-client: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -1,18 +1,46 @@
 #include "viscera/mcap/mcap_reader.hpp"
 
-#include <filesystem>
+#include <algorithm>
 #include <map>
 
 #include <sys/stat.h>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/same_file.hpp"
 #include "viscera/mcap/byte_codec.hpp"
 #include "viscera/mcap/compression.hpp"
 #include "viscera/mcap/mcap_writer.hpp"
 
 namespace viscera::mcap {
 
+/// Known schemas and channels while reading: a message needs its channel, a channel its schema.
+struct detail::Registry {
+  std::map<std::uint16_t, Schema> schemas;
+  std::map<std::uint16_t, Channel> channels;
+  void schema(const Schema& s, const DataVisitor& v) {
+    if (s.id == 0) throw FormatError("schema with id 0 (reserved for \"no schema\")");
+    const auto [it, fresh] = schemas.emplace(s.id, s);
+    if (!fresh && (it->second.name != s.name || it->second.data != s.data))
+      throw FormatError("schema " + std::to_string(s.id) + " given twice, differently");
+    if (fresh && v.schema) v.schema(s);
+  }
+  void channel(const Channel& c, const DataVisitor& v) {
+    if (c.schema_id != 0 && !schemas.count(c.schema_id))
+      throw FormatError("channel " + std::to_string(c.id) + " (" + c.topic + ") names schema " + std::to_string(c.schema_id) +
+                        ", which has not appeared");
+    const auto [it, fresh] = channels.emplace(c.id, c);
+    if (!fresh && (it->second.topic != c.topic || it->second.schema_id != c.schema_id))
+      throw FormatError("channel " + std::to_string(c.id) + " given twice, differently");
+    if (fresh && v.channel) v.channel(c);
+  }
+  void message(const Message& m) const {
+    if (!channels.count(m.channel_id)) throw FormatError("message on channel " + std::to_string(m.channel_id) + ", which has not appeared");
+  }
+};
+
 namespace {
+
+using detail::Registry;
 
 Schema parse_schema(ByteReader& r) {
   Schema s;
@@ -43,31 +71,6 @@ Message parse_message(ByteReader& r) {
   m.data.assign(rest.begin(), rest.end());
   return m;
 }
-
-/// Known schemas and channels while reading: a message needs its channel, a channel its schema.
-struct Registry {
-  std::map<std::uint16_t, Schema> schemas;
-  std::map<std::uint16_t, Channel> channels;
-  void schema(const Schema& s, const DataVisitor& v) {
-    if (s.id == 0) throw FormatError("schema with id 0 (reserved for \"no schema\")");
-    const auto [it, fresh] = schemas.emplace(s.id, s);
-    if (!fresh && (it->second.name != s.name || it->second.data != s.data))
-      throw FormatError("schema " + std::to_string(s.id) + " given twice, differently");
-    if (fresh && v.schema) v.schema(s);
-  }
-  void channel(const Channel& c, const DataVisitor& v) {
-    if (c.schema_id != 0 && !schemas.count(c.schema_id))
-      throw FormatError("channel " + std::to_string(c.id) + " (" + c.topic + ") names schema " + std::to_string(c.schema_id) +
-                        ", which has not appeared");
-    const auto [it, fresh] = channels.emplace(c.id, c);
-    if (!fresh && (it->second.topic != c.topic || it->second.schema_id != c.schema_id))
-      throw FormatError("channel " + std::to_string(c.id) + " given twice, differently");
-    if (fresh && v.channel) v.channel(c);
-  }
-  void message(const Message& m) const {
-    if (!channels.count(m.channel_id)) throw FormatError("message on channel " + std::to_string(m.channel_id) + ", which has not appeared");
-  }
-};
 
 /// A Chunk record's messages, its records checked against its CRC; its schemas and channels go
 /// into `known`.
@@ -162,61 +165,70 @@ std::vector<std::uint8_t> McapReader::read_at(std::uint64_t offset, std::uint64_
   return b;
 }
 
+std::uint64_t McapReader::read_record(std::uint64_t at, Registry& known, const DataVisitor& visit, DataEnd& end) {
+  if (size_ - at < 9) throw FormatError("the file ends inside a record's opcode and length (cut short?)");
+  const auto head = read_at(at, 9);
+  ByteReader h(head);
+  const auto opcode = static_cast<Opcode>(h.u8());
+  const std::uint64_t n = h.u64();
+  if (n > size_ - at - 9) throw FormatError("a record of " + std::to_string(n) + " bytes runs past the end of the file (cut short?)");
+  const auto content = read_at(at + 9, n);
+  ByteReader r(content);
+  switch (opcode) {
+    case Opcode::data_end: end.complete = true; break;
+    case Opcode::schema: known.schema(parse_schema(r), visit); break;
+    case Opcode::channel: known.channel(parse_channel(r), visit); break;
+    case Opcode::message: {
+      const Message m = parse_message(r);
+      known.message(m);
+      if (visit.message) visit.message(m);
+      ++end.messages;
+      break;
+    }
+    case Opcode::chunk: {
+      // The whole chunk first: a chunk whose records do not all parse gives nothing.
+      Registry inner = known;
+      const std::vector<Message> messages = chunk_messages(r, inner);
+      for (const auto& [id, sch] : inner.schemas)
+        if (!known.schemas.count(id)) known.schema(sch, visit);
+      for (const auto& [id, ch] : inner.channels)
+        if (!known.channels.count(id)) known.channel(ch, visit);
+      for (const Message& m : messages)
+        if (visit.message) visit.message(m);
+      end.messages += messages.size();
+      ++end.chunks;
+      break;
+    }
+    case Opcode::attachment: {
+      const Attachment a = parse_attachment(r, content);
+      if (visit.attachment) visit.attachment(a);
+      ++end.attachments;
+      break;
+    }
+    case Opcode::metadata: {
+      const Metadata m = parse_metadata(r);
+      if (visit.metadata) visit.metadata(m);
+      break;
+    }
+    case Opcode::header:
+    case Opcode::footer: throw FormatError("a Header or Footer inside the data section");
+    default:
+      // Opcode 0 is reserved by the specification: no writer makes it (zeros are space a crash
+      // left unwritten). Message indexes and records this reader does not use are skipped.
+      if (static_cast<std::uint8_t>(opcode) == 0) throw FormatError("opcode 0 is not a record (zero bytes: never written?)");
+      break;
+  }
+  return 9 + n;
+}
+
 DataEnd McapReader::read_data(const DataVisitor& visit) {
   DataEnd end;
   Registry known;
   std::uint64_t at = data_start_;
-  while (true) {
+  while (!end.complete) {
     end.offset = at;
     try {
-      if (size_ - at < 9) throw FormatError("the file ends inside a record's opcode and length (cut short?)");
-      const auto head = read_at(at, 9);
-      ByteReader h(head);
-      const auto opcode = static_cast<Opcode>(h.u8());
-      const std::uint64_t n = h.u64();
-      if (n > size_ - at - 9) throw FormatError("a record of " + std::to_string(n) + " bytes runs past the end of the file (cut short?)");
-      const auto content = read_at(at + 9, n);
-      ByteReader r(content);
-      switch (opcode) {
-        case Opcode::data_end: end.complete = true; return end;
-        case Opcode::schema: known.schema(parse_schema(r), visit); break;
-        case Opcode::channel: known.channel(parse_channel(r), visit); break;
-        case Opcode::message: {
-          const Message m = parse_message(r);
-          known.message(m);
-          if (visit.message) visit.message(m);
-          ++end.messages;
-          break;
-        }
-        case Opcode::chunk: {
-          // The whole chunk first: a chunk whose records do not all parse gives nothing.
-          Registry inner = known;
-          const std::vector<Message> messages = chunk_messages(r, inner);
-          for (const auto& [id, sch] : inner.schemas)
-            if (!known.schemas.count(id)) known.schema(sch, visit);
-          for (const auto& [id, ch] : inner.channels)
-            if (!known.channels.count(id)) known.channel(ch, visit);
-          for (const Message& m : messages)
-            if (visit.message) visit.message(m);
-          end.messages += messages.size();
-          ++end.chunks;
-          break;
-        }
-        case Opcode::attachment: {
-          const Attachment a = parse_attachment(r, content);
-          if (visit.attachment) visit.attachment(a);
-          break;
-        }
-        case Opcode::metadata: {
-          const Metadata m = parse_metadata(r);
-          if (visit.metadata) visit.metadata(m);
-          break;
-        }
-        case Opcode::header:
-        case Opcode::footer: throw FormatError("a Header or Footer inside the data section");
-        default: break;  // message indexes and records this reader does not use
-      }
-      at += 9 + n;
+      at += read_record(at, known, visit, end);
     } catch (const FormatError& e) {
       end.error = e.what();
       return end;
@@ -225,6 +237,109 @@ DataEnd McapReader::read_data(const DataVisitor& visit) {
       return end;
     }
   }
+  return end;
+}
+
+DataEnd McapReader::salvage_data(const DataVisitor& visit) {
+  DataEnd end;
+  Registry known;
+  // The summary, where it reads, names every schema and channel: messages of a chunk that follows a
+  // damaged one keep their channel.
+  try {
+    if (const auto s = summary()) {
+      for (const auto& sch : s->schemas) known.schema(sch, visit);
+      for (const auto& c : s->channels) known.channel(c, visit);
+    }
+  } catch (const common::InputError&) {  // a damaged summary: the data section alone
+  } catch (const FormatError&) {
+  }
+  std::uint64_t at = data_start_;
+  while (!end.complete) {
+    end.offset = at;
+    if (at == size_) {
+      end.error = "the file ends after the record before byte " + std::to_string(at) + ", without Data End (cut short)";
+      return end;
+    }
+    if (read_at(at, 1)[0] == 0 && zeros_to_end(at)) {
+      end.error = "zero bytes from byte " + std::to_string(at) + " to the end (space a crash left unwritten)";
+      end.damaged.push_back({at, size_ - at, std::to_string(size_ - at) + " zero bytes: nothing was written there"});
+      return end;
+    }
+    try {
+      at += read_record(at, known, visit, end);
+    } catch (const std::exception& e) {  // FormatError or common::InputError: the record does not parse
+      std::uint64_t next = size_;
+      if (size_ - at >= 9) {
+        const auto head = read_at(at, 9);
+        ByteReader h(head);
+        const std::uint8_t opcode = h.u8();
+        const std::uint64_t n = h.u64();
+        const bool framed = opcode >= 1 && opcode <= 0x0F && n <= size_ - at - 9;
+        // A record whose length holds is skipped whole, unless what follows it does not start a
+        // record (the length itself was damaged): then the walk resumes at the next record whose
+        // CRC holds.
+        next = framed && (at + 9 + n == size_ || checked_record_at(at + 9 + n) || read_at(at + 9 + n, 1)[0] <= 0x0F) ? at + 9 + n
+                                                                                                                     : next_checked_record(at + 1);
+      }
+      end.error = e.what();
+      end.damaged.push_back({at, next - at, e.what()});
+      at = next;
+      if (at == size_) return end;
+    }
+  }
+  return end;
+}
+
+bool McapReader::checked_record_at(std::uint64_t at) {
+  if (size_ - at < 9) return false;
+  const auto head = read_at(at, 9);
+  ByteReader h(head);
+  const auto opcode = static_cast<Opcode>(h.u8());
+  const std::uint64_t n = h.u64();
+  if ((opcode != Opcode::chunk && opcode != Opcode::attachment && opcode != Opcode::data_end) || n > size_ - at - 9) return false;
+  try {
+    const auto content = read_at(at + 9, n);
+    ByteReader r(content);
+    if (opcode == Opcode::data_end) return n == 4;
+    if (opcode == Opcode::attachment) {
+      parse_attachment(r, content);
+      return content.size() >= 4 &&
+             (content[content.size() - 4] | content[content.size() - 3] | content[content.size() - 2] | content[content.size() - 1]) != 0;
+    }
+    // A chunk: its CRC must be given (not 0) and hold (its channels may be in earlier chunks).
+    r.u64();
+    r.u64();
+    const std::uint64_t size = r.u64();
+    const std::uint32_t crc = r.u32();
+    const std::string compression = r.string();
+    const auto records = decompress(compression, r.raw(r.u64()), size);
+    return crc != 0 && crc32(records.data(), records.size()) == crc;
+  } catch (const FormatError&) {
+    return false;
+  } catch (const common::InputError&) {
+    return false;
+  }
+}
+
+std::uint64_t McapReader::next_checked_record(std::uint64_t from) {
+  constexpr std::uint64_t kWindow = 1 << 20;
+  for (std::uint64_t base = from; base < size_; base += kWindow) {
+    const auto window = read_at(base, std::min(kWindow, size_ - base));
+    for (std::size_t k = 0; k < window.size(); ++k) {
+      const auto op = static_cast<Opcode>(window[k]);
+      if ((op == Opcode::chunk || op == Opcode::attachment || op == Opcode::data_end) && checked_record_at(base + k)) return base + k;
+    }
+  }
+  return size_;
+}
+
+bool McapReader::zeros_to_end(std::uint64_t from) {
+  constexpr std::uint64_t kWindow = 1 << 20;
+  for (std::uint64_t base = from; base < size_; base += kWindow) {
+    const auto window = read_at(base, std::min(kWindow, size_ - base));
+    if (std::any_of(window.begin(), window.end(), [](std::uint8_t b) { return b != 0; })) return false;
+  }
+  return true;
 }
 
 std::optional<Summary> McapReader::summary() {
@@ -362,8 +477,8 @@ Attachment McapReader::read_attachment(const RecordIndex& index) {
 }
 
 DataEnd recover(const std::string& in, const std::string& out, const std::string& compression) {
-  if (std::filesystem::weakly_canonical(in) == std::filesystem::weakly_canonical(out))
-    throw common::InputError(out, 0, "", "is the file to recover: write the recovered copy to another file");
+  if (common::same_file(in, out))
+    throw common::InputError(out, 0, "", "is the file to recover (the same file by device and inode): write the recovered copy to another file");
   McapReader reader(in);
   WriterOptions options;
   options.profile = reader.profile();
@@ -380,7 +495,7 @@ DataEnd recover(const std::string& in, const std::string& out, const std::string
   v.message = [&](const Message& m) { writer.add_message(channel_id.at(m.channel_id), m.sequence, m.log_time, m.publish_time, m.data); };
   v.attachment = [&](const Attachment& a) { writer.add_attachment(a); };
   v.metadata = [&](const Metadata& m) { writer.add_metadata(m); };
-  DataEnd end = reader.read_data(v);
+  DataEnd end = reader.salvage_data(v);
   writer.close();
   return end;
 }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 #include "viscera/protocol/request_json.hpp"
 
 namespace viscera::recording {
@@ -146,7 +147,7 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
   // Requests that took effect before the recorder joined, from the scene's own account.
   if (!plan.scene.settings_json.empty()) {
     try {
-      const auto settings = nlohmann::json::parse(plan.scene.settings_json);
+      const auto settings = common::parse_json(plan.scene.settings_json, "the scene's settings");
       for (const auto& change : settings.value("changes", nlohmann::json::array())) {
         const std::uint64_t tick = change.value("tick", std::uint64_t{0});
         if (tick < plan.first_tick) continue;
@@ -155,8 +156,8 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
         else
           plan.notes.push_back("a change of the scene before the recording began does not read (" + why + "): left out");
       }
-    } catch (const nlohmann::json::exception& e) {
-      plan.notes.push_back(std::string("the scene's settings do not read as JSON: ") + e.what());
+    } catch (const std::exception& e) {  // an InputError of the parse, or a field of the wrong type
+      plan.notes.push_back(std::string("the scene's settings do not read: ") + e.what());
     }
   }
 

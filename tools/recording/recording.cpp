@@ -89,6 +89,8 @@ std::vector<std::uint8_t> Recording::attachment(const std::string& name) {
   throw InputError(path(), 0, "attachment " + name, "not in the recording");
 }
 
+mcap::Integrity Recording::integrity() { return mcap::check_integrity(reader_); }
+
 std::uint64_t Recording::start_ns() const { return summary_.statistics ? summary_.statistics->message_start_time : 0; }
 std::uint64_t Recording::end_ns() const { return summary_.statistics ? summary_.statistics->message_end_time : 0; }
 

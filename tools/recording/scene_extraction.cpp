@@ -26,12 +26,18 @@ std::vector<std::uint8_t> content(Recording& r, const RecordedFile& f) {
   return bytes;
 }
 
+/// A scene file's JSON, with what this file reads of it checked for its type: an object with an
+/// organ object that names its mesh and material (the scene reader checks the rest).
+json parse_scene(std::string_view text, const std::string& source) {
+  json j = common::parse_json(text, source);
+  const common::JsonObject organ = common::JsonObject(j, source).object("organ");
+  organ.text("mesh");
+  organ.text("material");
+  return j;
+}
+
 json parse(const std::vector<std::uint8_t>& bytes, const std::string& source) {
-  try {
-    return json::parse(bytes.begin(), bytes.end());
-  } catch (const json::exception& e) {
-    throw InputError(source, 0, "", std::string("does not read as JSON: ") + e.what());
-  }
+  return parse_scene(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), source);
 }
 
 /// What makes the organ the same organ (its geometry and its instruments), as "field: value",
@@ -92,7 +98,7 @@ ExtractedScenes extract_scenes(Recording& recording, const std::string& dir, con
   // The replacement: the same organ, other physics.
   const RecordedScene& first = *order.front();
   const json recorded = parse(content(recording, *first.file("scene")), recording.path());
-  const json here = common::read_json_file(*replacement);
+  const json here = parse_scene(common::read_text_file(*replacement, std::size_t{16} << 20), *replacement);
   const json replacement_organ = here.value("organ", json::object());
   const std::string mesh_path = (fs::path(*replacement).parent_path() / replacement_organ.value("mesh", std::string())).string();
   const std::string recorded_name = recorded.value("name", fs::path(first.file("scene")->path).stem().string());

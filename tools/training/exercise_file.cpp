@@ -1,5 +1,6 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/plain_name.hpp"
 #include "viscera/training/exercise.hpp"
 
 namespace viscera::training {
@@ -23,13 +24,17 @@ Exercise read(const nlohmann::json& j, const std::string& source) {
   Exercise e;
   e.source = source;
   e.name = top.text("name");
-  if (e.name.empty() || e.name.size() > 64) top.fail("name", "must have 1 to 64 characters");
+  // The name names the report's files: a plain name, never a path.
+  if (!common::is_plain_name(e.name))
+    top.fail("name", "'" + common::printable(e.name, 80) + "' is not a plain name (" + common::kPlainNameRule + ")");
   e.description = top.text("description", "");
   const std::string kind = top.choice("kind", {"palpation", "retraction", "force_drill"}, "");
   if (kind.empty()) top.fail("kind", "missing: one of palpation, retraction, force_drill");
   e.kind = kind == "palpation" ? ExerciseKind::palpation : kind == "retraction" ? ExerciseKind::retraction : ExerciseKind::force_drill;
   e.scene = top.text("scene");
-  if (e.scene.empty() || e.scene.size() > 64) top.fail("scene", "must name a scene of the server's scene directory (1-64 characters)");
+  if (!common::is_plain_name(e.scene))
+    top.fail("scene",
+             "'" + common::printable(e.scene, 80) + "' is not a scene of the server's scene directory by name (" + common::kPlainNameRule + ")");
   e.instrument = static_cast<std::uint32_t>(top.integer("instrument", 1, 1'000'000, 1));
   e.time_limit_s = top.number("time_limit_s", 1, 3600, 120);
   if (top.has("limits")) {

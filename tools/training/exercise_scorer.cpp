@@ -101,9 +101,9 @@ void ExerciseScorer::advance(std::uint64_t tick) {
     }
 }
 
-void ExerciseScorer::finish() {
+void ExerciseScorer::finish(const std::string& why) {
   advance(~std::uint64_t{0});
-  if (started() && !ended_) end(last_tick_, false, "the instrument stopped before the time limit");
+  if (started() && !ended_) end(last_tick_, false, why);
 }
 
 std::vector<std::string> ExerciseScorer::take_feedback() { return std::exchange(feedback_, {}); }

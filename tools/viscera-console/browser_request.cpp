@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/client/session_limits.hpp"
+#include "viscera/common/json_input.hpp"
 #include "viscera/console/recordings.hpp"
 
 namespace viscera::console {
@@ -59,8 +60,9 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
   };
   if (message.size() > kMaxRequestBytes)
     return fail("request of " + std::to_string(message.size()) + " bytes (at most " + std::to_string(kMaxRequestBytes) + ")");
-  const nlohmann::json j = nlohmann::json::parse(message, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) return fail("not JSON");
+  const auto parsed = common::try_parse_json(message);  // nesting bounded (common::kMaxJsonDepth)
+  if (!parsed) return fail("not JSON");
+  const nlohmann::json& j = *parsed;
   if (!j.is_object()) return fail("not a JSON object");
   const auto t = j.find("type");
   if (t == j.end() || !t->is_string()) return fail("type: missing, or not a string");

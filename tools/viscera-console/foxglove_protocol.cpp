@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "viscera/common/json_input.hpp"
 #include "viscera/protocol/binary_schemas.hpp"
 #include "viscera/protocol/messages.hpp"
 
@@ -69,8 +70,8 @@ std::string foxglove_message_data(std::uint32_t subscription, std::uint64_t rece
 nlohmann::json foxglove_status(int level, const std::string& message) { return {{"op", "status"}, {"level", level}, {"message", message}}; }
 
 std::optional<std::string> FoxgloveSubscriptions::apply(std::string_view message) {
-  const nlohmann::json j = nlohmann::json::parse(message, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("op") || !j["op"].is_string()) return "not a JSON object with an \"op\"";
+  const nlohmann::json j = common::try_parse_json(message).value_or(nlohmann::json());
+  if (!j.is_object() || !j.contains("op") || !j["op"].is_string()) return "not a JSON object with an \"op\"";
   const std::string op = j["op"].get<std::string>();
   const auto is_id = [](const nlohmann::json& v) { return v.is_number_unsigned() && v.get<std::uint64_t>() <= 0xffffffffULL; };
   if (op == "subscribe") {

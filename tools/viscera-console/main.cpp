@@ -100,8 +100,8 @@ int main(int argc, char** argv) {
     options.outbox_bytes = static_cast<std::size_t>(1024 * cl.number_in("outbox-kib", 64, 1 << 20));
     options.requests_per_s = cl.number_in("requests-per-s", 1, 1000);
     options.request_burst = 2 * options.requests_per_s;
-    const auto domain = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
-    const auto client_id = static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9));
+    const auto domain = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
+    const auto client_id = static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000));
     options.page_settings = {{"force_limit_n", cl.number_in("force-limit-n", 0.01, 1000)}, {"client_id", client_id}};
     const double force_period_s = 1.0 / cl.number_in("force-rate-hz", 1, 1000);
     const double stats_every_s = cl.number_in("stats-every-s", 0, 3600);

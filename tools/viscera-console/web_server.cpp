@@ -8,6 +8,7 @@
 #include <boost/asio/post.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include "viscera/common/json_input.hpp"
 #include "viscera/console/access_token.hpp"
 #include "viscera/console/browser_request.hpp"
 #include "viscera/console/foxglove_protocol.hpp"
@@ -214,7 +215,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
     if (!r) {
       ++server_->counters.malformed;
       // The reply names the request if its id can be read at all.
-      const auto j = nlohmann::json::parse(message, nullptr, false);
+      const auto j = common::try_parse_json(message).value_or(nlohmann::json());
       const bool has_id = j.is_object() && j.contains("id") && j["id"].is_number_unsigned();
       error(has_id ? j["id"].get<std::uint64_t>() : 0, why);
       return;

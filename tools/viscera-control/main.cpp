@@ -15,8 +15,13 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/session_limits.hpp"
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
 
 namespace {
+
+/// Text from the server (names from scene files and meshes, messages, annotations), printed with
+/// every byte a terminal could act on escaped.
+std::string shown(const std::string& text) { return viscera::common::printable(text, 400); }
 
 /// Exit status when the server went away while watched.
 constexpr int kServerGone = 4;
@@ -32,7 +37,7 @@ bool server_gone(viscera::client::Client& client) {
 /// missed slots over the watched span (by the server's stamps). Returns 1 if no report came.
 int watch_health(viscera::client::Client& client, const viscera::protocol::Scene& scene, double duration_s) {
   client.poll_telemetry();  // subscribe
-  std::printf("watching the health of scene %s (physics %.0f Hz) for %.1f s\n", scene.name.c_str(), scene.physics_rate_hz, duration_s);
+  std::printf("watching the health of scene %s (physics %.0f Hz) for %.1f s\n", shown(scene.name).c_str(), scene.physics_rate_hz, duration_s);
   std::fflush(stdout);
   std::optional<viscera::protocol::TelemetryReport> first, last;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
@@ -105,7 +110,7 @@ Request parse(const viscera::common::CommandLine& cl) {
                          : "material flags are for the material action");
   if (r.action == "load") {
     if (!viscera::client::is_scene_name(r.argument)) throw UsageError(viscera::client::not_a_scene_name(r.argument));
-    if (cl.has("seed")) r.seed = static_cast<std::uint64_t>(cl.number_in("seed", 0, 9007199254740991.0));
+    if (cl.has("seed")) r.seed = cl.integer_in("seed", 0, 9007199254740991);
   } else if (cl.has("seed")) {
     throw UsageError("--seed is for the load action");
   }
@@ -128,14 +133,15 @@ Request parse(const viscera::common::CommandLine& cl) {
 /// Prints the session's events and annotations for `duration_s`.
 int follow_events(viscera::client::Client& client, const viscera::protocol::Scene& scene, double duration_s) {
   client.poll_events();  // subscribe
-  std::printf("following the events of scene %s for %.1f s\n", scene.name.c_str(), duration_s);
+  std::printf("following the events of scene %s for %.1f s\n", shown(scene.name).c_str(), duration_s);
   std::fflush(stdout);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
   while (std::chrono::steady_clock::now() < end) {
     if (server_gone(client)) return kServerGone;
     for (const auto& e : client.poll_events()) {
       std::printf("event %s tick %llu sim %.3f s instrument %u client %u%s%s\n", viscera::protocol::event_name(e.kind),
-                  static_cast<unsigned long long>(e.tick), e.sim_time_s, e.instrument_id, e.client_id, e.text.empty() ? "" : ": ", e.text.c_str());
+                  static_cast<unsigned long long>(e.tick), e.sim_time_s, e.instrument_id, e.client_id, e.text.empty() ? "" : ": ",
+                  shown(e.text).c_str());
       std::fflush(stdout);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -157,10 +163,10 @@ int control(viscera::client::Client& client, const Request& r) {
       return 1;
     }
     if (!outcome->accepted) {
-      std::fprintf(stderr, "viscera-control: refused: %s\n", outcome->message.c_str());
+      std::fprintf(stderr, "viscera-control: refused: %s\n", shown(outcome->message).c_str());
       return 1;
     }
-    std::printf("%s\n", outcome->message.c_str());
+    std::printf("%s\n", shown(outcome->message).c_str());
     return 0;
   }
   const Action a = r.action == "pause" ? Action::pause : r.action == "resume" ? Action::resume : Action::reset;
@@ -172,31 +178,31 @@ int control(viscera::client::Client& client, const Request& r) {
 }
 
 void print_scene(const viscera::protocol::Scene& scene) {
-  std::printf("scene %s: %s, physics %.0f Hz, instruments:", scene.name.c_str(), scene.paused ? "paused" : "running", scene.physics_rate_hz);
+  std::printf("scene %s: %s, physics %.0f Hz, instruments:", shown(scene.name).c_str(), scene.paused ? "paused" : "running", scene.physics_rate_hz);
   for (const auto& i : scene.instruments)
     std::printf(" %u (%s, %s)", i.instrument_id, i.grasper ? "grasper" : "probe",
                 i.owner_client_id ? ("client " + std::to_string(i.owner_client_id)).c_str() : "free");
   const auto& m = scene.material;
   std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s", scene.generation,
-              m.name.c_str(), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q, m.damping_per_s);
+              shown(m.name).c_str(), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3, m.shear_q, m.damping_per_s);
   if (m.added_mass_fraction > 0) std::printf(", mass scaling +%.2f%% (smallest elements)", 100 * m.added_mass_fraction);
   std::printf("\n");
   std::string list;
   for (const auto& n : scene.available_scenes) list += " " + n;
-  std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : list.c_str(), scene.preparing.empty() ? "" : "; preparing ",
-              scene.preparing.c_str());
-  for (const auto& u : scene.unreadable_scenes) std::printf("  unreadable scene %s\n", u.c_str());
+  std::printf("  scenes to load:%s%s%s\n", list.empty() ? " (none)" : shown(list).c_str(), scene.preparing.empty() ? "" : "; preparing ",
+              shown(scene.preparing).c_str());
+  for (const auto& u : scene.unreadable_scenes) std::printf("  unreadable scene %s\n", shown(u).c_str());
   for (const auto& g : scene.regions) {
     if (g.shape == viscera::protocol::RegionShape::elements)
-      std::printf("  region %s: tagged elements around (%.4g, %.4g, %.4g) m, within (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", g.name.c_str(),
+      std::printf("  region %s: tagged elements around (%.4g, %.4g, %.4g) m, within (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", shown(g.name).c_str(),
                   g.center[0], g.center[1], g.center[2], g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0], g.box_max[1], g.box_max[2]);
     else if (g.shape == viscera::protocol::RegionShape::box)
-      std::printf("  region %s: box (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", g.name.c_str(), g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0],
-                  g.box_max[1], g.box_max[2]);
+      std::printf("  region %s: box (%.4g, %.4g, %.4g)-(%.4g, %.4g, %.4g) m", shown(g.name).c_str(), g.box_min[0], g.box_min[1], g.box_min[2],
+                  g.box_max[0], g.box_max[1], g.box_max[2]);
     else
-      std::printf("  region %s: sphere of radius %.4g m at (%.4g, %.4g, %.4g) m, its top %.3g m deep", g.name.c_str(), g.radius_m, g.center[0],
+      std::printf("  region %s: sphere of radius %.4g m at (%.4g, %.4g, %.4g) m, its top %.3g m deep", shown(g.name).c_str(), g.radius_m, g.center[0],
                   g.center[1], g.center[2], g.depth_m);
-    std::printf(", %u elements, material %s (E %.0f Pa)\n", g.elements, g.material_name.c_str(), g.youngs_modulus_pa);
+    std::printf(", %u elements, material %s (E %.0f Pa)\n", g.elements, shown(g.material_name).c_str(), g.youngs_modulus_pa);
   }
 }
 
@@ -230,8 +236,8 @@ int main(int argc, char** argv) {
   try {
     if (!cl.parse(argc, argv)) return 0;
     const Request r = parse(cl);
-    viscera::client::Client client(static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)),
-                                   static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9)), cl.text("partition"));
+    viscera::client::Client client(static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230)),
+                                   static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000)), cl.text("partition"));
     auto scene = client.wait_for_scene(std::chrono::seconds(10));
     if (!scene) {
       std::fprintf(stderr, "viscera-control: no viscera-server (or replay) found in 10 s (same domain, partition and CYCLONEDDS_URI?)\n");
@@ -241,7 +247,7 @@ int main(int argc, char** argv) {
     if (r.action == "health") return watch_health(client, *scene, r.duration_s);
     if (r.action == "annotate") {
       client.annotate(r.argument);  // waits for the readers' acknowledgements
-      std::printf("annotated scene %s\n", scene->name.c_str());
+      std::printf("annotated scene %s\n", shown(scene->name).c_str());
       return 0;
     }
     if (r.action != "show") {

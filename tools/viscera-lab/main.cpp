@@ -8,6 +8,7 @@
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/same_file.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/decimation.hpp"
 
@@ -47,6 +48,11 @@ int main(int argc, char** argv) {
   const bool quiet = cl.has("quiet");
   try {
     const auto t0 = std::chrono::steady_clock::now();
+    // The report never goes over what the run reads: not into the data set's folder (its plots are
+    // named after the tests), and not over the model predict reads.
+    if (positional.size() >= 2) viscera::common::refuse_overwrite(out, {positional.back()}, "--out");
+    if (positional[0] == "predict" && positional.size() == 3)
+      for (const char* written : {"report.json", "model.json"}) viscera::common::refuse_overwrite(out + "/" + written, {positional[1]}, "--out");
     if (positional[0] == "analyze") {
       if (positional.size() != 2) return usage_error("analyze takes one DATASET_DIR");
       const Dataset d = read_dataset(positional[1]);

@@ -12,6 +12,7 @@
 #include "viscera/client/stream_tap.hpp"
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/protocol/messages.hpp"
 #include "viscera/recording/payload_verification.hpp"
@@ -56,7 +57,7 @@ std::string megabytes(std::uint64_t bytes) {
 
 int record(const viscera::common::CommandLine& cl) {
   rec::RecordingInfo info;
-  info.domain_id = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
+  info.domain_id = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
   info.partition = cl.text("partition");
   info.streams = parse_topics(cl.text("topics"));
   info.recorder = "viscera-record, protocol schema " + std::to_string(proto::kSchemaVersion);
@@ -68,7 +69,7 @@ int record(const viscera::common::CommandLine& cl) {
   options.chunk_ns = static_cast<std::uint64_t>(cl.number_in("chunk-s", 0.01, 3600) * 1e9);
   options.library = info.recorder;
   const double duration = cl.number_in("duration", 0, 1e7);
-  const int depth = static_cast<int>(cl.number_in("depth", 1, 1e6));
+  const int depth = static_cast<int>(cl.integer_in("depth", 1, 1000000));
   const bool quiet = cl.has("quiet");
   const std::string out = cl.text("out");
 
@@ -122,15 +123,28 @@ int record(const viscera::common::CommandLine& cl) {
 int recover(const std::vector<std::string>& args) {
   if (args.size() != 3) throw UsageError("recover takes IN.mcap OUT.mcap");
   const auto end = viscera::mcap::recover(args[1], args[2]);
-  if (end.complete)
-    std::printf("viscera-record: %s was whole; %s has its %llu messages in %llu chunks\n", args[1].c_str(), args[2].c_str(),
+  const std::string in = viscera::common::printable(args[1], 200), out = viscera::common::printable(args[2], 200);
+  if (end.complete && end.intact())
+    std::printf("viscera-record: %s was whole; %s has its %llu messages in %llu chunks\n", in.c_str(), out.c_str(),
                 static_cast<unsigned long long>(end.messages), static_cast<unsigned long long>(end.chunks));
   else
-    std::printf("viscera-record: saved %llu messages in %llu complete chunks to %s; %s ends at byte %llu: %s\n",
-                static_cast<unsigned long long>(end.messages), static_cast<unsigned long long>(end.chunks), args[2].c_str(), args[1].c_str(),
-                static_cast<unsigned long long>(end.offset), end.error.c_str());
-  return 0;
+    std::printf("viscera-record: saved %llu messages in %llu intact chunks and %llu attachments to %s; %s %s\n",
+                static_cast<unsigned long long>(end.messages), static_cast<unsigned long long>(end.chunks),
+                static_cast<unsigned long long>(end.attachments), out.c_str(), in.c_str(),
+                end.complete ? "reached its Data End" : ("ends at byte " + std::to_string(end.offset) + ": " + end.error).c_str());
+  std::uint64_t lost = 0;
+  for (const auto& d : end.damaged) {
+    lost += d.length;
+    std::printf("viscera-record: lost bytes %llu to %llu (%llu bytes): %s\n", static_cast<unsigned long long>(d.offset),
+                static_cast<unsigned long long>(d.offset + d.length), static_cast<unsigned long long>(d.length), d.what.c_str());
+  }
+  if (lost == 0) return 0;
+  std::printf("viscera-record: %llu bytes of %s could not be recovered (exit 1)\n", static_cast<unsigned long long>(lost), in.c_str());
+  return 1;
 }
+
+/// Text from the file, printed with every byte a terminal could act on escaped.
+std::string shown(const std::string& text) { return viscera::common::printable(text, 400); }
 
 std::string seconds(std::uint64_t ns) {
   char b[32];
@@ -142,31 +156,31 @@ int info(const std::vector<std::string>& args, bool verify) {
   if (args.size() != 2) throw UsageError("info takes FILE.mcap");
   rec::Recording r(args[1]);
   const auto& s = r.summary();
-  std::printf("%s: viscera recording, protocol schema %s, DDS domain %s%s%s, by %s\n", r.path().c_str(), r.info().at("schema_version").c_str(),
-              r.info().count("domain_id") ? r.info().at("domain_id").c_str() : "?",
+  std::printf("%s: viscera recording, protocol schema %s, DDS domain %s%s%s, by %s\n", shown(r.path()).c_str(),
+              shown(r.info().at("schema_version")).c_str(), r.info().count("domain_id") ? shown(r.info().at("domain_id")).c_str() : "?",
               r.info().count("partition") && !r.info().at("partition").empty() ? ", partition " : "",
-              r.info().count("partition") ? r.info().at("partition").c_str() : "",
-              r.info().count("recorder") ? r.info().at("recorder").c_str() : "?");
+              r.info().count("partition") ? shown(r.info().at("partition")).c_str() : "",
+              r.info().count("recorder") ? shown(r.info().at("recorder")).c_str() : "?");
   const std::uint64_t span = r.end_ns() - r.start_ns();
   std::printf("  %llu messages over %s, %zu chunks, %zu channels, %zu schemas, %zu attachments\n",
               static_cast<unsigned long long>(s.statistics ? s.statistics->message_count : 0), seconds(span).c_str(), s.chunks.size(),
               s.channels.size(), s.schemas.size(), s.attachments.size());
-  for (const auto& sch : s.schemas) std::printf("  schema %u: %s (%s, %zu bytes)\n", sch.id, sch.name.c_str(), sch.encoding.c_str(), sch.data.size());
+  for (const auto& sch : s.schemas)
+    std::printf("  schema %u: %s (%s, %zu bytes)\n", sch.id, shown(sch.name).c_str(), shown(sch.encoding).c_str(), sch.data.size());
   for (const auto& c : s.channels) {
     const std::uint64_t n = s.statistics && s.statistics->channel_message_counts.count(c.id) ? s.statistics->channel_message_counts.at(c.id) : 0;
-    std::printf("  channel %u: %s, source %s, writer %s, schema %u: %llu messages\n", c.id, c.topic.c_str(),
-                c.metadata.count("source_id") ? c.metadata.at("source_id").c_str() : "?",
-                c.metadata.count("writer") ? c.metadata.at("writer").c_str() : "?", c.schema_id, static_cast<unsigned long long>(n));
+    std::printf("  channel %u: %s, source %s, writer %s, schema %u: %llu messages\n", c.id, shown(c.topic).c_str(),
+                c.metadata.count("source_id") ? shown(c.metadata.at("source_id")).c_str() : "?",
+                c.metadata.count("writer") ? shown(c.metadata.at("writer")).c_str() : "?", c.schema_id, static_cast<unsigned long long>(n));
   }
   for (std::size_t k = 0; k < r.scenes().size(); ++k) {
     const auto& scene = r.scenes()[k];
     // The server publishes a scene's files again when its settings change at run time (a
     // material, a physics rate): say so, rather than list it as another scene.
     std::size_t changes = 0;
-    try {
-      changes = nlohmann::json::parse(scene.settings_json).value("changes", nlohmann::json::array()).size();
-    } catch (const nlohmann::json::exception&) {
-      // no readable settings: no changes to count
+    if (const auto settings = viscera::common::try_parse_json(scene.settings_json); settings && settings->is_object()) {
+      const auto c = settings->find("changes");
+      if (c != settings->end() && c->is_array()) changes = c->size();
     }
     if (k > 0 && r.scenes()[k - 1].generation == scene.generation) {
       std::printf("  scene (generation %u): its settings changed at run time (%zu change%s so far)\n", scene.generation, changes,
@@ -174,33 +188,41 @@ int info(const std::vector<std::string>& args, bool verify) {
       continue;
     }
     std::printf("  scene (generation %u) from tick %llu, %s\n", scene.generation, static_cast<unsigned long long>(scene.first_tick),
-                scene.server_version.c_str());
+                shown(scene.server_version).c_str());
     for (const auto& f : scene.files)
-      std::printf("    %s: %s (attachment %s, sha256 %s)\n", f.role.c_str(), f.path.c_str(), f.attachment.c_str(), f.sha256.c_str());
+      std::printf("    %s: %s (attachment %s, sha256 %s)\n", shown(f.role).c_str(), shown(f.path).c_str(), shown(f.attachment).c_str(),
+                  shown(f.sha256).c_str());
   }
   if (r.drops()) {
-    std::printf("  drops: %s missing\n", r.drops()->count("missing") ? r.drops()->at("missing").c_str() : "?");
+    std::printf("  drops: %s missing\n", r.drops()->count("missing") ? shown(r.drops()->at("missing")).c_str() : "?");
     for (const auto& [k, v] : *r.drops())
-      if (k != "missing") std::printf("    %s: %s\n", k.c_str(), v.c_str());
+      if (k != "missing") std::printf("    %s: %s\n", shown(k).c_str(), shown(v).c_str());
   } else {
     std::printf("  drops: not recorded (the recording was recovered after its recorder stopped abruptly)\n");
   }
   if (!verify) return 0;
+  const viscera::mcap::Integrity integrity = r.integrity();
+  std::printf("  records: %s\n", integrity.intact() ? "every record reads and its CRC holds; the indexes point at them" : "damaged:");
+  for (const auto& p : integrity.problems) std::printf("    %s\n", viscera::common::printable(p, 300).c_str());
   std::uint64_t good = 0, bad = 0;
   std::string first_bad;
-  r.for_each([&](const rec::RecordedChannel& ch, const viscera::mcap::Message& m) {
-    std::string why;
-    if (rec::payload_decodes(ch.stream, m.data, &why)) {
-      ++good;
-    } else if (++bad == 1) {
-      first_bad = std::string(proto::stream_name(ch.stream)) + " message " + std::to_string(m.sequence) + " (log time " + std::to_string(m.log_time) +
-                  "): " + why;
-    }
-    return true;
-  });
+  try {
+    r.for_each([&](const rec::RecordedChannel& ch, const viscera::mcap::Message& m) {
+      std::string why;
+      if (rec::payload_decodes(ch.stream, m.data, &why)) {
+        ++good;
+      } else if (++bad == 1) {
+        first_bad = std::string(proto::stream_name(ch.stream)) + " message " + std::to_string(m.sequence) + " (log time " +
+                    std::to_string(m.log_time) + "): " + why;
+      }
+      return true;
+    });
+  } catch (const viscera::common::InputError& e) {  // a damaged chunk, already among the problems
+    if (integrity.intact()) throw;
+  }
   std::printf("  payloads: %llu decode with viscera's decoders, %llu do not%s%s\n", static_cast<unsigned long long>(good),
-              static_cast<unsigned long long>(bad), bad ? "; the first: " : "", first_bad.c_str());
-  return bad == 0 ? 0 : 1;
+              static_cast<unsigned long long>(bad), bad ? "; the first: " : "", viscera::common::printable(first_bad, 300).c_str());
+  return bad == 0 && integrity.intact() ? 0 : 1;
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
     if (args.size() != 2 || (args[0] != "play" && args[0] != "resimulate"))
       throw UsageError("expected: play FILE.mcap | resimulate FILE.mcap (see --help)");
     std::optional<std::uint32_t> domain;
-    if (cl.has("domain")) domain = static_cast<std::uint32_t>(cl.number_in("domain", 0, 230));
+    if (cl.has("domain")) domain = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     if (args[0] == "play") {
@@ -63,6 +63,9 @@ int main(int argc, char** argv) {
       if (cl.has("to")) o.to_s = cl.number_in("to", 0, 1e9);
       o.partition = cl.text("partition");
       if (o.partition.empty()) throw UsageError("--partition: a replay publishes in a partition of its own, not the live one");
+      if (viscera::protocol::has_partition_wildcard(o.partition))  // the SDK's StreamPublisher refuses it too
+        throw UsageError("--partition: '" + o.partition +
+                         "' holds a DDS wildcard ('*' or '?'), which would reach other partitions, live servers' too");
       o.domain = domain;
       o.keys = !cl.has("no-keys");
       o.quiet = cl.has("quiet");
@@ -81,6 +84,9 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "viscera-replay: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {  // a partition the SDK refuses to replay into
+    std::fprintf(stderr, "viscera-replay: --partition: %s\n", e.what());
     return 2;
   } catch (const viscera::protocol::DdsError& e) {
     std::fprintf(stderr, "viscera-replay: %s\n", e.what());

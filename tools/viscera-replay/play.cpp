@@ -71,7 +71,10 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
   rec::Recording recording(o.recording);
   const std::uint64_t t0 = recording.start_ns(), t_end = recording.end_ns();
   const auto at = [&](double s) { return t0 + static_cast<std::uint64_t>(std::max(0.0, s) * 1e9); };
-  const std::uint64_t from = std::min(at(o.from_s), t_end), to = o.to_s ? std::min(at(*o.to_s), t_end) : t_end;
+  if (at(o.from_s) > t_end)
+    throw common::InputError(o.recording, 0, "--from",
+                             seconds(at(o.from_s) - t0) + " is past the recording's end (it spans " + seconds(t_end - t0) + ")");
+  const std::uint64_t from = at(o.from_s), to = o.to_s ? std::min(at(*o.to_s), t_end) : t_end;
   if (from > to) throw common::InputError(o.recording, 0, "--from/--to", "the interval is empty (the recording spans " + seconds(t_end - t0) + ")");
   const std::uint32_t domain =
       o.domain ? *o.domain : static_cast<std::uint32_t>(std::stoul(recording.info().count("domain_id") ? recording.info().at("domain_id") : "0"));
@@ -84,6 +87,9 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
   for (const auto& [id, ch] : recording.channels()) streams[ch.stream] = true;
   for (const auto& [s, _] : streams) publisher.open(s);
   publisher.wait_for_readers(std::chrono::milliseconds(static_cast<long long>(o.discovery_s * 1000)));
+  const std::string live_server =
+      "partition '" + common::printable(o.partition, 80) + "' holds a live viscera-server: a replay never drives one (choose a partition of its own)";
+  if (publisher.live_server()) throw common::InputError("--partition", 0, "", live_server);
 
   // The scene state the replay shows: the recording's newest, with the playback's pause and the
   // outcomes of the requests sent to the replayer.
@@ -131,9 +137,16 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
   const auto clamp = [&](std::int64_t t) {
     return static_cast<std::uint64_t>(std::clamp<std::int64_t>(t, static_cast<std::int64_t>(from), static_cast<std::int64_t>(to)));
   };
-  // Keys and session requests: pause, resume, seek, quit.
+  // Keys and session requests: pause, resume, seek, quit; and a server that joins the partition.
+  bool server_joined = false;
+  auto server_checked = Clock::now();
   const auto handle_input = [&] {
     const auto now = Clock::now();
+    if (now - server_checked >= std::chrono::milliseconds(100)) {
+      server_checked = now;
+      server_joined = publisher.live_server();
+      quit = quit || server_joined;
+    }
     const std::string keys = terminal.keys();
     for (std::size_t i = 0; i < keys.size(); ++i) {
       const char k = keys[i];
@@ -224,6 +237,10 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
   if (!o.quiet)
     std::printf("viscera-replay: published %llu messages in %.1f s\n", static_cast<unsigned long long>(published),
                 std::chrono::duration<double>(Clock::now() - wall_start).count());
+  if (server_joined) {
+    std::fprintf(stderr, "viscera-replay: stopped: %s\n", live_server.c_str());
+    return 3;
+  }
   return 0;
 }
 

@@ -10,6 +10,7 @@
 
 #include "viscera/client/lockstep_driver.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/same_file.hpp"
 #include "viscera/process/child_process.hpp"
 #include "viscera/recording/lockstep_plan.hpp"
 #include "viscera/recording/recording.hpp"
@@ -40,6 +41,11 @@ struct TempDir {
 }  // namespace
 
 int resimulate(const ResimulateOptions& o) {
+  if (o.report) {  // before the work: never over a file this run reads
+    std::vector<std::string> inputs{o.recording};
+    if (o.scene) inputs.push_back(*o.scene);
+    common::refuse_overwrite(*o.report, inputs, "--report");
+  }
   rec::Recording recording(o.recording);
   const rec::LockstepPlan plan = rec::make_lockstep_plan(recording);
   TempDir dir;

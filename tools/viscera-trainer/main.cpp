@@ -13,7 +13,9 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/stream_tap.hpp"
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/same_file.hpp"
 #include "viscera/recording/recording.hpp"
 #include "viscera/training/exercise_scorer.hpp"
 
@@ -35,15 +37,21 @@ constexpr std::chrono::milliseconds kQuiet{300};
 
 /// The report as JSON and Markdown in `dir` (if given), the summary on stdout; exit status 0
 /// passed, 1 failed.
+/// The report's files in `dir`: EXERCISE.json and EXERCISE.md (the name is a plain name).
+std::vector<std::string> report_files(const std::string& dir, const std::string& exercise) {
+  return {dir + "/" + exercise + ".json", dir + "/" + exercise + ".md"};
+}
+
 int conclude(const ScoreReport& r, const std::string& dir) {
   const std::string md = to_markdown(r);
   std::printf("%s", md.c_str());
   if (!dir.empty()) {
     std::filesystem::create_directories(dir);
     const std::string base = dir + "/" + r.exercise;
-    std::ofstream(base + ".json") << to_json(r).dump(2) << "\n";
-    std::ofstream(base + ".md") << md;
-    std::printf("report: %s.json, %s.md\n", base.c_str(), base.c_str());
+    const std::string json = to_json(r).dump(2) + "\n";
+    viscera::common::write_file_bytes(base + ".json", std::span(reinterpret_cast<const std::uint8_t*>(json.data()), json.size()));
+    viscera::common::write_file_bytes(base + ".md", std::span(reinterpret_cast<const std::uint8_t*>(md.data()), md.size()));
+    std::printf("report: %s.json, %s.md\n", viscera::common::printable(base, 200).c_str(), viscera::common::printable(base, 200).c_str());
   }
   return r.passed ? 0 : 1;
 }
@@ -120,7 +128,10 @@ int run(const Exercise& exercise, std::uint32_t domain, std::optional<std::uint6
   }
   if (!scorer.ended()) {
     tap.take([&](const viscera::client::TapSample& s) { scorer.take(s.stream, s.payload); });
-    scorer.finish();
+    if (g_stop)
+      scorer.finish("the trainer was stopped (SIGINT or SIGTERM) before the exercise ended");
+    else
+      scorer.finish();
   }
   feedback();
   return conclude(scorer.report(), dir);
@@ -151,6 +162,10 @@ int main(int argc, char** argv) {
     if (args.empty() || !((args[0] == "run" && args.size() == 2) || (args[0] == "score" && args.size() == 3)))
       throw UsageError("expected: run EXERCISE.json | score EXERCISE.json FILE.mcap (see --help)");
     const Exercise exercise = viscera::training::read_exercise_file(args[1]);
+    // Before the work: the report never replaces a file this run reads.
+    if (!cl.text("report-dir").empty())
+      for (const auto& f : report_files(cl.text("report-dir"), exercise.name))
+        viscera::common::refuse_overwrite(f, {args.begin() + 1, args.end()}, "--report-dir");
     if (args[0] == "score") {
       if (cl.has("seed")) throw UsageError("--seed is for run: a recording holds the place the nodule had");
       return score(exercise, args[2], cl.text("report-dir"));
@@ -158,9 +173,9 @@ int main(int argc, char** argv) {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     std::optional<std::uint64_t> seed;
-    if (cl.has("seed")) seed = static_cast<std::uint64_t>(cl.number_in("seed", 0, 9007199254740991.0));
-    return run(exercise, static_cast<std::uint32_t>(cl.number_in("domain", 0, 230)), seed,
-               static_cast<std::uint32_t>(cl.number_in("client-id", 1, 4e9)), cl.text("report-dir"));
+    if (cl.has("seed")) seed = cl.integer_in("seed", 0, 9007199254740991);
+    return run(exercise, static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230)), seed,
+               static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000)), cl.text("report-dir"));
   } catch (const UsageError& e) {
     std::fprintf(stderr, "viscera-trainer: %s\n", e.what());
     return 2;

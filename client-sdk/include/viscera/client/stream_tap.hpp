@@ -45,9 +45,15 @@ class StreamTap {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Publishes recorded payloads again (a replay). It never reaches a live server: the partition must
+/// be a name of its own (not the default one, no DDS wildcard), and live_server() says when a
+/// viscera-server has appeared in it, whereupon the replayer stops.
 class StreamPublisher {
  public:
+  /// Throws std::invalid_argument for the default partition or one with a wildcard.
   StreamPublisher(std::uint32_t domain_id, const std::string& partition);
+  /// Whether a viscera-server (live or lockstep) has been discovered writing in this partition.
+  bool live_server();
   ~StreamPublisher();
   /// Makes the stream's writer now (so readers can discover it before the first sample).
   void open(protocol::Stream stream);

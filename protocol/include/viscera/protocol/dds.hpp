@@ -49,8 +49,11 @@ class Participant {
  public:
   /// `partition`: the DDS partition of every reader and writer made on it ("" : the default). A
   /// replay runs in a partition of its own, so it never drives a live server's instruments.
-  explicit Participant(std::uint32_t domain_id, std::string partition = {});
+  /// `role`: carried in the user data of every writer made on it, so that discovery tells a live
+  /// server (kServerRole) from a replayer that publishes the same streams.
+  explicit Participant(std::uint32_t domain_id, std::string partition = {}, std::string role = {});
   const std::string& partition() const { return partition_; }
+  const std::string& role() const { return role_; }
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
@@ -61,8 +64,13 @@ class Participant {
  private:
   int32_t handle_;
   int32_t topics_[kStreamCount] = {};
-  std::string partition_;
+  std::string partition_, role_;
 };
+
+/// The role of a viscera-server's writers (live or lockstep).
+inline constexpr const char* kServerRole = "viscera-server";
+/// Whether a partition name holds a DDS wildcard ('*' or '?'), which matches other partitions.
+bool has_partition_wildcard(const std::string& partition);
 
 struct Received {
   std::uint32_t source_id;
@@ -129,9 +137,10 @@ class Reader {
 
 /// The partitions in which writers of a stream have appeared on the domain (DDS discovery: the
 /// built-in publication topic), e.g. every partition that holds a viscera server (its scene state).
+/// With a `role`, only writers made by participants of that role count.
 class PartitionDiscovery {
  public:
-  PartitionDiscovery(Participant& p, Stream s);
+  PartitionDiscovery(Participant& p, Stream s, std::string role = {});
   ~PartitionDiscovery();
   PartitionDiscovery(const PartitionDiscovery&) = delete;
   PartitionDiscovery& operator=(const PartitionDiscovery&) = delete;
@@ -141,7 +150,7 @@ class PartitionDiscovery {
 
  private:
   int32_t reader_;
-  std::string topic_;
+  std::string topic_, role_;
   std::set<std::string> seen_;
 };
 

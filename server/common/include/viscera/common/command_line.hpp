@@ -1,6 +1,7 @@
 #pragma once
 // A small, strict command-line parser shared by viscera's programs: every flag is declared with
 // its help text; unknown flags, missing values and bad numbers give one clear line.
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -40,6 +41,9 @@ class CommandLine {
   /// A number that must satisfy lo <= v <= hi.
   double number_in(const std::string& name, double lo, double hi) const;
   long integer(const std::string& name) const;
+  /// A whole number with lo <= v <= hi ("1.5" and "1e400" are refused, never truncated). Written
+  /// as a decimal or in exponent form ("1e6"), up to 2^53.
+  std::uint64_t integer_in(const std::string& name, std::uint64_t lo, std::uint64_t hi) const;
   /// Comma-separated numbers, exactly `count` of them.
   std::vector<double> numbers(const std::string& name, std::size_t count) const;
   std::string help() const;

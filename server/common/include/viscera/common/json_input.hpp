@@ -19,9 +19,16 @@ namespace viscera::common {
 /// (missing, a directory, a FIFO or device, too large, unreadable).
 std::string read_text_file(const std::string& path, std::size_t max_bytes);
 
+/// The deepest nesting of objects and arrays any JSON input may have (files and messages alike).
+inline constexpr std::size_t kMaxJsonDepth = 64;
+
 /// Parses JSON text (a UTF-8 byte-order mark is skipped). Syntax errors, numbers that overflow a
-/// double and keys given twice in one object throw InputError(source, line, ...).
+/// double, keys given twice in one object and nesting deeper than kMaxJsonDepth throw
+/// InputError(source, line, ...).
 nlohmann::json parse_json(std::string_view text, const std::string& source);
+/// parse_json for text that is not a file (a browser's message, a recorded scene's settings): the
+/// document, or nothing with the reason in `why`.
+std::optional<nlohmann::json> try_parse_json(std::string_view text, std::string* why = nullptr);
 /// read_text_file (at most 16 MiB) + parse_json.
 nlohmann::json read_json_file(const std::string& path);
 

@@ -16,6 +16,10 @@
 
 namespace viscera::mcap {
 
+namespace detail {
+struct Registry;  ///< the schemas and channels met so far while reading
+}  // namespace detail
+
 /// Where a chunk is and what it holds (the summary's Chunk Index records).
 struct ChunkIndex {
   std::uint64_t start_time = 0, end_time = 0;  ///< [ns] log times of its first and last message
@@ -47,13 +51,23 @@ struct DataVisitor {
   std::function<void(const Metadata&)> metadata;
 };
 
+/// A stretch of the data section that salvage_data() skipped: what was lost there and why.
+struct Damage {
+  std::uint64_t offset = 0, length = 0;  ///< [bytes] where the stretch starts in the file, and its size
+  std::string what;
+};
+
 /// How the data section ended: at Data End (complete), or at a record that does not parse (a file
 /// cut short by a crash, or damaged), and what was read before it.
 struct DataEnd {
   bool complete = false;
   std::uint64_t offset = 0;  ///< of Data End, or of the record that failed
   std::string error;  ///< why it failed ("" when complete)
-  std::uint64_t chunks = 0, messages = 0;
+  std::uint64_t chunks = 0, messages = 0, attachments = 0;
+  std::vector<Damage> damaged;  ///< salvage_data(): every stretch skipped, in file order (read_data stops at the first)
+  /// Nothing of the data section was lost: complete, or cut exactly after a record (a killed
+  /// writer's file, whose summary alone is missing), with no stretch skipped.
+  bool intact() const { return damaged.empty(); }
 };
 
 class McapReader {
@@ -69,6 +83,13 @@ class McapReader {
   /// Walks the data section. Messages come after their channel; each chunk's messages only once the
   /// whole chunk has been read, decompressed and checked (so a chunk cut short gives none).
   DataEnd read_data(const DataVisitor& visit);
+  /// Walks the data section as read_data() does, but keeps going past damage: a record that does
+  /// not parse (a CRC that does not match, a chunk that does not decompress) is skipped whole when
+  /// its length still holds, and otherwise the walk resumes at the next chunk or attachment whose
+  /// CRC holds; a tail of zero bytes (space a crash left unwritten) ends it. Every stretch skipped
+  /// is in DataEnd::damaged. Channels and schemas come from the summary too, where it reads, so the
+  /// messages after a damaged chunk keep their channels.
+  DataEnd salvage_data(const DataVisitor& visit);
   /// The summary, when the file ends with a footer whose summary CRC holds; nullopt for a file cut
   /// short (recover() rebuilds one); throws common::InputError for a footer that points outside
   /// the file or a summary CRC that does not match.
@@ -80,6 +101,15 @@ class McapReader {
 
  private:
   std::vector<std::uint8_t> read_at(std::uint64_t offset, std::uint64_t n);
+  /// Reads the record at `at`, visits what it holds and returns its size with opcode and length;
+  /// throws FormatError or common::InputError for a record that does not parse.
+  std::uint64_t read_record(std::uint64_t at, detail::Registry& known, const DataVisitor& visit, DataEnd& end);
+  /// Whether a chunk or attachment whose CRC holds starts at `at` (where a walk past damage resumes).
+  bool checked_record_at(std::uint64_t at);
+  /// The first offset after `from` where checked_record_at() holds, or the file's size.
+  std::uint64_t next_checked_record(std::uint64_t from);
+  /// Whether every byte from `from` to the end of the file is zero.
+  bool zeros_to_end(std::uint64_t from);
   /// The content of the record at `offset` with that opcode (throws FormatError otherwise).
   std::vector<std::uint8_t> record_at(std::uint64_t offset, Opcode opcode);
   [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const;
@@ -90,9 +120,10 @@ class McapReader {
   std::uint64_t size_ = 0, data_start_ = 0;
 };
 
-/// The messages, schemas, channels, attachments and metadata of a file up to its last complete
-/// chunk, written to `out` as a complete, indexed file. Returns what was read (DataEnd says where
-/// the input ended and why). `in` and `out` must differ.
+/// The messages, schemas, channels, attachments and metadata of every record of a file that is
+/// intact (salvage_data()), written to `out` as a complete, indexed file. Returns what was read:
+/// where the input ended and why, and every stretch lost. `out` must not be `in` (by device and
+/// inode: a hard or symbolic link to `in` is refused too).
 DataEnd recover(const std::string& in, const std::string& out, const std::string& compression = "zstd");
 
 }  // namespace viscera::mcap

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "viscera/mcap/integrity.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/protocol/dds.hpp"
 
@@ -52,6 +53,8 @@ class Recording {
   const std::vector<RecordedScene>& scenes() const { return scenes_; }
   /// The attachment of that name's content; throws InputError if the recording has none.
   std::vector<std::uint8_t> attachment(const std::string& name);
+  /// The whole file checked, record by record (mcap::check_integrity).
+  mcap::Integrity integrity();
   /// [ns] log times of the first and last message (0, 0 when there is none).
   std::uint64_t start_ns() const;
   std::uint64_t end_ns() const;

@@ -28,8 +28,9 @@ class ExerciseScorer {
   void take(protocol::Stream stream, std::span<const std::uint8_t> payload);
   /// Processes the forces and events of ticks up to `tick` (live: a margin behind newest_tick()).
   void advance(std::uint64_t tick);
-  /// Processes everything taken (a recording's end, or a live run's).
-  void finish();
+  /// Processes everything taken (a recording's end, or a live run's). `why` says why it ended
+  /// before the exercise did (default: the instrument stopped; a trainer stopped by a signal says so).
+  void finish(const std::string& why = "the instrument stopped before the time limit");
 
   /// Whether the exercise has started (its scene loaded) and ended (completed, or out of time).
   bool started() const { return start_tick_.has_value(); }
