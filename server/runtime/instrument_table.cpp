@@ -53,11 +53,12 @@ Handover InstrumentTable::take_over(std::uint32_t instrument_id, std::uint32_t t
   const std::uint32_t from = e.owner;
   if (from == to) return {HandoverResult::already_owner, from};
   if (from == 0) {
-    e = {to, false, now_ns, {}, 0};
+    e = {to, false, now_ns, {}, 0, true};
     return {HandoverResult::handed_over, 0};
   }
   hand_over_locked(e, from, to, now_ns);
   e.taken_from = from;
+  e.taken_over = true;
   return {HandoverResult::handed_over, from};
 }
 
@@ -67,10 +68,15 @@ Handover InstrumentTable::hand_back(std::uint32_t instrument_id, std::uint32_t b
   if (it == entries_.end()) return {HandoverResult::unknown_instrument, 0};
   Entry& e = it->second;
   if (e.owner != by) return {HandoverResult::not_owner, 0};
-  if (e.taken_from == 0) return {HandoverResult::not_taken_over, 0};
+  if (!e.taken_over) return {HandoverResult::not_taken_over, 0};
   const std::uint32_t to = e.taken_from;
+  if (to == 0) {  // it was free: free again, for whoever claims it next
+    e = {};
+    return {HandoverResult::handed_over, 0};
+  }
   hand_over_locked(e, by, to, now_ns);
   e.taken_from = 0;
+  e.taken_over = false;
   return {HandoverResult::handed_over, to};
 }
 

@@ -141,7 +141,7 @@ void SimulationServer::Impl::hand_over(const proto::SessionRequest& req, const S
   switch (h.result) {
     case HandoverResult::handed_over:
       message = take ? (h.from ? id + " taken over from client " + std::to_string(h.from) : id + " was free: claimed")
-                     : id + " handed back to client " + std::to_string(h.from);
+                     : (h.from ? id + " handed back to client " + std::to_string(h.from) : id + " handed back: it was free, and is free again");
       break;
     case HandoverResult::already_owner: message = id + ": already this client's"; break;
     case HandoverResult::not_owner: message = id + ": not this client's to hand back"; break;
@@ -150,7 +150,9 @@ void SimulationServer::Impl::hand_over(const proto::SessionRequest& req, const S
   }
   const bool accepted = h.result == HandoverResult::handed_over || h.result == HandoverResult::already_owner;
   session.record(req, accepted, message);
-  if (h.result == HandoverResult::handed_over) {
+  if (h.result == HandoverResult::handed_over && !take && h.from == 0) {
+    event(proto::EventKind::instrument_released, req.instrument_id, req.client_id, message, req.request_seq);
+  } else if (h.result == HandoverResult::handed_over) {
     // The new owner's claim names the one it came from; no release in between.
     const std::uint32_t to = take ? req.client_id : h.from;
     event(proto::EventKind::instrument_claimed, req.instrument_id, to, message, req.request_seq);

@@ -111,7 +111,11 @@ PY
 node "$node_dir/check_mcap.mjs" --cut "$tmp/killed.mcap" > "$tmp/cut.json"; cat "$tmp/cut.json"
 "$rec" recover "$tmp/killed.mcap" "$tmp/recovered.mcap" > "$tmp/recover.log" 2>&1; rc_recover=$?; cat "$tmp/recover.log"
 node "$node_dir/check_mcap.mjs" "$tmp/recovered.mcap" > "$tmp/recovered.json"; rc_rofficial=$?
-check "recover wrote a file (rc $rc_recover) the official reader accepts (rc $rc_rofficial)" "[ $rc_recover -eq 0 ] && [ $rc_rofficial -eq 0 ]"
+# Exit 0: the kill fell between two records, nothing in the file was lost; exit 1: it fell inside a
+# chunk being written, whose bytes are lost (said, with where).
+killed_size=$(stat -c %s "$tmp/killed.mcap")
+check "recover wrote a file (rc $rc_recover) the official reader accepts (rc $rc_rofficial)" \
+  "[ $rc_rofficial -eq 0 ] && { [ $rc_recover -eq 0 ] || { [ $rc_recover -eq 1 ] && grep -q 'lost bytes [0-9]* to $killed_size ' '$tmp/recover.log'; }; }"
 pycheck "$tmp/cut.json" "$tmp/recovered.json" "$tmp/recover.log" <<'PY'
 import json, re, sys
 cut, rec, log = json.load(open(sys.argv[1])), json.load(open(sys.argv[2])), open(sys.argv[3]).read()
@@ -234,6 +238,63 @@ bad "not MCAP" "not-mcap.mcap" "$replay" resimulate "$tmp/not-mcap.mcap" --domai
 bad "newer schema" "newer viscera" "$replay" play "$tmp/newer.mcap" --domain "$domain" --no-keys --quiet
 bad "another organ's scene" "other-organ.json" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --scene "$tmp/other-organ.json" --quiet
 bad "recover onto itself" "another file" "$rec" recover "$tmp/killed.mcap" "$tmp/killed.mcap"
+bad "play from past the end" "is past the recording" "$replay" play "$tmp/session.mcap" --from 1000 --partition x --domain "$domain" --no-keys --quiet
+echo '[1, 2]' > "$tmp/array-scene.json"
+bad "a scene that is an array" "array-scene.json: JSON: [1,2] is not an object" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --scene "$tmp/array-scene.json" --quiet
+
+# --- Damage: recover keeps what is intact and says what was lost; info --verify judges the same --
+python3 - "$tmp/session.mcap" "$tmp" <<'PY'
+import sys
+b = open(sys.argv[1], "rb").read()
+def save(name, data): open(f"{sys.argv[2]}/{name}", "wb").write(data)
+def first(opcode):  # the offset of the first record with that opcode: walk the records after the magic
+    at = 8
+    while b[at] != opcode:
+        at += 9 + int.from_bytes(b[at + 1:at + 9], "little")
+    return at
+a = first(9) + 9 + 16  # an attachment: opcode, length, two times, then its name, media type, data length, data
+for _ in range(2):
+    a += 4 + int.from_bytes(b[a:a + 4], "little")
+i = a + 8  # its data, which its u64 length precedes
+flip = bytearray(b); flip[i + 10] ^= 1; save("att-flip.mcap", flip)
+huge = bytearray(b); n = int.from_bytes(b[i - 8:i], "little"); huge[i - 8:i] = (n + 2**40).to_bytes(8, "little"); save("att-huge.mcap", huge)
+at = first(6)  # the first chunk
+length = int.from_bytes(b[at + 1:at + 9], "little")
+chunk = bytearray(b); chunk[at + 9 + length // 2] ^= 0x40; save("chunk-flip.mcap", chunk)
+PY
+for f in att-flip att-huge chunk-flip; do
+  "$rec" info "$tmp/$f.mcap" --verify > "$tmp/$f.info" 2>&1; rc=$?
+  check "info --verify finds $f (rc $rc, want 1)" "[ $rc -eq 1 ] && grep -q 'damaged:' '$tmp/$f.info'"
+done
+grep -A2 "records:" "$tmp/att-huge.info"
+"$rec" recover "$tmp/chunk-flip.mcap" "$tmp/chunk-fixed.mcap" > "$tmp/chunk-fixed.log" 2>&1; rc_fix=$?; cat "$tmp/chunk-fixed.log"
+node "$node_dir/check_mcap.mjs" "$tmp/chunk-fixed.mcap" > "$tmp/chunk-fixed.json"; rc_fixed_official=$?
+check "recover of a damaged first chunk exits 1 naming the loss, the official reader accepts the copy (rc $rc_fix, $rc_fixed_official)" \
+  "[ $rc_fix -eq 1 ] && grep -q 'lost bytes' '$tmp/chunk-fixed.log' && [ $rc_fixed_official -eq 0 ]"
+pycheck "$tmp/chunk-fixed.json" "$tmp/official.json" <<'PY'
+import json, sys
+fixed, whole = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+n, total = fixed["statistics"]["messageCount"], whole["statistics"]["messageCount"]
+print(f"a damaged first chunk: {n} of {total} messages recovered, {len(fixed['attachments'])} attachments")
+sys.exit(0 if 0.5 * total < n < total and len(fixed["attachments"]) == len(whole["attachments"]) else 1)
+PY
+
+# --- A replay never drives a live server ------------------------------------------------------
+"$build/server/runtime/viscera-server" --scene "$scene" --partition live-guard > "$tmp/guard-server.log" 2>&1 & guard=$!; pids+=($guard)
+wait_for "DDS domain" "$tmp/guard-server.log"
+bad "a replay into a live server's partition" "holds a live viscera-server" "$replay" play "$tmp/session.mcap" --partition live-guard --domain "$domain" --no-keys --quiet
+bad "a replay into every partition" "holds a DDS wildcard" "$replay" play "$tmp/session.mcap" --partition '*' --domain "$domain" --no-keys --quiet
+"$ctl" show --partition live-guard --domain "$domain" > "$tmp/guard-show.log" 2>&1
+check "the live server's instruments stay free" "grep -q 'instruments: 1 (probe, free)' '$tmp/guard-show.log'"
+# A server that starts in a replay's partition stops the replay.
+"$replay" play "$tmp/session.mcap" --loop --partition late-guard --domain "$domain" --no-keys --quiet > "$tmp/late.log" 2>&1 & late=$!; pids+=($late)
+sleep 1.5
+"$build/server/runtime/viscera-server" --scene "$scene" --partition late-guard > "$tmp/late-server.log" 2>&1 & late_server=$!; pids+=($late_server)
+for _ in $(seq 150); do kill -0 "$late" 2>/dev/null || break; sleep 0.1; done
+wait "$late"; rc_late=$?
+cat "$tmp/late.log"
+check "a server joining the replay's partition stops it (rc $rc_late, want 3)" "[ $rc_late -eq 3 ] && grep -q 'holds a live viscera-server' '$tmp/late.log'"
+kill -INT "$guard" "$late_server"; wait "$guard" "$late_server"
 
 echo "recording: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -109,11 +109,18 @@ TEST(InstrumentTable, TakeOverRemembersWhomFromAndHandsBackToThem) {
   EXPECT_EQ(back.from, 11u);
   EXPECT_EQ(t.owner(1), 11u);
   EXPECT_EQ(t.hand_back(1, 11, 31 * kMs).result, HandoverResult::not_taken_over);  // once only
-  // A free instrument is simply claimed; there is nobody to hand it back to.
+  // A free instrument taken over is claimed; handed back, it is free again, and the trainee's
+  // client claims it (it used to stay the instructor's until the console restarted).
   const Handover free = t.take_over(3, 950, 40 * kMs);
   EXPECT_EQ(free.result, HandoverResult::handed_over);
   EXPECT_EQ(free.from, 0u);
-  EXPECT_EQ(t.hand_back(3, 950, 41 * kMs).result, HandoverResult::not_taken_over);
+  EXPECT_EQ(t.claim(3, 12, 40 * kMs), ClaimResult::taken);
+  const Handover freed = t.hand_back(3, 950, 41 * kMs);
+  EXPECT_EQ(freed.result, HandoverResult::handed_over);
+  EXPECT_EQ(freed.from, 0u);
+  EXPECT_EQ(t.owner(3), 0u);
+  EXPECT_EQ(t.claim(3, 12, 42 * kMs), ClaimResult::claimed);
+  EXPECT_EQ(t.hand_back(3, 12, 43 * kMs).result, HandoverResult::not_taken_over);  // claimed, not taken over
   EXPECT_EQ(t.take_over(9, 950, 42 * kMs).result, HandoverResult::unknown_instrument);
 }
 

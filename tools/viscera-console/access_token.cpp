@@ -1,26 +1,36 @@
 #include "viscera/console/access_token.hpp"
 
-#include <fstream>
+#include <cstdio>
+
+#include <sys/stat.h>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 
 namespace viscera::console {
 
 std::string read_token_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw common::InputError(path, 0, "--token-file", "cannot be read");
-  std::string line;
-  std::getline(in, line);
+  const std::string text = common::read_text_file(path, 4096);
+  const std::string line = text.substr(0, text.find('\n'));
   const auto first = line.find_first_not_of(" \t\r");
   const auto last = line.find_last_not_of(" \t\r");
   std::string token = first == std::string::npos ? std::string() : line.substr(first, last - first + 1);
   for (const char c : token)
     if (c <= ' ' || c > '~') throw common::InputError(path, 1, "token", "holds a blank or a character outside printable ASCII");
-  if (token.size() < kMinTokenChars)
-    throw common::InputError(
-        path, 1, "token",
-        "has " + std::to_string(token.size()) + " characters (at least " + std::to_string(kMinTokenChars) + "; e.g. openssl rand -hex 16)");
+  if (token.size() < kMinTokenChars || token.size() > kMaxTokenChars)
+    throw common::InputError(path, 1, "token",
+                             "has " + std::to_string(token.size()) + " characters (" + std::to_string(kMinTokenChars) + " to " +
+                                 std::to_string(kMaxTokenChars) + "; e.g. openssl rand -hex 16)");
   return token;
+}
+
+std::string token_file_warning(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || (st.st_mode & (S_IRWXG | S_IRWXO)) == 0) return {};
+  char mode[8];
+  std::snprintf(mode, sizeof mode, "%03o", static_cast<unsigned>(st.st_mode & 0777));
+  return common::printable(path, 200) + " (mode " + mode +
+         ") may be read by others than its owner: anyone who reads it commands the session (chmod 600 " + common::printable(path, 200) + ")";
 }
 
 bool token_matches(std::string_view given, std::string_view token) {

@@ -96,6 +96,9 @@ int main(int argc, char** argv) {
     const auto listen = parse_listen(cl.text("listen"));
     viscera::console::WebOptions options;
     options.token = viscera::console::read_token_file(cl.text("token-file"));
+    if (const auto w = viscera::console::token_file_warning(cl.text("token-file")); !w.empty())
+      std::fprintf(stderr, "viscera-console: warning: %s\n", w.c_str());
+    const std::string token = options.token;
     options.files = read_page(cl.text("web-root"));
     options.outbox_bytes = static_cast<std::size_t>(1024 * cl.number_in("outbox-kib", 64, 1 << 20));
     options.requests_per_s = cl.number_in("requests-per-s", 1, 1000);
@@ -169,7 +172,7 @@ int main(int argc, char** argv) {
     const auto ep = server->endpoint();
     const std::string host = ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
     std::printf("viscera-console: domain %u, %zu station(s); open http://%s:%u/?token=%s\n", domain, stations.size(), host.c_str(), ep.port(),
-                viscera::console::read_token_file(cl.text("token-file")).c_str());
+                token.c_str());
     std::fflush(stdout);
 
     // --discover: a station for every partition where a server's scene state appears (DDS

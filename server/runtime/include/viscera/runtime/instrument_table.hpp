@@ -57,7 +57,8 @@ class InstrumentTable {
   /// `to` takes the instrument from whoever owns it (hand_over, remembering whom from), or claims
   /// it if it is free.
   Handover take_over(std::uint32_t instrument_id, std::uint32_t to, std::int64_t now_ns);
-  /// `by`, who took the instrument over, hands it back to the client it took it from (hand_over).
+  /// `by`, who took the instrument over, hands it back to the client it took it from (hand_over),
+  /// or frees it if it was free when taken over (Handover::from 0).
   Handover hand_back(std::uint32_t instrument_id, std::uint32_t by, std::int64_t now_ns);
   /// A command from `command.client_id`: accepted (the newest) if it owns the instrument and the
   /// sequence is newer; renews the owner's lease either way.
@@ -79,7 +80,8 @@ class InstrumentTable {
     bool has_command = false;
     std::int64_t last_heard_ns = 0;  ///< the owner's last claim or command
     protocol::Command last;
-    std::uint32_t taken_from = 0;  ///< the owner before a take-over (0: not taken over)
+    std::uint32_t taken_from = 0;  ///< the owner before a take-over (0: it was free)
+    bool taken_over = false;  ///< the owner took it over (and may hand it back)
   };
   HandoverResult hand_over_locked(Entry& e, std::uint32_t from, std::uint32_t to, std::int64_t now_ns);
   std::vector<InstrumentSpec> specs_;
