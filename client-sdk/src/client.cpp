@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -27,6 +28,7 @@ struct Client::Impl {
   proto::Writer commands, sessions;
   proto::Reader forces, scene;
   std::optional<proto::Scene> last_scene;
+  std::set<std::uint32_t> claimed;  // instruments this client claimed (another process may run under its id)
   std::unique_ptr<proto::Reader> topology, frames, events, telemetry;  // created on first use
   std::unique_ptr<proto::Writer> annotations;
   std::optional<proto::SurfaceTopology> surface;
@@ -92,6 +94,9 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
   const auto end = std::chrono::steady_clock::now() + timeout;
   const proto::SessionRequest r{client_id_, proto::Action::claim_instrument, instrument_id};
   std::string why = "no scene state from the server";
+  // Shown as this id's before this client asked for it: another process runs under this client id
+  // and holds it. Not asked for (a claim would renew that process's lease) until it lets it go.
+  bool another_owner_seen = impl_->claimed.count(instrument_id) > 0;
   while (std::chrono::steady_clock::now() < end) {
     impl_->take_scene(rejected_);
     if (const auto& s = impl_->last_scene) {
@@ -103,7 +108,15 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
           list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.grasper ? " (grasper)" : " (probe)");
         return {false, "scene " + s->name + " has no instrument " + std::to_string(instrument_id) + " (its instruments: " + list + ")"};
       }
+      if (it->owner_client_id == client_id_ && !another_owner_seen) {
+        why = "instrument " + std::to_string(instrument_id) + " is held under this client id (" + std::to_string(client_id_) +
+              ") by another client: two clients must not run with one id";
+        impl_->scene.wait(std::chrono::milliseconds(100));
+        continue;
+      }
+      another_owner_seen = true;
       if (it->owner_client_id == client_id_) {
+        impl_->claimed.insert(instrument_id);
         // Before the first command: every reader of commands (the server's, a recorder's) knows
         // this client's writer, or the first commands are lost to the one that learns of it last.
         impl_->commands.wait_for_settled_readers(std::chrono::milliseconds(100), std::chrono::milliseconds(500));
@@ -119,6 +132,7 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
 }
 
 void Client::release(std::uint32_t instrument_id) {
+  impl_->claimed.erase(instrument_id);
   impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, proto::Action::release_instrument, instrument_id}));
 }
 

@@ -24,13 +24,24 @@ command -v chromium >/dev/null || { echo "FAIL chromium is not installed (deploy
 "$console" --help > "$tmp/help.txt"; rc=$?
 check "--help" '[ $rc -eq 0 ] && grep -q -- "--token-file" "$tmp/help.txt"'
 "$console" --token-file "$tmp/none" > "$tmp/e1.txt" 2>&1; rc=$?
-check "a missing token file is named" '[ $rc -eq 2 ] && grep -q "$tmp/none: --token-file: cannot be read" "$tmp/e1.txt"'
+check "a missing token file is named" '[ $rc -eq 2 ] && grep -q "$tmp/none: cannot open file" "$tmp/e1.txt"'
 echo short > "$tmp/short"
 "$console" --token-file "$tmp/short" > "$tmp/e2.txt" 2>&1; rc=$?
-check "a short token is refused" '[ $rc -eq 2 ] && grep -q "short:1: token: has 5 characters (at least 32" "$tmp/e2.txt"'
-openssl rand -hex 16 > "$tmp/token"
+check "a short token is refused" '[ $rc -eq 2 ] && grep -q "short:1: token: has 5 characters (32 to 256" "$tmp/e2.txt"'
+# Token files that are not small regular files: refused at once, never read without end.
+mkfifo "$tmp/fifo"
+head -c 10000000 /dev/zero | tr '\0' 'a' > "$tmp/huge-token"
+for f in /dev/zero "$tmp/fifo" "$tmp/huge-token"; do
+  timeout 10 "$console" --token-file "$f" > "$tmp/e4.txt" 2>&1; rc=$?
+  check "token file $f refused at once (rc $rc: $(head -c 200 "$tmp/e4.txt"))" '[ $rc -eq 2 ] && [ $(wc -l < "$tmp/e4.txt") -eq 1 ]'
+done
+openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
+cp "$tmp/token" "$tmp/loose-token"; chmod 644 "$tmp/loose-token"
+timeout 10 "$console" --token-file "$tmp/loose-token" --domain 999 > "$tmp/e5.txt" 2>&1
+check "a token file others may read is warned about" 'grep -q "warning: .*loose-token (mode 644) may be read by others" "$tmp/e5.txt"'
 "$console" --token-file "$tmp/token" --listen 127.0.0.1:99999 > "$tmp/e3.txt" 2>&1; rc=$?
 check "a bad --listen is refused" '[ $rc -eq 2 ] && grep -q "port is not in" "$tmp/e3.txt"'
+check "a token file only its owner reads is not warned about" '! grep -q warning "$tmp/e3.txt"'
 cat "$tmp/e1.txt" "$tmp/e2.txt" "$tmp/e3.txt"
 
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 & pids+=($!)
@@ -51,6 +62,16 @@ node "$node_dir/console_replay.mjs" "$url" session.mcap > "$tmp/replay.json"; rc
 check "a recording opened for replay from the console (console_replay.mjs)" '[ $rc_replay -eq 0 ]'
 node "$node_dir/foxglove_client.mjs" "$url" > "$tmp/foxglove.json"; rc_foxglove=$?
 check "a Foxglove client on the live session (foxglove_client.mjs)" '[ $rc_foxglove -eq 0 ]'
+# Recordings that cannot be replayed, and a link out of the folder; a link at the path where the
+# console once wrote its replays' logs in /tmp (it must not be written through).
+: > "$tmp/recordings/empty.mcap"
+ln -s /etc/passwd "$tmp/recordings/passwd.mcap"
+echo "mine" > "$tmp/victim"; old_log=/tmp/viscera-console-viscera-replay-2.log
+[ -e "$old_log" ] || [ -L "$old_log" ] || ln -s "$tmp/victim" "$old_log"
+node "$node_dir/console_faults.mjs" "$url" "$bridge" 2 > "$tmp/faults.json"; rc_faults=$?
+check "the console's faults of issue 31 (console_faults.mjs)" '[ $rc_faults -eq 0 ]'
+check "nothing was written through a link in /tmp" '[ "$(cat "$tmp/victim")" = mine ]'
+[ "$(readlink "$old_log")" = "$tmp/victim" ] && rm -f "$old_log"
 node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?
 check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'

@@ -173,6 +173,7 @@ struct RunResult {
   int server_returns = 0;  // --reconnect: servers claimed again after a loss
   bool lost = false;  // ended because the server was gone
   int taken_over = 0;  // times another client (an instructor's console) took the instrument over
+  double instrument_lost_t_s = -1;  // when the client noticed its instrument was no longer its own (-1: never)
 };
 
 void print_live(const Options& o, viscera::client::Client& client, double t, const Vector3& tip, const viscera::protocol::Force& f,
@@ -251,6 +252,18 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
                                      [&](const viscera::protocol::InstrumentInfo& i) { return i.instrument_id == o.instrument; });
         const std::uint32_t owner = it == now->instruments.end() ? 0 : it->owner_client_id;
         const bool taken = owner != 0 && owner != client.id();
+        // Free, though this client claimed it and drove it: another process under this client id
+        // released it (or the server released it for silence). The commands would all be refused:
+        // the force fades and the run ends, saying so.
+        if (owner == 0 && !standing_by && run.instrument_lost_t_s < 0) {
+          run.instrument_lost_t_s = t;
+          renderer.server_lost(t);
+          std::printf(
+              "t = %5.2f s  instrument %u is no longer this client's (the server shows it free: released by another client with "
+              "client id %u?); the force fades to zero over %.2f s\n",
+              t, o.instrument, client.id(), o.fade.fade_s);
+          std::fflush(stdout);
+        }
         if (taken != standing_by) {
           standing_by = taken;
           run.taken_over += taken;
@@ -271,6 +284,16 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
         next = std::chrono::steady_clock::now();
         continue;
       }
+    }
+    if (run.instrument_lost_t_s >= 0) {  // nothing is sent; the force fades out, then the run ends
+      device.render(renderer.render(last_tip, t).force, false);
+      if (renderer.gain(t) == 0) {
+        run.faded_t_s = t;
+        break;
+      }
+      next += period;
+      std::this_thread::sleep_until(next);
+      continue;
     }
     if (standing_by) {  // nothing is sent and the device is not read; the force it renders fades out
       device.render(renderer.render(last_tip, t).force, false);
@@ -336,6 +359,7 @@ void write_report(const Options& o, const std::string& scene, const std::string&
                    {"fade", {{"stale_after_s", o.fade.stale_after_s}, {"fade_s", o.fade.fade_s}}},
                    {"server_lost_t_s", run.server_lost_t_s},
                    {"taken_over", run.taken_over},
+                   {"instrument_lost_t_s", run.instrument_lost_t_s},
                    {"faded_t_s", run.faded_t_s},
                    {"server_returns", run.server_returns},
                    {"samples", to_json(run.samples)}};
@@ -363,7 +387,8 @@ int main(int argc, char** argv) {
       "(--reconnect: it waits for a server to come back and claims the instrument again).\n"
       "While another client (an instructor's console) has taken the instrument over, the client sends nothing,\n"
       "its rendered force fades out and the device waits; it drives again once the instrument is handed back.\n"
-      "Exit status: 0 done, 2 bad arguments, 3 no server or instrument not claimed, 4 the server went away, 1 other errors.");
+      "Exit status: 0 done, 2 bad arguments, 3 no server or instrument not claimed, 4 the server went away, 5 the instrument was\n"
+      "released by another client (another process under this client id?), 1 other errors.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");
   cl.flag("instrument", "ID", "instrument to claim", "1");
@@ -404,7 +429,7 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     const double start_epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
     const RunResult run = run_device(o, client, *device, scene->generation);
-    if (!run.lost) client.release(o.instrument);
+    if (!run.lost && run.instrument_lost_t_s < 0) client.release(o.instrument);
     const auto rtt = client.round_trip();
     std::printf(
         "haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
@@ -419,6 +444,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "haptic-client: the server went away at t = %.2f s; the force had faded to zero at t = %.2f s\n", run.server_lost_t_s,
                    run.faded_t_s);
       return 4;
+    }
+    if (run.instrument_lost_t_s >= 0) {
+      std::fprintf(stderr, "haptic-client: instrument %u was no longer this client's at t = %.2f s; the force had faded to zero at t = %.2f s\n",
+                   o.instrument, run.instrument_lost_t_s, run.faded_t_s);
+      return 5;
     }
     return 0;
   } catch (const viscera::common::UsageError& e) {

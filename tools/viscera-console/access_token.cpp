@@ -1,5 +1,6 @@
 #include "viscera/console/access_token.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <sys/stat.h>
@@ -31,6 +32,12 @@ std::string token_file_warning(const std::string& path) {
   std::snprintf(mode, sizeof mode, "%03o", static_cast<unsigned>(st.st_mode & 0777));
   return common::printable(path, 200) + " (mode " + mode +
          ") may be read by others than its owner: anyone who reads it commands the session (chmod 600 " + common::printable(path, 200) + ")";
+}
+
+bool origin_allowed(std::string_view origin, std::string_view host, const std::vector<std::string>& allowed) {
+  if (origin.empty()) return true;
+  if (!host.empty() && (origin == "http://" + std::string(host) || origin == "https://" + std::string(host))) return true;
+  return std::find(allowed.begin(), allowed.end(), origin) != allowed.end();
 }
 
 bool token_matches(std::string_view given, std::string_view token) {

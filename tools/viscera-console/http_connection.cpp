@@ -2,6 +2,8 @@
 
 #include <boost/beast/websocket.hpp>
 
+#include "viscera/common/input_error.hpp"
+#include "viscera/console/access_token.hpp"
 #include "viscera/console/foxglove_protocol.hpp"
 
 #include "web_server_impl.hpp"
@@ -47,6 +49,15 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (websocket::is_upgrade(req)) {
       const std::string target(req.target());
       if (!ok) return respond(req, http::status::unauthorized, "text/plain", "the console's token is missing or wrong\n", false);
+      const auto origin = req.find(http::field::origin);
+      const auto host = req.find(http::field::host);
+      const std::string_view origin_text = origin == req.end() ? std::string_view() : std::string_view(origin->value().data(), origin->value().size());
+      if (!origin_allowed(origin_text, host == req.end() ? std::string_view() : std::string_view(host->value().data(), host->value().size()),
+                          server_->opt.allowed_origins)) {
+        ++server_->counters.refused;
+        return respond(req, http::status::forbidden, "text/plain",
+                       "origin '" + common::printable(origin_text, 100) + "' is not this console's (viscera-console --allow-origin)\n", false);
+      }
       const std::string path = target.substr(0, target.find('?'));
       if (path != "/ws" && path != "/") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
       if (server_->browsers.size() >= server_->opt.max_browsers)

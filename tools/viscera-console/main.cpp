@@ -4,10 +4,13 @@
 // material, annotate and bookmark in (docs/CONSOLE.md).
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
@@ -28,6 +31,18 @@
 #endif
 
 namespace {
+
+/// Removes a folder (if named) with what it holds when it goes out of scope.
+struct RemoveAll {
+  const std::string& path;
+  explicit RemoveAll(const std::string& p) : path(p) {}
+  RemoveAll(const RemoveAll&) = delete;
+  RemoveAll& operator=(const RemoveAll&) = delete;
+  ~RemoveAll() {
+    std::error_code ec;
+    if (!path.empty()) std::filesystem::remove_all(path, ec);
+  }
+};
 
 namespace asio = boost::asio;
 using viscera::common::UsageError;
@@ -88,6 +103,7 @@ int main(int argc, char** argv) {
   cl.flag("outbox-kib", "KIB", "what may wait for one browser before its oldest forces and telemetry are dropped [KiB]", "4096");
   cl.flag("requests-per-s", "R", "requests a browser may send a second (bursts of twice that)", "20");
   cl.flag("recordings", "DIR", "session recordings (viscera-record) a browser may open for replay, each as a station of its own (none: no replays)");
+  cl.flag("allow-origin", "ORIGIN,...", "WebSocket origins allowed besides the console's own address (a proxy's https://HOST, a Foxglove web app)", "");
   cl.flag("replayer", "PATH", "the viscera-replay program (default: the one beside this program)");
   cl.flag("stats-every-s", "S", "print the browsers' traffic every S seconds (0: never)", "0");
   try {
@@ -100,6 +116,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "viscera-console: warning: %s\n", w.c_str());
     const std::string token = options.token;
     options.files = read_page(cl.text("web-root"));
+    options.allowed_origins = split(cl.text("allow-origin"), ',');
     options.outbox_bytes = static_cast<std::size_t>(1024 * cl.number_in("outbox-kib", 64, 1 << 20));
     options.requests_per_s = cl.number_in("requests-per-s", 1, 1000);
     options.request_burst = 2 * options.requests_per_s;
@@ -137,20 +154,30 @@ int main(int argc, char** argv) {
     }
     // Replays opened from the page: viscera-replay play in a partition of its own each, stopped
     // with the console. Called on the web server's thread.
+    std::string log_dir;
+    const RemoveAll remove_log_dir{log_dir};  // after the replays have stopped
     std::vector<std::unique_ptr<viscera::process::ChildProcess>> replays;
+    std::size_t replays_opened = 0;
     const std::string replayer = cl.has("replayer") ? cl.text("replayer") : viscera::process::find_program("viscera-replay", "tools/viscera-replay");
     const std::string recordings_dir = cl.has("recordings") ? cl.text("recordings") : std::string();
     if (!recordings_dir.empty()) {
       options.recordings_dir = recordings_dir;
       if (!std::filesystem::is_directory(options.recordings_dir))
         throw viscera::common::InputError(options.recordings_dir, 0, "--recordings", "is not a folder");
+      // The replays' logs in a folder of this console's own (mkdtemp: a fresh name, mode 0700),
+      // never at a path in /tmp that another user could have linked elsewhere.
+      std::string tmpl = (std::filesystem::temp_directory_path() / "viscera-console-XXXXXX").string();
+      if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("cannot make a folder for the replays' logs in " + tmpl);
+      log_dir = tmpl;
       options.open_replay = [&, domain, client_id, force_period_s](const std::string& file, std::string* why) -> viscera::console::Station* {
+        // A replay that ended (played out, or failed) frees its slot.
+        std::erase_if(replays, [](const auto& r) { return !r->alive(); });
         if (replays.size() >= 4) {
-          *why = "4 replays are open already (restart the console to close them)";
+          *why = "4 replays are playing already (one must end first)";
           return nullptr;
         }
-        const std::string partition = "viscera-replay-" + std::to_string(replays.size() + 1);
-        const std::string log = std::filesystem::temp_directory_path() / ("viscera-console-" + partition + ".log");
+        const std::string partition = "viscera-replay-" + std::to_string(++replays_opened);
+        const std::string log = (std::filesystem::path(log_dir) / (partition + ".log")).string();
         try {
           replays.push_back(std::make_unique<viscera::process::ChildProcess>(
               std::vector<std::string>{replayer, "play", recordings_dir + "/" + file, "--partition", partition, "--domain", std::to_string(domain),
@@ -158,6 +185,15 @@ int main(int argc, char** argv) {
               log));
         } catch (const std::exception& e) {
           *why = e.what();
+          return nullptr;
+        }
+        // A recording the replayer refuses (empty, damaged, not MCAP) makes it exit at once: its own
+        // one-line error goes to the page, and nothing is left behind.
+        for (int k = 0; k < 40 && replays.back()->alive(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        if (!replays.back()->alive()) {
+          *why = replays.back()->log_tail(1);
+          if (why->empty()) *why = "the replayer stopped at once";
+          replays.pop_back();
           return nullptr;
         }
         const std::size_t k = stations.size();

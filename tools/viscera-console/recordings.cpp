@@ -16,9 +16,15 @@ std::vector<std::string> list_recordings(const std::string& dir) {
   std::vector<std::string> out;
   if (dir.empty()) return out;
   std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+  const auto folder = std::filesystem::canonical(dir, ec);
+  if (ec) return out;
+  for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
     const std::string name = e.path().filename().string();
-    if (e.is_regular_file(ec) && is_recording_name(name)) out.push_back(name);
+    if (!e.is_regular_file(ec) || !is_recording_name(name)) continue;
+    // A symbolic link counts only if it stays inside the folder (never /etc/passwd).
+    const auto target = std::filesystem::canonical(e.path(), ec);
+    if (ec || target.parent_path() != folder) continue;
+    out.push_back(name);
   }
   std::sort(out.begin(), out.end());
   return out;

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <chrono>
 #include <map>
+#include <set>
+#include <utility>
 
 #include <boost/asio/post.hpp>
 #include <boost/beast/websocket.hpp>
@@ -130,8 +132,10 @@ class Browser : public std::enable_shared_from_this<Browser> {
     beast::error_code ec;
     beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
     beast::get_lowest_layer(ws_).socket().close(ec);
-    server_->browsers.erase(id_);
+    leave();
   }
+
+  bool foxglove() const { return foxglove_; }
 
  private:
   void hello() {
@@ -170,7 +174,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
   void on_read(beast::error_code ec) {
     if (ec) {
       if (ec == websocket::error::message_too_big) ++server_->counters.oversized;
-      if (!closing_) server_->browsers.erase(id_);
+      if (!closing_) leave();
       closing_ = true;
       return;
     }
@@ -242,9 +246,19 @@ class Browser : public std::enable_shared_from_this<Browser> {
     if (r->type == RequestType::open_recording) return open_recording(*r);
     std::weak_ptr<Browser> weak = shared_from_this();
     asio::io_context& io = server_->io;
-    const bool queued = server_->stations[station_]->request(*r, [weak, &io](nlohmann::json reply) {
-      asio::post(io, [weak, reply = std::move(reply)] {
-        if (auto b = weak.lock()) b->send_json(reply);
+    const auto held = std::pair{station_, r->instrument};
+    const RequestType type = r->type;
+    const bool queued = server_->stations[station_]->request(*r, [weak, &io, held, type, server = server_](nlohmann::json reply) {
+      asio::post(io, [weak, held, type, server, reply = std::move(reply)] {
+        const bool ok = reply.value("ok", false);
+        auto b = weak.lock();
+        // An instrument this browser took over is handed back when the browser goes, also if it
+        // went before the server answered.
+        if (type == RequestType::take_over && ok && (!b || b->closing_)) hand_back(*server, held);
+        if (!b) return;
+        if (type == RequestType::take_over && ok) b->taken_.insert(held);
+        if (type == RequestType::hand_back && ok) b->taken_.erase(held);
+        b->send_json(reply);
       });
     });
     if (!queued) {
@@ -274,6 +288,19 @@ class Browser : public std::enable_shared_from_this<Browser> {
     send_snapshot();
   }
 
+  /// The browser has gone: out of the list, and what it took over handed back.
+  void leave() {
+    server_->browsers.erase(id_);
+    for (const auto& held : std::exchange(taken_, {})) hand_back(*server_, held);
+  }
+
+  static void hand_back(WebServer::Impl& server, std::pair<std::size_t, std::uint32_t> held) {
+    BrowserRequest back;
+    back.type = RequestType::hand_back;
+    back.instrument = held.second;
+    server.stations[held.first]->request(back, [](const nlohmann::json&) {});
+  }
+
   void pump() {
     if (writing_ || closing_) return;
     auto m = outbox_.take();
@@ -285,7 +312,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
       self->writing_ = false;
       self->current_.reset();
       if (ec) {
-        if (!self->closing_) self->server_->browsers.erase(self->id_);
+        if (!self->closing_) self->leave();
         self->closing_ = true;
         return;
       }
@@ -306,6 +333,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
   std::size_t station_ = 0;
   bool writing_ = false, closing_ = false, foxglove_ = false, accepted_ = false;
   FoxgloveSubscriptions subscriptions_;
+  std::set<std::pair<std::size_t, std::uint32_t>> taken_;  ///< (station, instrument) this browser took over
   std::uint64_t bytes_sent_ = 0, messages_sent_ = 0, errors_sent_ = 0, refused_in_a_row_ = 0;
   std::string address_;
   std::chrono::steady_clock::time_point opened_ = std::chrono::steady_clock::now();
@@ -344,7 +372,8 @@ void WebServer::Impl::add_station(Station* s) {
   latched.resize(stations.size());
   nlohmann::json names = nlohmann::json::array();
   for (const Station* x : stations) names.push_back(x->name());
-  for (auto& [id, b] : std::map(browsers)) b->send_json({{"type", "stations"}, {"stations", names}});
+  for (auto& [id, b] : std::map(browsers))
+    if (!b->foxglove()) b->send_json({{"type", "stations"}, {"stations", names}});
 }
 
 void WebServer::add_station(Station* station) { impl_->add_station(station); }
@@ -389,14 +418,14 @@ tcp::endpoint WebServer::endpoint() const { return impl_->acceptor.local_endpoin
 void WebServer::post_frame(std::size_t station, std::shared_ptr<const std::string> frame) {
   asio::post(impl_->io, [impl = impl_, station, frame = std::move(frame)] {
     for (auto& [id, b] : std::map(impl->browsers))
-      if (b->station() == station) b->send_frame(frame);
+      if (b->station() == station && !b->foxglove()) b->send_frame(frame);  // the page's protocol only
   });
 }
 
 void WebServer::post_message(std::size_t station, OutMessage m) {
   asio::post(impl_->io, [impl = impl_, station, m = std::move(m)] {
     for (auto& [id, b] : std::map(impl->browsers))
-      if (b->station() == station) b->send(m);
+      if (b->station() == station && !b->foxglove()) b->send(m);  // the page's protocol only
   });
 }
 

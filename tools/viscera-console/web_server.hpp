@@ -30,6 +30,7 @@ struct WebOptions {  // NOLINT(bugprone-exception-escape): its defaults do not t
   std::uint32_t max_browsers = 32;
   nlohmann::json page_settings;  ///< sent to each browser in its hello (force limit, ...)
   std::string recordings_dir;  ///< the recordings a browser may open for replay ("" : none)
+  std::vector<std::string> allowed_origins;  ///< WebSocket origins besides the console's own (origin_allowed)
   /// Starts a replay of `file` (in recordings_dir) as a new station: its Station, or nullptr and why.
   std::function<Station*(const std::string& file, std::string* why)> open_replay;
 };

@@ -52,6 +52,9 @@ class Client {
   std::optional<protocol::Scene> scene();
   /// Claims an instrument: claimed once the scene state shows this client as its owner; refused at
   /// once with the server's reason if the scene has no such instrument or another client owns it.
+  /// An instrument the scene shows as this client id's before this client claimed it is held by
+  /// another process under the same id: not claimed (two clients must not run with one id) until
+  /// that one lets it go or loses it to the lease.
   ClaimResult claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout);
   void release(std::uint32_t instrument_id);
   /// Session control for the whole scene (any client, e.g. an instructor's console): pause,

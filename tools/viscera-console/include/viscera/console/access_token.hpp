@@ -2,6 +2,7 @@
 // The console's access token: read from a file given at start, compared in constant time.
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace viscera::console {
 
@@ -16,6 +17,12 @@ inline constexpr std::size_t kMaxTokenChars = 256;
 std::string read_token_file(const std::string& path);
 /// A warning when others than the file's owner may read the token file (empty otherwise).
 std::string token_file_warning(const std::string& path);
+
+/// Whether a WebSocket upgrade with this Origin header may open: none (not a browser: the token
+/// still decides), the console's own address (`host`, the request's Host header, as http:// or
+/// https://), or one of `allowed` (a proxy's address, a Foxglove web app), exactly. A page of
+/// another site that learnt the token cannot open a session from the user's browser.
+bool origin_allowed(std::string_view origin, std::string_view host, const std::vector<std::string>& allowed);
 
 /// Whether `given` equals `token`, in time that depends on the token's length only (never on
 /// where the two first differ).
