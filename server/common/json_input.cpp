@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/plain_name.hpp"
 
 namespace viscera::common {
 
@@ -201,7 +202,9 @@ std::string JsonObject::text(const char* key) const {
   if (!has(key)) fail(key, "missing");
   const json& v = value_[key];
   if (!v.is_string()) fail(key, show_json(v) + " is not a string");
-  return v.get<std::string>();
+  std::string s = v.get<std::string>();
+  if (has_control_characters(s)) fail(key, "'" + printable(s, 80) + "' holds a control character (a newline, an escape): text fields are printed");
+  return s;
 }
 
 std::string JsonObject::text(const char* key, const std::string& fallback) const { return has(key) ? text(key) : fallback; }

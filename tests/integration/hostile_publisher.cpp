@@ -2,11 +2,14 @@
 // another schema, NaN positions, commands for an instrument the sender does not own, and commands
 // and releases for an instrument the scene does not have.
 // Usage: hostile_publisher DOMAIN SECONDS
+//        hostile_publisher DOMAIN release INSTRUMENT CLIENT   (a release under another process's
+//        client id, as a second run of a client under one id sends it; prints when, Unix seconds)
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 #include <thread>
 
 #include "viscera/protocol/dds.hpp"
@@ -15,12 +18,24 @@
 using namespace viscera::protocol;
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: hostile_publisher DOMAIN SECONDS\n");
+  if (argc != 3 && !(argc == 5 && std::string(argv[2]) == "release")) {
+    std::fprintf(stderr, "usage: hostile_publisher DOMAIN SECONDS | DOMAIN release INSTRUMENT CLIENT\n");
     return 2;
   }
   Participant p(static_cast<std::uint32_t>(std::atoi(argv[1])));
   Writer commands(p, Stream::instrument_command), sessions(p, Stream::session_request);
+  if (argc == 5) {
+    SessionRequest r;
+    r.client_id = static_cast<std::uint32_t>(std::atoi(argv[4]));
+    r.action = Action::release_instrument;
+    r.instrument_id = static_cast<std::uint32_t>(std::atoi(argv[3]));
+    sessions.wait_for_readers(std::chrono::seconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the server's reader knows this writer
+    sessions.write(r.client_id, encode(r));
+    std::printf("released at %.6f\n", 1e-9 * static_cast<double>(now_ns()));
+    sessions.wait_for_acks(std::chrono::seconds(2));
+    return 0;
+  }
   std::mt19937_64 rng(99);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[2]));
   long sent = 0;

@@ -68,6 +68,16 @@ TEST(JsonInput, NestingIsBoundedSoNoInputCanExhaustTheStack) {
   EXPECT_NE(error_of([&] { JsonObject(j, "f.json"); }).find("is not an object"), std::string::npos);
 }
 
+TEST(JsonInput, TextFieldsHoldNoControlCharactersForTheTerminal) {
+  const nlohmann::json j = parse_json(R"({"a": "liver \u00e9", "b": "\u001b]0;owned\u0007", "c": "two\nlines", "d": "c1 \u009b2J"})", "f.json");
+  const JsonObject o(j, "f.json");
+  EXPECT_EQ(o.text("a"), "liver \xC3\xA9");  // UTF-8 is text
+  EXPECT_EQ(error_of([&] { o.text("b"); }),
+            "f.json: b: '\\x1B]0;owned\\x07' holds a control character (a newline, an escape): text fields are printed");
+  EXPECT_NE(error_of([&] { o.text("c"); }).find("holds a control character"), std::string::npos);
+  EXPECT_NE(error_of([&] { o.text("d"); }).find("holds a control character"), std::string::npos);  // a C1 control in UTF-8
+}
+
 TEST(JsonInput, AByteOrderMarkIsSkipped) { EXPECT_EQ(parse_json("\xEF\xBB\xBF{\"a\": 2}", "bom.json")["a"].get<int>(), 2); }
 
 TEST(JsonInput, FieldsAreCheckedForTypeRangeAndWholeness) {

@@ -55,10 +55,15 @@ exercise "$tmp/nul.json" '"a\u0000b"' '"liver"'
 exercise "$tmp/tty.json" '"\u001b]0;owned\u0007"' '"liver"'
 exercise "$tmp/path.json" '"drill"' '"../../etc/passwd"'
 expect exercise-name-path 2 "escape.json: name: '../../escaped' is not a plain name" -- "$trainer" score "$tmp/escape.json" x.mcap --report-dir "$tmp/r"
-expect exercise-name-nul 2 "nul.json: name: 'a\\x00b' is not a plain name" -- "$trainer" score "$tmp/nul.json" x.mcap --report-dir "$tmp/r"
-expect exercise-name-tty 2 "tty.json: name: '\\x1B]0;owned\\x07' is not a plain name" -- "$trainer" score "$tmp/tty.json" x.mcap
+expect exercise-name-nul 2 "nul.json: name: 'a\\x00b' holds a control character" -- "$trainer" score "$tmp/nul.json" x.mcap --report-dir "$tmp/r"
+expect exercise-name-tty 2 "tty.json: name: '\\x1B]0;owned\\x07' holds a control character" -- "$trainer" score "$tmp/tty.json" x.mcap
 expect exercise-scene-path 2 "path.json: scene: '../../etc/passwd' is not a scene" -- "$trainer" run "$tmp/path.json"
 [ ! -e "$tmp/escaped.json" ] && [ ! -e "$tmp/../escaped.json" ] && passed=$((passed+1)) || fail "a report escaped its folder"
+
+# Text from files that programs print holds no control characters (an escape sequence would reach
+# the terminal of whoever runs viscera-control show or the server).
+sed 's/"name": "liver"/"name": "\\u001b]0;owned\\u0007liver"/' "$tmp/scenes/liver.json" > "$tmp/tty-scene.json"
+expect scene-name-escape 2 "tty-scene.json: name: '\x1B]0;owned\x07liver' holds a control character" -- "$server" --scene "$tmp/tty-scene.json"
 
 # 4. No program writes over a file it reads, whatever the name it is given by.
 mkdir -p "$tmp/ex"; cp "$src/data/exercises/force-drill.json" "$tmp/ex/force-drill.json"; cp "$tmp/ex/force-drill.json" "$tmp/drill.copy"

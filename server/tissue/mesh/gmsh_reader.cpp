@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/plain_name.hpp"
 #include "viscera/tissue/mesh/mesh_builder.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/mesh/text_cursor.hpp"
@@ -177,6 +178,7 @@ void read_physical_names(TextCursor& in, MeshBuilder& b) {
     const auto first = name.find_first_not_of(" \t\r"), last = name.find_last_not_of(" \t\r");
     name = first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
     if (name.size() < 2 || name.front() != '"' || name.back() != '"') in.fail("physical name", "'" + printable(name) + "' is not a quoted name");
+    if (common::has_control_characters(name)) in.fail("physical name", "'" + printable(name) + "' holds a control character (names are printed)");
     if (dim == 3) b.name_group(static_cast<int>(tag), name.substr(1, name.size() - 2));
   }
   expect(in, "$EndPhysicalNames");
