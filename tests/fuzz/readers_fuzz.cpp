@@ -1,6 +1,8 @@
 // libFuzzer target for every reader of a file a user edits or hands over: scene, material,
 // data set (its dataset.json and its CSV), fitted model, the Gmsh, legacy VTK and VTU mesh
-// readers, the MCAP reader of session recordings and the trainer's exercise files. Whatever the bytes, a reader returns or throws InputError (one
+// readers, the MCAP reader of session recordings (with the integrity judgement and recover) and the
+// trainer's exercise files; JSON nested past the bound (seeded 100,000 deep); and the rule for names
+// that become paths (a plain name never leaves its folder nor carries a control character). Whatever the bytes, a reader returns or throws InputError (one
 // line naming the file); any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan + UBSan by
 // tests/fuzz/run_fuzz.sh).
 //
@@ -16,7 +18,9 @@
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/plain_name.hpp"
 #include "viscera/lab/dataset.hpp"
+#include "viscera/mcap/integrity.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/tissue/material/material_file.hpp"
@@ -62,13 +66,23 @@ void read_mcap(const std::string& path) {
     for (const auto& m : summary->metadata) (void)reader.read_metadata(m);
   }
   (void)viscera::mcap::recover(path, (folder() / "recovered.mcap").string());
+  viscera::mcap::McapReader again(path);
+  (void)viscera::mcap::check_integrity(again);
+}
+
+/// A name the rule accepts stays inside its folder and prints as itself.
+void check_plain_name(std::string_view name) {
+  if (!viscera::common::is_plain_name(name)) return;
+  const std::filesystem::path dir("/reports");
+  const auto inside = (dir / std::string(name)).lexically_normal();
+  if (inside.parent_path() != dir || viscera::common::has_control_characters(name) || viscera::common::printable(name, 100) != name) __builtin_trap();
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  const std::uint8_t pick = data[0] % 11;
+  const std::uint8_t pick = data[0] % 12;
   ++data;
   --size;
   using namespace viscera;
@@ -95,6 +109,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 8: (void)common::parse_json(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json"); break;
       case 9: read_mcap(write("session.mcap", data, size)); break;
       case 10: (void)training::read_exercise_file(write("exercise.json", data, size)); break;
+      case 11: check_plain_name(std::string_view(reinterpret_cast<const char*>(data), size)); break;
     }
   } catch (const common::InputError&) {
     // the one error a reader may give

@@ -30,6 +30,11 @@ seed 6 "$src/data/titin-passive-muscle/dataset.json"
 for f in "$src"/data/titin-passive-muscle/*.csv; do seed 7 "$f"; done
 "$out/mcap_seeds" "$out/seeds-mcap"
 for f in "$out"/seeds-mcap/*.mcap; do seed 9 "$f"; done
+# Nesting far past the bound, for every JSON reader (a recursion per level crashed them).
+python3 -c "print('['*100000 + ']'*100000)" > "$out/deep.json"
+for k in 0 1 6 8 10; do seed "$k" "$out/deep.json"; done
+# Names that become paths.
+for n in force-drill ../../escaped .hidden 'a/b' "$(printf 'a\033b')" liver.json; do printf '\013%s' "$n" > "$seeds/11-$(echo "$n" | tr -c 'a-z' _)"; done
 printf '\002{"model": "m", "fitted_to": "d", "units": "SI", "mechanisms": ["broadband_relaxation", "strain_stiffening"], "modulus_pa": 1000, "viscosity_pa_s": 10, "relaxation_time_s": [0.1, 10], "relaxation_modulus_pa": [100, 50], "stiffening_b": 3}' > "$seeds/2-model.json"
 "$out/readers_fuzz" -max_total_time="$seconds" -max_len=262144 -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
   "$out/corpus-readers" "$seeds" 2>&1 | tail -8
