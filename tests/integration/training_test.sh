@@ -75,6 +75,14 @@ with open(sys.argv[3], "w") as f:
 print(f"wrong place: ({x:.3f}, {y:.3f}) m, {((x - cx) ** 2 + (y - cy) ** 2) ** 0.5 * 1000:.0f} mm from the nodule's centre across")
 PY
 perform palpation_bad palpation 3 --instrument 1 --trajectory "$tmp/wrong-place.csv" --frame scene --quiet
+# A trainer stopped by a signal mid-exercise says so (it used to blame the instrument).
+"$trainer" run "$ex/force-drill.json" --domain "$domain" > "$tmp/stopped.log" 2>&1 & tr=$!
+wait_for "trainer: exercise" "$tmp/stopped.log" 300 || true
+"$hc" --domain "$domain" --client-id 21 --instrument 1 --script hold --force 1.0 --duration 2 --quiet > /dev/null 2>&1
+kill -TERM $tr; wait $tr; rc_stopped=$?
+grep -iE "stopped" "$tmp/stopped.log"
+check "a trainer stopped by SIGTERM says it was stopped (rc $rc_stopped)" \
+  "grep -q 'the trainer was stopped (SIGINT or SIGTERM)' '$tmp/stopped.log' && ! grep -q 'the instrument stopped' '$tmp/stopped.log'"
 kill -INT $server; wait $server; rc_server=$?
 grep region "$tmp/nodule.log"
 
