@@ -255,9 +255,11 @@ class Browser : public std::enable_shared_from_this<Browser> {
         // An instrument this browser took over is handed back when the browser goes, also if it
         // went before the server answered.
         if (type == RequestType::take_over && ok && (!b || b->closing_)) hand_back(*server, held);
+        // Handed back by any browser of this console (they share its client id): no longer anyone's to hand back.
+        if (type == RequestType::hand_back && ok)
+          for (auto& [id, other] : server->browsers) other->taken_.erase(held);
         if (!b) return;
         if (type == RequestType::take_over && ok) b->taken_.insert(held);
-        if (type == RequestType::hand_back && ok) b->taken_.erase(held);
         b->send_json(reply);
       });
     });

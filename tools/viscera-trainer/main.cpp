@@ -163,6 +163,11 @@ int main(int argc, char** argv) {
       throw UsageError("expected: run EXERCISE.json | score EXERCISE.json FILE.mcap (see --help)");
     const Exercise exercise = viscera::training::read_exercise_file(args[1]);
     // Before the work: the report never replaces a file this run reads.
+    if (const std::string dir = cl.text("report-dir"); !dir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(dir, ec);
+      if (ec || !std::filesystem::is_directory(dir)) throw viscera::common::InputError(dir, 0, "--report-dir", "is not a folder that can be written");
+    }
     if (!cl.text("report-dir").empty())
       for (const auto& f : report_files(cl.text("report-dir"), exercise.name))
         viscera::common::refuse_overwrite(f, {args.begin() + 1, args.end()}, "--report-dir");
