@@ -44,10 +44,27 @@ TEST(AccessToken, ReadsTheFirstLineAndRefusesShortOrBlankTokens) {
     vc::read_token_file(write_temp("short", "abc\n"));
     FAIL();
   } catch (const viscera::common::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("token: has 3 characters (at least 32"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("token: has 3 characters (32 to 256"), std::string::npos) << e.what();
   }
   EXPECT_THROW(vc::read_token_file(write_temp("blank", std::string(20, 'a') + " " + std::string(20, 'b'))), viscera::common::InputError);
   EXPECT_THROW(vc::read_token_file("/nonexistent/token"), viscera::common::InputError);
+  // Bounded: a long token, a large file, a device that never ends.
+  EXPECT_THROW(vc::read_token_file(write_temp("long", std::string(257, 'a') + "\n")), viscera::common::InputError);
+  EXPECT_EQ(vc::read_token_file(write_temp("longest", std::string(256, 'a') + "\n")), std::string(256, 'a'));
+  EXPECT_THROW(vc::read_token_file(write_temp("large", token + "\n" + std::string(5000, '#'))), viscera::common::InputError);
+  EXPECT_THROW(vc::read_token_file("/dev/zero"), viscera::common::InputError);
+}
+
+TEST(AccessToken, OnlyTheConsolesOwnOriginOrAnAllowedOneOpensASession) {
+  EXPECT_TRUE(vc::origin_allowed("", "127.0.0.1:8080", {}));  // not a browser: the token decides
+  EXPECT_TRUE(vc::origin_allowed("http://127.0.0.1:8080", "127.0.0.1:8080", {}));
+  EXPECT_TRUE(vc::origin_allowed("https://console.example:443", "console.example:443", {}));
+  EXPECT_FALSE(vc::origin_allowed("http://evil.example", "127.0.0.1:8080", {}));
+  EXPECT_FALSE(vc::origin_allowed("http://127.0.0.1:8081", "127.0.0.1:8080", {}));  // another port is another origin
+  EXPECT_FALSE(vc::origin_allowed("null", "127.0.0.1:8080", {}));
+  EXPECT_FALSE(vc::origin_allowed("http://127.0.0.1:8080", "", {}));
+  EXPECT_TRUE(vc::origin_allowed("https://proxy.example", "127.0.0.1:8080", {"https://proxy.example"}));
+  EXPECT_FALSE(vc::origin_allowed("https://proxy.example.evil", "127.0.0.1:8080", {"https://proxy.example"}));
 }
 
 TEST(AccessToken, MatchesExactlyTheToken) {

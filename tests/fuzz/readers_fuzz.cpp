@@ -2,8 +2,8 @@
 // data set (its dataset.json and its CSV), fitted model, the Gmsh, legacy VTK and VTU mesh
 // readers, the MCAP reader of session recordings (with the integrity judgement and recover) and the
 // trainer's exercise files; JSON nested past the bound (seeded 100,000 deep); and the rule for names
-// that become paths (a plain name never leaves its folder nor carries a control character). Whatever the bytes, a reader returns or throws InputError (one
-// line naming the file); any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan + UBSan by
+// that become paths (a plain name never leaves its folder nor carries a control character). Whatever the bytes, a reader returns or throws InputError
+// (one line naming the file); any other exception, a crash, a hang or an out-of-bounds read is a failure (built with ASan + UBSan by
 // tests/fuzz/run_fuzz.sh).
 //
 // The first byte picks the reader; the rest is the file. Files are written to a folder of this

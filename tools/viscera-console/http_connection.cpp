@@ -51,7 +51,8 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
       if (!ok) return respond(req, http::status::unauthorized, "text/plain", "the console's token is missing or wrong\n", false);
       const auto origin = req.find(http::field::origin);
       const auto host = req.find(http::field::host);
-      const std::string_view origin_text = origin == req.end() ? std::string_view() : std::string_view(origin->value().data(), origin->value().size());
+      const std::string_view origin_text =
+          origin == req.end() ? std::string_view() : std::string_view(origin->value().data(), origin->value().size());
       if (!origin_allowed(origin_text, host == req.end() ? std::string_view() : std::string_view(host->value().data(), host->value().size()),
                           server_->opt.allowed_origins)) {
         ++server_->counters.refused;

@@ -103,7 +103,8 @@ int main(int argc, char** argv) {
   cl.flag("outbox-kib", "KIB", "what may wait for one browser before its oldest forces and telemetry are dropped [KiB]", "4096");
   cl.flag("requests-per-s", "R", "requests a browser may send a second (bursts of twice that)", "20");
   cl.flag("recordings", "DIR", "session recordings (viscera-record) a browser may open for replay, each as a station of its own (none: no replays)");
-  cl.flag("allow-origin", "ORIGIN,...", "WebSocket origins allowed besides the console's own address (a proxy's https://HOST, a Foxglove web app)", "");
+  cl.flag("allow-origin", "ORIGIN,...", "WebSocket origins allowed besides the console's own address (a proxy's https://HOST, a Foxglove web app)",
+          "");
   cl.flag("replayer", "PATH", "the viscera-replay program (default: the one beside this program)");
   cl.flag("stats-every-s", "S", "print the browsers' traffic every S seconds (0: never)", "0");
   try {
