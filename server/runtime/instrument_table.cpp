@@ -109,8 +109,15 @@ std::vector<Ownership> InstrumentTable::release_silent(std::int64_t now_ns, std:
   std::vector<Ownership> released;
   for (auto& [id, e] : entries_)
     if (e.owner != 0 && now_ns - e.last_heard_ns > lease_ns) {
-      released.push_back({id, e.owner});
-      e = {};
+      const std::uint32_t back = e.taken_over ? e.taken_from : 0;
+      released.push_back({id, e.owner, back});
+      if (back != 0) {  // a console that took it over died or went silent: the trainee has it again
+        hand_over_locked(e, e.owner, back, now_ns);
+        e.taken_from = 0;
+        e.taken_over = false;
+      } else {
+        e = {};
+      }
     }
   return released;
 }

@@ -186,8 +186,15 @@ void SimulationServer::Impl::conclude(const proto::SessionRequest& req, bool acc
 void SimulationServer::Impl::release_silent(const Status& status) {
   const auto released = instruments.release_silent(proto::now_ns(), std::chrono::nanoseconds(proto::kLivelinessLease).count());
   for (const auto& o : released) {
-    if (status)
-      status("instrument " + std::to_string(o.instrument_id) + " released: client " + std::to_string(o.owner) + " silent for more than the lease");
+    const std::string id = "instrument " + std::to_string(o.instrument_id);
+    if (o.handed_back_to != 0) {
+      const std::string message = id + " handed back to client " + std::to_string(o.handed_back_to) + ": client " + std::to_string(o.owner) +
+                                  ", which had taken it over, silent for more than the lease";
+      if (status) status(message);
+      event(proto::EventKind::instrument_claimed, o.instrument_id, o.handed_back_to, message);
+      continue;
+    }
+    if (status) status(id + " released: client " + std::to_string(o.owner) + " silent for more than the lease");
     event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "owner silent for more than the lease");
   }
   if (!released.empty()) publish_scene();

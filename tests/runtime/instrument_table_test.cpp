@@ -124,6 +124,24 @@ TEST(InstrumentTable, TakeOverRemembersWhomFromAndHandsBackToThem) {
   EXPECT_EQ(t.take_over(9, 950, 42 * kMs).result, HandoverResult::unknown_instrument);
 }
 
+TEST(InstrumentTable, AnInstrumentWhoseTakerGoesSilentGoesBackToItsOwner) {
+  InstrumentTable t = table();
+  t.claim(1, 11, 0);
+  t.take_over(1, 950, 100 * kMs);  // the console takes it over, then dies (or its browser's bridge does)
+  t.command(command(1, 950, 1, 0.05), 200 * kMs);
+  EXPECT_TRUE(t.release_silent(700 * kMs, kLease).empty());
+  EXPECT_EQ(t.release_silent(700 * kMs + 1, kLease), (std::vector<Ownership>{{1, 950, 11}}));
+  EXPECT_EQ(t.owner(1), 11u);  // the trainee's again, not free for anyone
+  EXPECT_EQ(t.hand_back(1, 950, 701 * kMs).result, HandoverResult::not_owner);
+  // Its lease starts again: silent too, it is freed.
+  EXPECT_TRUE(t.release_silent(1200 * kMs + 1, kLease).empty());
+  EXPECT_EQ(t.release_silent(1201 * kMs + 1, kLease), (std::vector<Ownership>{{1, 11, 0}}));
+  EXPECT_EQ(t.owner(1), 0u);
+  // Taken over while free, the silent taker's instrument is freed.
+  t.take_over(3, 950, 2000 * kMs);
+  EXPECT_EQ(t.release_silent(2500 * kMs + 1, kLease), (std::vector<Ownership>{{3, 950, 0}}));
+}
+
 TEST(InstrumentTable, ANewSceneTakesEveryInstrumentFromItsOwner) {
   InstrumentTable t = table();
   t.claim(1, 11, 0);

@@ -29,6 +29,7 @@ struct Handover {
 /// An instrument and its owner (0: none).
 struct Ownership {
   std::uint32_t instrument_id = 0, owner = 0;
+  std::uint32_t handed_back_to = 0;  ///< release_silent: the client a silent taker had taken it from, who has it again (0: freed)
   bool operator==(const Ownership&) const = default;
 };
 
@@ -64,7 +65,8 @@ class InstrumentTable {
   /// sequence is newer; renews the owner's lease either way.
   CommandResult command(const protocol::Command& command, std::int64_t now_ns);
   /// Owners silent (no claim or command) for longer than `lease_ns` at `now_ns` lose their
-  /// instruments; returns them.
+  /// instruments; returns them. An instrument a silent owner had taken over goes back to the client
+  /// it was taken from (whose lease starts again), as a hand-back would; any other is freed.
   std::vector<Ownership> release_silent(std::int64_t now_ns, std::int64_t lease_ns);
 
   /// The owner (0: none), or nullopt for an instrument the scene does not have.
