@@ -135,8 +135,9 @@ int recover(const std::vector<std::string>& args) {
   std::uint64_t lost = 0;
   for (const auto& d : end.damaged) {
     lost += d.length;
+    const std::uint64_t end_byte = d.offset + d.length;
     std::printf("viscera-record: lost bytes %llu to %llu (%llu bytes): %s\n", static_cast<unsigned long long>(d.offset),
-                static_cast<unsigned long long>(d.offset + d.length), static_cast<unsigned long long>(d.length), d.what.c_str());
+                static_cast<unsigned long long>(end_byte), static_cast<unsigned long long>(d.length), d.what.c_str());
   }
   if (lost == 0) return 0;
   std::printf("viscera-record: %llu bytes of %s could not be recovered (exit 1)\n", static_cast<unsigned long long>(lost), in.c_str());
