@@ -5,6 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
+  ccache                   # compiled objects kept between builds and clones: a warm test run rebuilds only what changed
   libeigen3-dev            # dense/sparse linear algebra (Eigen 3.4)
   libsuitesparse-dev       # CHOLMOD sparse Cholesky for the implicit integrator
   libopenblas0-serial      # CHOLMOD's dense kernels: halves the 96k liver's load (the reference BLAS is slow)

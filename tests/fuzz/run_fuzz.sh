@@ -6,7 +6,12 @@
 set -euo pipefail
 build="$1"; src="$2"; seconds="$3"
 out="$build/fuzz"
-cmake -S "$src/tests/fuzz" -B "$out" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None \
+launcher=()
+if command -v ccache >/dev/null; then  # as deploy/build.sh: objects kept between runs and clones
+  export CCACHE_BASEDIR="$src" CCACHE_NOHASHDIR=true
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
+cmake -S "$src/tests/fuzz" -B "$out" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None "${launcher[@]}" \
   -DVISCERA_SOURCE="$src" -DVISCERA_BUILD="$build" > /dev/null
 cmake --build "$out" -j "$(nproc)"
 
