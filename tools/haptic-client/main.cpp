@@ -379,7 +379,7 @@ int main(int argc, char** argv) {
       "(with --hold: pulls up at 1 cm/s, holds HOLD seconds, then opens).\n"
       "Script 'hold': the probe presses until the force it feels is FORCE and holds it there (a force drill).\n"
       "Script 'palpate': the probe palpates the organ's top on a grid, pressing DEPTH beyond contact and judging each point\n"
-      "by the force half way (deeper, the tip slips off a stiff spot), and marks the centre of the stiff area\n"
+      "by the force held still half way (deeper, a thin lobe bends away), and marks the centre of the stiff area\n"
       "around the stiffest place with button 1 (a palpation exercise; it never reads where the nodule is).\n"
       "--trajectory FILE.csv plays a recorded or designed trajectory instead (docs/PROTOCOL.md).\n"
       "Prints force and command-to-force round trip live; --report writes every sample as JSON.\n"

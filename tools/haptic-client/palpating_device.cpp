@@ -9,6 +9,7 @@ namespace viscera::haptic {
 namespace {
 constexpr double kTravelSpeed = 0.2, kDescendSpeed = 0.1, kPressSpeed = 0.05, kLiftSpeed = 0.2;  // [m/s]
 constexpr double kDwellS = 0.05;  // at DEPTH before the force is noted [s]
+constexpr double kSettleS = 0.2, kSettleMeanS = 0.05;  // held at DEPTH / 2; the force is the mean over the hold's end [s]
 constexpr double kCoarse = 0.02, kFine = 0.01;  // grid spacings [m]
 constexpr double kCentreRadius = 1.5 * kFine;  // the stiff area's centre is weighed over the points this close to the stiffest [m]
 constexpr double kMargin = 0.15;  // of the organ's extent kept clear at its sides
@@ -118,56 +119,74 @@ client::DeviceSample PalpatingDevice::read(double t) {
       break;
     case Phase::press: {
       if (magnitude(force_) > kSafeForceN && !marking_) {
-        // The tissue pushes back hard enough to stop the press: judged by the force half way if
-        // the tip got there, else by the force that stopped it (a lump this hard so near the
-        // surface is the stiffest place there is); still left out if it leans (a slope).
-        if (z_ > contact_z_ - 0.5 * depth_) {
-          p.half_force_n = magnitude(force_);
-          p.half_vertical = force_[2] >= kMinVerticalShare * p.half_force_n;
-        }
-        p.force_n = p.half_vertical ? p.half_force_n : -1.0;
+        // The tissue pushes back hard enough to stop the press. Past the hold at half the depth,
+        // the point is judged by the force held there (the tissue is firm); before it, by
+        // nothing: a force that high so soon is the surface still moving from the last press,
+        // and the point is left out.
+        p.force_n = p.settled && p.half_vertical ? p.half_force_n : -1.0;
         if (verbose_) {
           std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.1f mm, stopped at %.3f N before %.0f mm%s\n", p.x, p.y, contact_z_,
                       p.half_force_n, 1e3 * std::min(contact_z_ - z_, 0.5 * depth_), magnitude(force_), 1000 * depth_,
-                      p.force_n < 0 ? " (steep: left out)" : "");
+                      !p.settled      ? " (before half way: left out)"
+                      : p.force_n < 0 ? " (steep: left out)"
+                                      : "");
           std::fflush(stdout);
         }
         phase_ = Phase::lift;
         break;
       }
-      if (z_ > contact_z_ - 0.5 * depth_) {
-        p.half_force_n = magnitude(force_);
-        p.half_vertical = p.half_force_n > 0 && force_[2] >= kMinVerticalShare * p.half_force_n;
-      }
       // The marking press goes half as deep: where the tip still holds on to the surface, so
       // that the mark is made touching the tissue.
-      const double depth = marking_ && current_ + 1 == probes_.size() ? 0.5 * depth_ : depth_;
+      const bool mark = marking_ && current_ + 1 == probes_.size();
+      const double depth = mark || !p.settled ? 0.5 * depth_ : depth_;
       z_ = std::max(contact_z_ - depth, z_ - kPressSpeed * dt);
       if (z_ <= contact_z_ - depth) {
-        phase_ = Phase::dwell;
+        phase_ = mark || p.settled ? Phase::dwell : Phase::settle;
         phase_t_ = t;
+        settle_sum_ = {};
+        settle_samples_ = 0;
       }
       break;
     }
-    case Phase::dwell:
-      if (marking_ && current_ + 1 == probes_.size()) buttons_ = t - phase_t_ < 0.5 * kDwellS ? 0u : 1u;  // the mark: button 1 pressed
-      if (t - phase_t_ >= kDwellS) {
-        // Judged at half the depth, where the tip still holds on to the surface: deeper, on a
-        // coarse mesh, it slips off a stiff spot and the force falls (in 26 of 47 presses on the
-        // 1.5k liver the force at 6 mm was below that at 3 mm, most of all over the nodule).
-        const double F = magnitude(force_);
-        p.force_n = p.half_vertical ? p.half_force_n : -1.0;
-        if (verbose_) {
-          std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s\n", p.x, p.y, contact_z_, p.half_force_n,
-                      500 * depth_, F, 1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
-          std::fflush(stdout);
-        }
-        buttons_ = 0;
-        phase_ = Phase::lift;
+    case Phase::settle:
+    case Phase::dwell: {
+      // Held still, at DEPTH / 2 and then at DEPTH; the force is the mean over the end of each
+      // hold. The marking press holds briefly, pressing button 1 for its second half.
+      const bool mark = marking_ && current_ + 1 == probes_.size();
+      const double hold = mark ? kDwellS : kSettleS;
+      if (mark) buttons_ = t - phase_t_ < 0.5 * kDwellS ? 0u : 1u;
+      if (t - phase_t_ >= hold - kSettleMeanS) {
+        for (int k = 0; k < 3; ++k) settle_sum_[k] += force_[k];
+        ++settle_samples_;
       }
+      if (t - phase_t_ < hold) break;
+      protocol::Vector3 mean{};
+      for (int k = 0; k < 3; ++k) mean[k] = settle_sum_[k] / std::max(1, settle_samples_);
+      const double F = magnitude(mean);
+      if (phase_ == Phase::settle) {
+        p.half_force_n = F;
+        p.half_vertical = F > 0 && mean[2] >= kMinVerticalShare * F;
+        p.settled = true;
+        phase_ = Phase::press;
+        break;
+      }
+      // Judged by the forces held at half the depth and at the full depth together: half way
+      // alone the lump is barely reached, and the full depth alone misleads where the tip slips
+      // sideways off a stiff spot and the force stops growing.
+      p.force_n = p.half_vertical ? p.half_force_n + F : -1.0;
+      if (verbose_ && !mark) {
+        std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s\n", p.x, p.y, contact_z_, p.half_force_n,
+                    500 * depth_, F, 1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
+        std::fflush(stdout);
+      }
+      buttons_ = 0;
+      phase_ = Phase::lift;
       break;
+    }
     case Phase::lift:
-      z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
+      // Slowly while touching, so that the tissue follows the tip back and is not left ringing
+      // for the next press; then fast.
+      z_ = std::min(safe_z_, z_ + (z_ < contact_z_ ? kPressSpeed : kLiftSpeed) * dt);
       if (z_ >= safe_z_) next_point();
       break;
     case Phase::done: break;

@@ -1,8 +1,10 @@
 #pragma once
 // A virtual device that palpates the organ from above to find what is stiffer inside it, as a
 // trainee's hand would: at each point of a grid over the organ's top (2 cm apart, then 1 cm apart
-// around the stiffest), it comes down until it touches, presses DEPTH further, notes the force it
-// feels half way (deeper, the tip slips off a stiff spot on a coarse mesh) and lifts off; then it
+// around the stiffest), it comes down until it touches, presses DEPTH / 2 further and holds still
+// there until the tissue settles, notes the force it feels then (the mean over the last 50 ms of
+// 0.2 s held: a force read while still moving measures how fast the tissue gets out of the way,
+// not how stiff it is), presses on to DEPTH and lifts off; then it
 // presses at the centre of the stiff area around the stiffest point and marks it (button 1). It
 // never reads the scene's regions: only the forces tell it where the nodule is. Where the surface
 // slopes steeply (the force it feels half way leans more than about 37 degrees from the vertical),
@@ -26,12 +28,13 @@ class PalpatingDevice : public client::Device {
   void render(const protocol::Vector3& force_n, bool in_contact) override;
 
  private:
-  enum class Phase { travel, descend, press, dwell, lift, done };
+  enum class Phase { travel, descend, press, settle, dwell, lift, done };
   struct Probe {
     double x = 0, y = 0;
     double force_n = -1;  ///< what the point is judged by: the force at DEPTH / 2; -1: not yet, no tissue, or steep
-    double half_force_n = 0;  ///< felt at DEPTH / 2
+    double half_force_n = 0;  ///< felt at DEPTH / 2, held still
     bool half_vertical = false;  ///< ... and mostly vertical there
+    bool settled = false;  ///< the hold at DEPTH / 2 is done
   };
   void next_point();
   /// The centre of the stiff area around `best`: the points within 1.5 cm of it, each weighted by
@@ -47,6 +50,8 @@ class PalpatingDevice : public client::Device {
   double safe_z_, bottom_, depth_;
   double x_, y_, z_, t_ = 0, phase_t_ = 0, contact_z_ = 0;
   protocol::Vector3 force_{};
+  protocol::Vector3 settle_sum_{};  // force summed over the end of the hold at DEPTH / 2 [N]
+  int settle_samples_ = 0;
   bool contact_ = false, verbose_ = false;
   std::uint32_t buttons_ = 0;
 };
