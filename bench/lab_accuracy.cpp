@@ -12,8 +12,7 @@
 #include <vector>
 
 #include "viscera/lab/analysis.hpp"
-
-#include "lab_protocols.hpp"
+#include "viscera/lab/lab_protocols.hpp"
 
 using namespace viscera::lab;
 

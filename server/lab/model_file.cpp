@@ -1,4 +1,4 @@
-#include "model_file.hpp"
+#include "viscera/lab/model_file.hpp"
 
 #include <fstream>
 

@@ -20,14 +20,13 @@
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/plain_name.hpp"
 #include "viscera/lab/dataset.hpp"
+#include "viscera/lab/model_file.hpp"
 #include "viscera/mcap/integrity.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/training/exercise.hpp"
-
-#include "model_file.hpp"
 
 namespace {
 

@@ -8,8 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "viscera/lab/analysis.hpp"
-
-#include "lab_protocols.hpp"
+#include "viscera/lab/lab_protocols.hpp"
 
 using namespace viscera::lab;
 

@@ -8,8 +8,7 @@
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
 #include "viscera/lab/stress_controlled.hpp"
-
-#include "synthetic_data.hpp"
+#include "viscera/lab/synthetic_data.hpp"
 
 using namespace viscera::lab;
 

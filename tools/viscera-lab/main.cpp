@@ -11,8 +11,8 @@
 #include "viscera/common/same_file.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/decimation.hpp"
+#include "viscera/lab/model_file.hpp"
 
-#include "model_file.hpp"
 #include "report.hpp"
 
 using namespace viscera::lab;

@@ -6,10 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/lab/fit.hpp"
+#include "viscera/lab/model_file.hpp"
 #include "viscera/lab/stress_controlled.hpp"
 #include "viscera/plot/svg_plot.hpp"
-
-#include "model_file.hpp"
 
 namespace viscera::lab {
 

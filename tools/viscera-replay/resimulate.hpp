@@ -1,7 +1,7 @@
 #pragma once
 // viscera-replay resimulate: a fresh lockstep server on the recorded scene, fed the recorded
 // commands and requests at the ticks the original applied them, every force, event and frame
-// compared (tools/recording: lockstep_plan.hpp, resimulation_check.hpp).
+// compared (client-sdk/recording: lockstep_plan.hpp, resimulation_check.hpp).
 #include <cstdint>
 #include <optional>
 #include <string>

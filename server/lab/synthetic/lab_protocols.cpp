@@ -1,4 +1,4 @@
-#include "lab_protocols.hpp"
+#include "viscera/lab/lab_protocols.hpp"
 
 #include <algorithm>
 #include <cmath>

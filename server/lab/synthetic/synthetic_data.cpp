@@ -1,4 +1,4 @@
-#include "synthetic_data.hpp"
+#include "viscera/lab/synthetic_data.hpp"
 
 #include <cmath>
 #include <functional>
