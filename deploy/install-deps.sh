@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev            # dense/sparse linear algebra (Eigen 3.4)
   libsuitesparse-dev       # CHOLMOD sparse Cholesky for the implicit integrator
   libopenblas0-serial      # CHOLMOD's dense kernels: halves the 96k liver's load (the reference BLAS is slow)
-  libspdlog-dev            # logging in programs (never in the tissue hot loops)
+  libspdlog-dev            # the services' log (viscera-server, viscera-console), never in the libraries
   libgtest-dev googletest  # unit and integration tests
   libbenchmark-dev         # bench/
   cyclonedds-dev cyclonedds-tools   # DDS C API, idlc, ddsperf

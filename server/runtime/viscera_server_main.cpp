@@ -11,6 +11,7 @@
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/program_log.hpp"
 #include "viscera/protocol/dds.hpp"
 #include "viscera/runtime/simulation_server.hpp"
 
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
   cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "100");
   cl.flag("partition", "NAME", "DDS partition of every stream (default: none; a replay or a re-simulation uses its own)", "");
   cl.option_switch("lockstep", "ticks advance when a driver says so (deterministic; no tick budget unless --max-tick-ms is given)");
+  cl.flag("log-file", "FILE", "append the log's lines to this file too (a service's log)", "");
   cl.option_switch("quiet", "no status lines");
   std::string scene, scene_dir;
   double duration = 0;
@@ -70,51 +72,47 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
     return 2;
   }
+  std::shared_ptr<spdlog::logger> log;
+  try {
+    log = viscera::common::program_log("viscera-server", cl.text("log-file"), {scene});
+  } catch (const viscera::common::InputError& e) {
+    std::fprintf(stderr, "viscera-server: %s\n", e.what());
+    return 2;
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
     // Building a large organ takes seconds (the 96k liver about 3 s): say so before it starts.
-    if (!quiet) {
-      std::printf("viscera-server: loading %s\n", scene.c_str());
-      std::fflush(stdout);
-    }
+    if (!quiet) log->info("loading {}", scene);
     const viscera::runtime::SceneSpec spec = viscera::runtime::read_scene_file(scene);
     viscera::runtime::DdsEndpoints endpoints(spec.domain_id, partition, lockstep);
     auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget, lockstep);
-    std::printf("viscera-server: %s%s\n", lockstep ? "lockstep, " : "", server->describe().c_str());
-    std::fflush(stdout);
+    log->info("{}{}", lockstep ? "lockstep, " : "", server->describe());
     g_running = true;
     const auto status = [&](const std::string& line) {
-      if (!quiet) {
-        std::printf("viscera-server: %s\n", line.c_str());
-        std::fflush(stdout);
-      }
+      if (!quiet) log->info("{}", line);
     };
     const auto stats = lockstep ? server->run_lockstep(g_stop, endpoints, status) : server->run(g_stop, duration, status);
-    std::printf(
-        "viscera-server: stopped after %llu ticks, %llu late, %llu missed slots, %llu physics resets, %llu forces sent, %llu messages rejected "
-        "(malformed %llu, not owner %llu, unknown instrument %llu), %llu mesh frames\n",
-        static_cast<unsigned long long>(stats.ticks), static_cast<unsigned long long>(stats.late_ticks),
-        static_cast<unsigned long long>(stats.missed_slots), static_cast<unsigned long long>(stats.physics_resets),
-        static_cast<unsigned long long>(stats.forces_sent), static_cast<unsigned long long>(stats.rejected),
-        static_cast<unsigned long long>(stats.rejected_malformed), static_cast<unsigned long long>(stats.rejected_not_owner),
-        static_cast<unsigned long long>(stats.rejected_unknown_instrument), static_cast<unsigned long long>(stats.mesh_frames));
+    log->info(
+        "stopped after {} ticks, {} late, {} missed slots, {} physics resets, {} forces sent, {} messages rejected "
+        "(malformed {}, not owner {}, unknown instrument {}), {} mesh frames",
+        stats.ticks, stats.late_ticks, stats.missed_slots, stats.physics_resets, stats.forces_sent, stats.rejected, stats.rejected_malformed,
+        stats.rejected_not_owner, stats.rejected_unknown_instrument, stats.mesh_frames);
     server.reset();  // leaves the DDS domain: clients see the server gone at once
     if (viscera::runtime::SimulationServer::abandoned_work() > 0) {
       // An organ still being built in the background is not waited for.
-      std::fflush(stdout);
-      std::fflush(stderr);
+      log->flush();
       std::quick_exit(0);
     }
     return 0;
   } catch (const viscera::common::InputError& e) {
-    std::fprintf(stderr, "viscera-server: %s\n", e.what());
+    log->error("{}", e.what());
     return 2;
   } catch (const viscera::protocol::DdsError& e) {
-    std::fprintf(stderr, "viscera-server: %s\n", e.what());
+    log->error("{}", e.what());
     return 3;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "viscera-server: %s\n", e.what());
+    log->error("{}", e.what());
     return 1;
   }
 }

@@ -38,7 +38,7 @@ done
 openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 cp "$tmp/token" "$tmp/loose-token"; chmod 644 "$tmp/loose-token"
 timeout 10 "$console" --token-file "$tmp/loose-token" --domain 999 > "$tmp/e5.txt" 2>&1
-check "a token file others may read is warned about" 'grep -q "warning: .*loose-token (mode 644) may be read by others" "$tmp/e5.txt"'
+check "a token file others may read is warned about" 'grep -q "warning viscera-console: .*loose-token (mode 644) may be read by others" "$tmp/e5.txt"'
 "$console" --token-file "$tmp/token" --listen 127.0.0.1:99999 > "$tmp/e3.txt" 2>&1; rc=$?
 check "a bad --listen is refused" '[ $rc -eq 2 ] && grep -q "port is not in" "$tmp/e3.txt"'
 check "a token file only its owner reads is not warned about" '! grep -q warning "$tmp/e3.txt"'

@@ -19,6 +19,7 @@
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/program_log.hpp"
 #include "viscera/console/access_token.hpp"
 #include "viscera/process/child_process.hpp"
 #include "viscera/protocol/dds.hpp"
@@ -107,14 +108,22 @@ int main(int argc, char** argv) {
           "");
   cl.flag("replayer", "PATH", "the viscera-replay program (default: the one beside this program)");
   cl.flag("stats-every-s", "S", "print the browsers' traffic every S seconds (0: never)", "0");
+  cl.flag("log-file", "FILE", "append the log's lines to this file too (a service's log)", "");
+  std::shared_ptr<spdlog::logger> logger;  // once the command line is read
+  const auto fail = [&](const std::string& message) {
+    if (logger)
+      logger->error("{}", message);
+    else
+      std::fprintf(stderr, "viscera-console: %s\n", message.c_str());
+  };
   try {
     if (!cl.parse(argc, argv)) return 0;
     if (!cl.has("token-file")) throw UsageError("--token-file is required (the access token: openssl rand -hex 16 > FILE)");
     const auto listen = parse_listen(cl.text("listen"));
+    logger = viscera::common::program_log("viscera-console", cl.text("log-file"), {cl.text("token-file")});
     viscera::console::WebOptions options;
     options.token = viscera::console::read_token_file(cl.text("token-file"));
-    if (const auto w = viscera::console::token_file_warning(cl.text("token-file")); !w.empty())
-      std::fprintf(stderr, "viscera-console: warning: %s\n", w.c_str());
+    if (const auto w = viscera::console::token_file_warning(cl.text("token-file")); !w.empty()) logger->warn("{}", w);
     const std::string token = options.token;
     options.files = read_page(cl.text("web-root"));
     options.allowed_origins = split(cl.text("allow-origin"), ',');
@@ -199,8 +208,7 @@ int main(int argc, char** argv) {
         }
         const std::size_t k = stations.size();
         stations.push_back(std::make_unique<viscera::console::Station>(domain, partition, client_id, force_period_s, make_sink(k)));
-        std::printf("viscera-console: replaying %s as station %s (log %s)\n", file.c_str(), partition.c_str(), log.c_str());
-        std::fflush(stdout);
+        logger->info("replaying {} as station {} (log {})", file, partition, log);
         return stations.back().get();
       };
     }
@@ -208,9 +216,7 @@ int main(int argc, char** argv) {
     web = server.get();
     const auto ep = server->endpoint();
     const std::string host = ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
-    std::printf("viscera-console: domain %u, %zu station(s); open http://%s:%u/?token=%s\n", domain, stations.size(), host.c_str(), ep.port(),
-                token.c_str());
-    std::fflush(stdout);
+    logger->info("domain {}, {} station(s); open http://{}:{}/?token={}", domain, stations.size(), host, ep.port(), token);
 
     // --discover: a station for every partition where a server's scene state appears (DDS
     // discovery), unless one is offered already (given, a replay opened here, or found before).
@@ -224,8 +230,7 @@ int main(int argc, char** argv) {
         const std::size_t k = stations.size();
         stations.push_back(std::make_unique<viscera::console::Station>(domain, partition, client_id, force_period_s, make_sink(k)));
         server->add_station(stations.back().get());
-        std::printf("viscera-console: a server appeared in partition %s: offered as station %s\n", name.c_str(), name.c_str());
-        std::fflush(stdout);
+        logger->info("a server appeared in partition {}: offered as station {}", name, name);
       }
       discovery_timer.expires_after(std::chrono::seconds(1));
       discovery_timer.async_wait([&](const boost::system::error_code& e) {
@@ -247,10 +252,8 @@ int main(int argc, char** argv) {
         if (ec) return;
         const auto s = server->stats();
         for (const auto& b : s["browsers"])
-          std::printf("viscera-console: browser %s: %.0f B/s, %s frames skipped, %s KiB waiting\n", b["address"].get<std::string>().c_str(),
-                      b["bytes_per_s"].get<double>(), b["frames_skipped"].dump().c_str(),
-                      std::to_string(b["queued_bytes"].get<std::size_t>() / 1024).c_str());
-        std::fflush(stdout);
+          logger->info("browser {}: {:.0f} B/s, {} frames skipped, {} KiB waiting", b["address"].get<std::string>(), b["bytes_per_s"].get<double>(),
+                       b["frames_skipped"].dump(), b["queued_bytes"].get<std::size_t>() / 1024);
         print_stats();
       });
     };
@@ -258,19 +261,19 @@ int main(int argc, char** argv) {
     io.run();
     web = nullptr;
     server.reset();
-    std::printf("viscera-console: stopped\n");
+    logger->info("stopped");
     return 0;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "viscera-console: %s\n", e.what());
     return 2;
   } catch (const viscera::common::InputError& e) {
-    std::fprintf(stderr, "viscera-console: %s\n", e.what());
+    fail(e.what());
     return 2;
   } catch (const boost::system::system_error& e) {
-    std::fprintf(stderr, "viscera-console: cannot listen on %s: %s\n", cl.text("listen").c_str(), e.code().message().c_str());
+    fail("cannot listen on " + cl.text("listen") + ": " + e.code().message());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "viscera-console: %s\n", e.what());
+    fail(e.what());
     return 1;
   }
 }
