@@ -9,6 +9,7 @@
 
 #include "viscera/common/percentile.hpp"
 #include "viscera/protocol/dds.hpp"
+#include "viscera/protocol/typed_reader.hpp"
 
 namespace viscera::client {
 
@@ -26,10 +27,15 @@ const char* to_string(ServerState s) {
 struct Client::Impl {
   proto::Participant participant;
   proto::Writer commands, sessions;
-  proto::Reader forces, scene;
+  proto::TypedReader<proto::Stream::force_feedback> forces;
+  proto::TypedReader<proto::Stream::scene_state> scene;
   std::optional<proto::Scene> last_scene;
   std::set<std::uint32_t> claimed;  // instruments this client claimed (another process may run under its id)
-  std::unique_ptr<proto::Reader> topology, frames, events, telemetry;  // created on first use
+  std::unique_ptr<proto::TypedReader<proto::Stream::surface_topology>> topology;  // created on first use
+  std::unique_ptr<proto::TypedReader<proto::Stream::mesh_frame>> frames;
+  std::unique_ptr<proto::TypedReader<proto::Stream::event>> events;
+  std::unique_ptr<proto::TypedReader<proto::Stream::telemetry>> telemetry;
+  proto::Rejections rejections;  // payloads of every stream that failed their decoder
   std::unique_ptr<proto::Writer> annotations;
   std::optional<proto::SurfaceTopology> surface;
   // The server's liveliness, as its scene-state writer's: set by a DDS listener thread.
@@ -42,9 +48,9 @@ struct Client::Impl {
       : participant(domain, partition),
         commands(participant, proto::Stream::instrument_command),
         sessions(participant, proto::Stream::session_request),
-        forces(participant, proto::Stream::force_feedback),
-        scene(participant, proto::Stream::scene_state) {
-    scene.on_alive_writers_changed([this](int alive) { liveliness(alive); });
+        forces(participant),
+        scene(participant) {
+    scene.raw().on_alive_writers_changed([this](int alive) { liveliness(alive); });
     liveliness(scene.alive_writers());  // a server discovered before the listener was set
   }
   void liveliness(int alive) {
@@ -59,15 +65,9 @@ struct Client::Impl {
     server = now;
     if (callback) callback(now);
   }
-  void take_scene(std::uint64_t& rejected) {
+  void take_scene() {
     if (scene_stale.exchange(false)) last_scene.reset();  // a restarted server publishes its own
-    scene.take([&](const proto::Received& r) {
-      std::string why;
-      if (auto s = proto::decode_scene(r.payload, &why))
-        last_scene = *s;
-      else
-        ++rejected;
-    });
+    scene.take([&](proto::Scene s, const proto::Received&) { last_scene = std::move(s); }, rejections);
   }
 };
 
@@ -79,14 +79,14 @@ std::optional<proto::Scene> Client::wait_for_scene(std::chrono::milliseconds tim
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
     impl_->scene.wait(std::chrono::milliseconds(50));
-    impl_->take_scene(rejected_);
+    impl_->take_scene();
     if (impl_->last_scene) return impl_->last_scene;
   }
   return std::nullopt;
 }
 
 std::optional<proto::Scene> Client::scene() {
-  impl_->take_scene(rejected_);
+  impl_->take_scene();
   return impl_->last_scene;
 }
 
@@ -98,7 +98,7 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
   // and holds it. Not asked for (a claim would renew that process's lease) until it lets it go.
   bool another_owner_seen = impl_->claimed.count(instrument_id) > 0;
   while (std::chrono::steady_clock::now() < end) {
-    impl_->take_scene(rejected_);
+    impl_->take_scene();
     if (const auto& s = impl_->last_scene) {
       // The scene state lists the instruments and their owners.
       const auto it = std::find_if(s->instruments.begin(), s->instruments.end(), [&](const auto& i) { return i.instrument_id == instrument_id; });
@@ -144,7 +144,7 @@ bool Client::control(proto::Action action, std::chrono::milliseconds timeout) {
     // A reset shows in no state: it is done once the server acknowledged the request.
     if (action == proto::Action::reset) return impl_->sessions.wait_for_acks(timeout);
     impl_->scene.wait(std::chrono::milliseconds(100));
-    impl_->take_scene(rejected_);
+    impl_->take_scene();
     if (impl_->last_scene && impl_->last_scene->paused == (action == proto::Action::pause)) return true;
   } while (std::chrono::steady_clock::now() < end);
   return false;
@@ -161,7 +161,7 @@ std::optional<proto::RequestOutcome> Client::request(proto::SessionRequest r, st
   impl_->sessions.write(client_id_, proto::encode(r));
   while (std::chrono::steady_clock::now() < end) {
     impl_->scene.wait(std::chrono::milliseconds(100));
-    impl_->take_scene(rejected_);
+    impl_->take_scene();
     if (impl_->last_scene)
       for (const auto& o : impl_->last_scene->recent_requests)
         if (o.client_id == client_id_ && o.request_seq == r.request_seq) return o;
@@ -227,24 +227,20 @@ void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, do
 
 std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
   const std::int64_t now = proto::now_ns();
-  impl_->forces.take([&](const proto::Received& r) {
-    std::string why;
-    const auto f = proto::decode_force(r.payload, &why);
-    if (!f) {
-      ++rejected_;
-      return;
-    }
-    if (f->client_id != client_id_) return;
-    if (f->step_time_ns > 0) {  // published after a tick (the immediate answers carry 0)
-      auto& end = tick_end_ns_[f->instrument_id];
-      end = std::max(end, f->server_stamp_ns);
-    }
-    auto& slot = latest_[f->instrument_id];
-    if (f->command_seq >= slot.command_seq) {
-      if (f->command_seq > slot.command_seq) rtt_us_.push_back(1e-3 * static_cast<double>(now - f->command_client_stamp_ns));
-      slot = *f;
-    }
-  });
+  impl_->forces.take(
+      [&](const proto::Force& f, const proto::Received&) {
+        if (f.client_id != client_id_) return;
+        if (f.step_time_ns > 0) {  // published after a tick (the immediate answers carry 0)
+          auto& end = tick_end_ns_[f.instrument_id];
+          end = std::max(end, f.server_stamp_ns);
+        }
+        auto& slot = latest_[f.instrument_id];
+        if (f.command_seq >= slot.command_seq) {
+          if (f.command_seq > slot.command_seq) rtt_us_.push_back(1e-3 * static_cast<double>(now - f.command_client_stamp_ns));
+          slot = f;
+        }
+      },
+      impl_->rejections);
   const auto it = latest_.find(instrument_id);
   if (it == latest_.end()) return std::nullopt;
   return it->second;
@@ -268,62 +264,49 @@ std::optional<proto::Force> Client::wait_force(std::uint32_t instrument_id, std:
 
 std::optional<proto::SurfaceTopology> Client::surface() {
   if (!impl_->topology) {
-    impl_->topology = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::surface_topology);
-    impl_->frames = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::mesh_frame);
+    impl_->topology = std::make_unique<proto::TypedReader<proto::Stream::surface_topology>>(impl_->participant);
+    impl_->frames = std::make_unique<proto::TypedReader<proto::Stream::mesh_frame>>(impl_->participant);
   }
-  impl_->topology->take([&](const proto::Received& r) {
-    std::string why;
-    if (auto t = proto::decode_surface_topology(r.payload, &why))
-      impl_->surface = std::move(*t);
-    else
-      ++rejected_;
-  });
+  impl_->topology->take([&](proto::SurfaceTopology t, const proto::Received&) { impl_->surface = std::move(t); }, impl_->rejections);
   return impl_->surface;
 }
 
 std::optional<proto::MeshFrame> Client::poll_mesh_frame() {
   const auto topology = surface();
   std::optional<proto::MeshFrame> newest;
-  impl_->frames->take([&](const proto::Received& r) {
-    std::string why;
-    auto f = proto::decode_mesh_frame(r.payload, &why);
-    if (f && (!topology || f->mesh_id > topology->mesh_id)) return;  // its topology (transient local) is still on its way
-    if (!f || !topology || f->mesh_id != topology->mesh_id || f->positions.size() != 3ull * topology->vertex_count) {
-      ++rejected_;
-      return;
-    }
-    ++mesh_frames_;
-    if (!newest || f->frame > newest->frame) newest = std::move(f);
-  });
+  impl_->frames->take(
+      [&](proto::MeshFrame f, const proto::Received&) {
+        if (!topology || f.mesh_id > topology->mesh_id) return;  // its topology (transient local) is still on its way
+        if (f.mesh_id != topology->mesh_id || f.positions.size() != 3ull * topology->vertex_count) {
+          impl_->rejections.add("mesh_frame: " + std::to_string(f.positions.size() / 3) + " vertices for mesh " + std::to_string(f.mesh_id) +
+                                ", whose topology has " + std::to_string(topology->vertex_count) + " (mesh " + std::to_string(topology->mesh_id) +
+                                ")");
+          return;
+        }
+        ++mesh_frames_;
+        if (!newest || f.frame > newest->frame) newest = std::move(f);
+      },
+      impl_->rejections);
   return newest;
 }
 
 std::vector<proto::Event> Client::poll_events() {
-  if (!impl_->events) impl_->events = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::event);
+  if (!impl_->events) impl_->events = std::make_unique<proto::TypedReader<proto::Stream::event>>(impl_->participant);
   std::vector<proto::Event> out;
-  impl_->events->take([&](const proto::Received& r) {
-    std::string why;
-    if (auto e = proto::decode_event(r.payload, &why))
-      out.push_back(std::move(*e));
-    else
-      ++rejected_;
-  });
+  impl_->events->take([&](proto::Event e, const proto::Received&) { out.push_back(std::move(e)); }, impl_->rejections);
   return out;
 }
 
 std::vector<proto::TelemetryReport> Client::poll_telemetry() {
-  if (!impl_->telemetry) impl_->telemetry = std::make_unique<proto::Reader>(impl_->participant, proto::Stream::telemetry);
+  if (!impl_->telemetry) impl_->telemetry = std::make_unique<proto::TypedReader<proto::Stream::telemetry>>(impl_->participant);
   std::vector<proto::TelemetryReport> out;
-  impl_->telemetry->take([&](const proto::Received& r) {
-    std::string why;
-    if (auto t = proto::decode_telemetry(r.payload, &why))
-      out.push_back(*t);
-    else
-      ++rejected_;
-  });
+  impl_->telemetry->take([&](proto::TelemetryReport t, const proto::Received&) { out.push_back(t); }, impl_->rejections);
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.server_stamp_ns < b.server_stamp_ns; });
   return out;
 }
+
+std::uint64_t Client::rejected() const { return impl_->rejections.count; }
+std::string Client::last_rejection() const { return impl_->rejections.last_reason; }
 
 void Client::annotate(const std::string& text) {
   if (text.size() > 1024) throw std::invalid_argument("annotation of " + std::to_string(text.size()) + " bytes (at most 1024)");

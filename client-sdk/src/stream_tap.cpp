@@ -3,14 +3,17 @@
 #include <map>
 #include <stdexcept>
 
+#include "viscera/protocol/streams.hpp"
+
 namespace viscera::client {
 
 namespace proto = viscera::protocol;
 
 std::vector<proto::Stream> session_streams() {
-  return {proto::Stream::instrument_command, proto::Stream::force_feedback, proto::Stream::session_request,
-          proto::Stream::scene_state,        proto::Stream::telemetry,      proto::Stream::surface_topology,
-          proto::Stream::mesh_frame,         proto::Stream::event,          proto::Stream::scene_files};
+  std::vector<proto::Stream> out;
+  for (const auto& s : proto::streams())
+    if (s.session) out.push_back(s.stream);
+  return out;
 }
 
 struct StreamTap::Impl {
@@ -23,7 +26,7 @@ StreamTap::StreamTap(std::uint32_t domain_id, const std::string& partition, cons
     : impl_(std::make_unique<Impl>(domain_id, partition)) {
   for (const proto::Stream s : streams) {
     // The streams whose history is their state (kept last per key) keep it; the others keep `depth`.
-    const bool state = s == proto::Stream::scene_state || s == proto::Stream::surface_topology || s == proto::Stream::scene_files;
+    const bool state = proto::stream_info(s).state;
     impl_->readers.emplace_back(s, std::make_unique<proto::Reader>(impl_->participant, s, proto::ReaderOptions{state ? 0 : depth}));
   }
 }

@@ -4,6 +4,8 @@
 
 #include <dds/dds.h>
 
+#include "viscera/protocol/streams.hpp"
+
 #include "envelope.h"
 
 namespace viscera::protocol {
@@ -21,39 +23,16 @@ dds_qos_t* qos_for(Stream s, const std::string& partition, const std::string& ro
     const char* names[] = {partition.c_str()};
     dds_qset_partition(q, 1, names);
   }
-  switch (s) {
-    case Stream::instrument_command:
-    case Stream::force_feedback:
-    case Stream::telemetry:
-      dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
-      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
-      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-      break;
-    case Stream::session_request:
-    case Stream::event:
-      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, s == Stream::event ? 64 : 16);
-      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-      break;
-    case Stream::mesh_frame:
-      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
-      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-      break;
-    case Stream::scene_state:
-    case Stream::surface_topology:
-    case Stream::scene_files:
-      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-      dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
-      dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
-      break;
-    case Stream::lockstep_step:
-    case Stream::lockstep_result:
-      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
-      dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
-      dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-      break;
-  }
+  const StreamInfo& info = stream_info(s);
+  if (info.reliability == Reliability::best_effort)
+    dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
+  else  // a writer blocks at most this long on a full history: long only where every sample must arrive (keep all)
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, info.depth == 0 ? DDS_SECS(10) : DDS_MSECS(100));
+  if (info.depth == 0)
+    dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
+  else
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, info.depth);
+  dds_qset_durability(q, info.durability == Durability::transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   // A client that dies or goes silent loses its liveliness within this lease.
   dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(kLivelinessLease.count()));
   return q;
@@ -62,22 +41,7 @@ dds_qos_t* qos_for(Stream s, const std::string& partition, const std::string& ro
 
 DdsError::DdsError(const std::string& what, int32_t code) : std::runtime_error("DDS: " + what + ": " + dds_strretcode(code)) {}
 
-const char* topic_name(Stream s) {
-  switch (s) {
-    case Stream::instrument_command: return "viscera_instrument_command";
-    case Stream::force_feedback: return "viscera_force_feedback";
-    case Stream::session_request: return "viscera_session_request";
-    case Stream::scene_state: return "viscera_scene_state";
-    case Stream::telemetry: return "viscera_telemetry";
-    case Stream::surface_topology: return "viscera_surface_topology";
-    case Stream::mesh_frame: return "viscera_mesh_frame";
-    case Stream::event: return "viscera_event";
-    case Stream::scene_files: return "viscera_scene_files";
-    case Stream::lockstep_step: return "viscera_lockstep_step";
-    case Stream::lockstep_result: return "viscera_lockstep_result";
-  }
-  return "?";
-}
+const char* topic_name(Stream s) { return stream_info(s).topic; }
 
 const char* stream_name(Stream s) { return topic_name(s) + std::strlen("viscera_"); }
 

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <mutex>
 
 #include <spdlog/sinks/base_sink.h>
@@ -36,9 +37,7 @@ std::shared_ptr<spdlog::logger> program_log(const std::string& program, const st
   std::vector<spdlog::sink_ptr> sinks{std::make_shared<ConsoleSink>()};
   if (!file.empty()) {
     refuse_overwrite(file, inputs, "--log-file");
-    if (std::FILE* f = std::fopen(file.c_str(), "a"))
-      std::fclose(f);
-    else
+    if (!std::ofstream(file, std::ios::app))
       throw InputError(file, 0, "--log-file", std::string("cannot be opened for appending: ") + std::strerror(errno));
     sinks.push_back(std::make_shared<spdlog::sinks::basic_file_sink_mt>(file, false));
   }

@@ -9,6 +9,7 @@
 #include "viscera/console/console_wire.hpp"
 #include "viscera/console/force_decimator.hpp"
 #include "viscera/console/foxglove_protocol.hpp"
+#include "viscera/protocol/streams.hpp"
 
 namespace viscera::console {
 
@@ -57,8 +58,7 @@ void Station::stream_loop() {
     const bool raw = sink_.wants_raw && sink_.wants_raw();
     tap.take([&](const client::TapSample& s) {
       // The state streams always (the bridge keeps their newest for Foxglove clients that come later).
-      const bool state =
-          s.stream == proto::Stream::scene_state || s.stream == proto::Stream::surface_topology || s.stream == proto::Stream::scene_files;
+      const bool state = proto::stream_info(s.stream).state;
       if (raw || state) sink_.raw(s.stream, s.stamp_ns, std::make_shared<const std::vector<std::uint8_t>>(s.payload.begin(), s.payload.end()));
       std::string why;
       switch (s.stream) {

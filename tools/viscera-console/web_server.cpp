@@ -16,6 +16,7 @@
 #include "viscera/console/foxglove_protocol.hpp"
 #include "viscera/console/rate_limit.hpp"
 #include "viscera/console/recordings.hpp"
+#include "viscera/protocol/streams.hpp"
 
 #include "web_server_impl.hpp"
 
@@ -438,8 +439,7 @@ bool WebServer::wants_raw() const { return impl_->foxglove_browsers > 0; }
 void WebServer::post_raw(std::size_t station, protocol::Stream stream, std::int64_t stamp_ns,
                          std::shared_ptr<const std::vector<std::uint8_t>> payload) {
   asio::post(impl_->io, [impl = impl_, station, stream, stamp_ns, payload = std::move(payload)] {
-    if (stream == protocol::Stream::scene_state || stream == protocol::Stream::surface_topology || stream == protocol::Stream::scene_files)
-      impl->latched[station][stream] = {stamp_ns, payload};
+    if (protocol::stream_info(stream).state) impl->latched[station][stream] = {stamp_ns, payload};
     for (auto& [id, b] : std::map(impl->browsers))
       if (b->station() == station) b->send_raw(stream, stamp_ns, *payload);
   });

@@ -14,6 +14,7 @@
 #include "viscera/client/stream_tap.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/protocol/messages.hpp"
+#include "viscera/protocol/streams.hpp"
 #include "viscera/recording/playback_clock.hpp"
 #include "viscera/recording/recording.hpp"
 
@@ -103,13 +104,13 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
     s.recent_requests.insert(s.recent_requests.end(), outcomes.begin(), outcomes.end());
     publisher.publish(proto::Stream::scene_state, 0, proto::encode(s));
   };
-  // What a client joining at recording time `t` must have: the newest scene state and surface
-  // topology before it.
+  // What a client joining at recording time `t` must have: the newest sample of each state stream
+  // (scene state, surface topology, scene files) before it.
   const auto prime = [&](std::uint64_t t) {
     std::map<std::pair<proto::Stream, std::uint32_t>, std::vector<std::uint8_t>> last;
     recording.for_each(
         [&](const rec::RecordedChannel& ch, const mcap::Message& m) {
-          if (ch.stream == proto::Stream::scene_state || ch.stream == proto::Stream::surface_topology) last[{ch.stream, ch.source_id}] = m.data;
+          if (proto::stream_info(ch.stream).state) last[{ch.stream, ch.source_id}] = m.data;
           return true;
         },
         t0, t);

@@ -123,7 +123,9 @@ class Client {
   /// Calls `f` on a DDS thread each time server_state() changes. Keep it short (set a flag).
   void on_server_state(std::function<void(ServerState)> f);
   /// Payloads that failed verification and were dropped.
-  std::uint64_t rejected() const { return rejected_; }
+  std::uint64_t rejected() const;
+  /// Why the newest of them was ("force_feedback: force: not finite"); "" if none was.
+  std::string last_rejection() const;
 
  private:
   struct Impl;
@@ -131,7 +133,7 @@ class Client {
   std::uint32_t client_id_;
   std::optional<protocol::RequestOutcome> request(protocol::SessionRequest r, std::chrono::milliseconds timeout);
 
-  std::uint64_t seq_ = 0, rejected_ = 0, mesh_frames_ = 0;
+  std::uint64_t seq_ = 0, mesh_frames_ = 0;
   std::uint64_t request_seq_ = 0;  // starts at the clock: a restarted client never matches its old outcomes
   std::vector<double> rtt_us_;
   std::map<std::uint32_t, protocol::Force> latest_;
