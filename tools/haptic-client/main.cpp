@@ -19,8 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/client/client.hpp"
-#include "viscera/client/local_force_model.hpp"
-#include "viscera/client/tick_phase.hpp"
+#include "viscera/client/device_runner.hpp"
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
@@ -163,17 +162,11 @@ std::unique_ptr<viscera::client::Device> make_device(const Options& o, const vis
   return std::make_unique<viscera::haptic::TrajectoryDevice>(o.trajectory_file, o.trajectory, origin);
 }
 
-/// What the device loop saw, for the summary and the report.
-struct RunResult {
-  std::uint64_t clamps = 0, phased = 0, near_phase = 0;  // periods timed by the phase lock; of them within 50 us of the target
+/// What the run saw, for the summary and the report: the SDK loop's result, and what this
+/// program keeps besides (every period's numbers for --report, the surface frames).
+struct RunResult : viscera::client::DeviceRunResult {
   std::vector<ForceSample> samples;
   MeshWatch mesh;
-  double server_lost_t_s = -1;  // when the client noticed the server was gone (-1: never)
-  double faded_t_s = -1;  // when the rendered force had faded to zero after that
-  int server_returns = 0;  // --reconnect: servers claimed again after a loss
-  bool lost = false;  // ended because the server was gone
-  int taken_over = 0;  // times another client (an instructor's console) took the instrument over
-  double instrument_lost_t_s = -1;  // when the client noticed its instrument was no longer its own (-1: never)
 };
 
 void print_live(const Options& o, viscera::client::Client& client, double t, const Vector3& tip, const viscera::protocol::Force& f,
@@ -185,163 +178,40 @@ void print_live(const Options& o, viscera::client::Client& client, double t, con
   std::fflush(stdout);
 }
 
-/// The device loop: read the device, send the tip, render the server's local model, keep the
-/// phase after the server's ticks, claim again after a scene load, and fade out when the server
-/// goes away.
+/// The SDK's device loop (device_runner.hpp), with this program's live lines, report samples and
+/// surface frames as its hooks.
 RunResult run_device(const Options& o, viscera::client::Client& client, viscera::client::Device& device, std::uint32_t generation) {
   RunResult run;
-  // Tip of each of the last 4096 commands, for the local model (a ring: no allocation per period).
-  struct Sent {
-    std::uint64_t seq = 0;
-    Vector3 tip{};
-  };
-  std::vector<Sent> sent(4096);
-  std::uint64_t seq = 0, model_seq = 0;
-  viscera::client::LocalForceRenderer renderer(o.max_force_n, o.blend_s, o.fade);
   run.mesh.record = !o.report.empty();
   // Reserved up front so the loop never reallocates (pages are touched only as samples come).
   if (!o.report.empty()) run.samples.reserve(static_cast<std::size_t>(std::min(o.duration_s * o.rate_hz + 16, double{1 << 22})));
-  const auto period = std::chrono::nanoseconds(static_cast<long long>(1e9 / o.rate_hz));
-  const auto start = std::chrono::steady_clock::now();
-  auto next = start;
-  // Commands timed to arrive just after a physics tick, in the server's idle time (tick_phase.hpp).
-  std::optional<viscera::client::TickPhase> phase;
-  if (o.tick_phase_us >= 0) phase.emplace(period, std::chrono::nanoseconds(std::llround(o.tick_phase_us * 1e3)));
-  const auto rate_matches = [&](const viscera::protocol::Scene& s) { return std::abs(s.physics_rate_hz - o.rate_hz) <= 0.01 * o.rate_hz; };
-  bool in_phase_possible = true, standing_by = false;
-  Vector3 last_tip{};
-  double last_print = -1, last_scene_check = 0;
-  for (;;) {
-    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (t >= o.duration_s) break;
-    const auto server = client.server_state();
-    if (server == viscera::client::ServerState::lost && run.server_lost_t_s < 0) {
-      run.server_lost_t_s = t;
-      renderer.server_lost(t);
-      std::printf("t = %5.2f s  the server is gone (no DDS liveliness); the force fades to zero over %.2f s\n", t, o.fade.fade_s);
-      std::fflush(stdout);
-    }
-    if (run.lost) break;  // the period after the force reached zero: it was rendered, and recorded
-    if (run.server_lost_t_s >= 0 && run.faded_t_s < 0 && renderer.gain(t) == 0) {
-      run.faded_t_s = t;
-      run.lost = !o.reconnect;  // this period still renders (zero), then the loop ends
-      if (o.reconnect) {
-        std::printf("t = %5.2f s  waiting for a server to come back (--reconnect)\n", t);
-        std::fflush(stdout);
-      }
-    }
-    if (run.faded_t_s >= 0 && server == viscera::client::ServerState::alive) {  // --reconnect: a server is back
-      const auto again = client.claim(o.instrument, std::chrono::seconds(5));
-      std::printf("t = %5.2f s  a server is back: instrument %u %s\n", t, o.instrument,
-                  again ? "claimed again" : ("not claimed: " + again.why).c_str());
-      std::fflush(stdout);
-      if (const auto now = client.scene()) generation = now->generation;
-      run.server_lost_t_s = run.faded_t_s = -1;
-      ++run.server_returns;
-      next = std::chrono::steady_clock::now();
-      continue;
-    }
-    if (t - last_scene_check >= 0.1 && run.server_lost_t_s < 0) {  // a scene loaded at run time releases every instrument: claim it again
-      last_scene_check = t;
-      const auto now = client.scene();
-      if (now) in_phase_possible = rate_matches(*now);  // the physics rate may change at run time
-      // An instructor may take the instrument over (and hand it back): meanwhile this client sends
-      // nothing (its commands would be refused) and the force it renders fades out.
-      if (now && now->generation == generation) {
-        const auto it = std::find_if(now->instruments.begin(), now->instruments.end(),
-                                     [&](const viscera::protocol::InstrumentInfo& i) { return i.instrument_id == o.instrument; });
-        const std::uint32_t owner = it == now->instruments.end() ? 0 : it->owner_client_id;
-        const bool taken = owner != 0 && owner != client.id();
-        // Free, though this client claimed it and drove it: another process under this client id
-        // released it (or the server released it for silence). The commands would all be refused:
-        // the force fades and the run ends, saying so.
-        if (owner == 0 && !standing_by && run.instrument_lost_t_s < 0) {
-          run.instrument_lost_t_s = t;
-          renderer.server_lost(t);
-          std::printf(
-              "t = %5.2f s  instrument %u is no longer this client's (the server shows it free: released by another client with "
-              "client id %u?); the force fades to zero over %.2f s\n",
-              t, o.instrument, client.id(), o.fade.fade_s);
-          std::fflush(stdout);
-        }
-        if (taken != standing_by) {
-          standing_by = taken;
-          run.taken_over += taken;
-          if (taken) renderer.server_lost(t);
-          std::printf(taken ? "t = %5.2f s  instrument %u taken over by client %u: this device stands by until it is handed back\n"
-                            : "t = %5.2f s  instrument %u handed back (owner client %u): driving it again\n",
-                      t, o.instrument, owner);
-          std::fflush(stdout);
-        }
-      }
-      if (now && now->generation != generation) {
-        generation = now->generation;
-        standing_by = false;
-        const auto again = client.claim(o.instrument, std::chrono::seconds(2));
-        std::printf("t = %5.2f s  the server loaded scene %s: instrument %u %s\n", t, now->name.c_str(), o.instrument,
-                    again ? "claimed again" : ("could not be claimed again: " + again.why).c_str());
-        std::fflush(stdout);
-        next = std::chrono::steady_clock::now();
-        continue;
-      }
-    }
-    if (run.instrument_lost_t_s >= 0) {  // nothing is sent; the force fades out, then the run ends
-      device.render(renderer.render(last_tip, t).force, false);
-      if (renderer.gain(t) == 0) {
-        run.faded_t_s = t;
-        break;
-      }
-      next += period;
-      std::this_thread::sleep_until(next);
-      continue;
-    }
-    if (standing_by) {  // nothing is sent and the device is not read; the force it renders fades out
-      device.render(renderer.render(last_tip, t).force, false);
-      next += period;
-      std::this_thread::sleep_until(next);
-      continue;
-    }
-    const auto in = device.read(t);
-    if (in.finished) break;
-    last_tip = in.tip_m;
-    client.send_tip(o.instrument, in.tip_m, in.jaw_rad, in.buttons);
-    ++seq;
-    sent[seq % sent.size()] = {seq, in.tip_m};
-    // Wait for the answer to this command until shortly before the next device period.
-    if (const auto f = client.wait_force(o.instrument, next + period - std::chrono::microseconds(100))) {
-      // The force rendered now, from the server's local models at the current tip: a new model
-      // (the answer to a newer command) is blended in over --blend seconds.
-      if (f->command_seq > model_seq)
-        if (const Sent& it = sent[f->command_seq % sent.size()]; it.seq == f->command_seq && it.seq != 0) {
-          renderer.update(*f, it.tip, t);
-          model_seq = f->command_seq;
-        }
-      const auto rendered = renderer.render(in.tip_m, t);
-      device.render(rendered.force, f->in_contact);
-      run.clamps += rendered.clamped;
+  viscera::client::DeviceRunOptions options;
+  options.loop = {o.client_id, o.instrument, o.max_force_n, o.blend_s, o.fade, o.reconnect};
+  options.rate_hz = o.rate_hz;
+  options.duration_s = o.duration_s;
+  options.tick_phase_us = o.tick_phase_us;
+  double last_print = -1;
+  viscera::client::DeviceRunHooks hooks;
+  hooks.note = [](const std::string& line) {
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  hooks.period = [&](const viscera::client::DevicePeriod& p) {
+    const auto& f = p.force;
+    if (!o.report.empty()) {
       double normal_stiffness = 0;  // n^T K n of the local model [N/m]
       for (std::size_t i = 0; i < 3; ++i)
-        for (std::size_t j = 0; j < 3; ++j) normal_stiffness += f->contact_normal[i] * f->stiffness[3 * i + j] * f->contact_normal[j];
-      if (!o.report.empty())
-        run.samples.push_back({t, in.tip_m[2], in.jaw_rad, f->force, f->torque, rendered.force, f->in_contact, f->penetration_m, normal_stiffness,
-                               1e3 * renderer.model_age_s(t), seq - f->command_seq, f->command_seq});
-      if (!o.quiet && t - last_print >= 0.25) {
-        print_live(o, client, t, in.tip_m, *f, run.mesh.frames);
-        last_print = t;
-      }
+        for (std::size_t j = 0; j < 3; ++j) normal_stiffness += f.contact_normal[i] * f.stiffness[3 * i + j] * f.contact_normal[j];
+      run.samples.push_back({p.t_s, p.device.tip_m[2], p.device.jaw_rad, f.force, f.torque, p.rendered.force, f.in_contact, f.penetration_m,
+                             normal_stiffness, 1e3 * p.model_age_s, p.model_age_commands, f.command_seq});
     }
-    if (o.watch_mesh) run.mesh.take(client, t, in.tip_m);
-    next += period;
-    if (phase && in_phase_possible)
-      if (const auto tick_end = client.last_tick_end_ns(o.instrument)) {
-        const std::int64_t next_ns =
-            viscera::client::now_ns() + std::chrono::duration_cast<std::chrono::nanoseconds>(next - std::chrono::steady_clock::now()).count();
-        ++run.phased;
-        run.near_phase += std::abs(phase->error(next_ns, *tick_end).count()) < 50'000;
-        next += phase->correction(next_ns, *tick_end);
-      }
-    std::this_thread::sleep_until(next);
-  }
+    if (!o.quiet && p.t_s - last_print >= 0.25) {
+      print_live(o, client, p.t_s, p.device.tip_m, f, run.mesh.frames);
+      last_print = p.t_s;
+    }
+    if (o.watch_mesh) run.mesh.take(client, p.t_s, p.device.tip_m);
+  };
+  static_cast<viscera::client::DeviceRunResult&>(run) = viscera::client::run_device(client, device, options, generation, hooks);
   return run;
 }
 

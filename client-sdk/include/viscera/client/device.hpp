@@ -2,8 +2,9 @@
 // The interface between a haptic client and a device. A client samples the device at its rate,
 // sends the pose to the server, and commands the device with the force rendered from the
 // server's local model. A real device (a Phantom/Touch through OpenHaptics, a Falcon through
-// libnifalcon, a device driven by CHAI3D, ...) implements this class in its own client; the
-// virtual devices of tools/haptic-client (scripted, trajectory file) implement it too.
+// libnifalcon, a device driven by CHAI3D, ...) implements this class and hands it to run_device
+// (device_runner.hpp), which runs the whole loop; the virtual devices of tools/haptic-client
+// (scripted, palpating, trajectory file) do the same.
 #include <cstdint>
 #include <string>
 

@@ -1,0 +1,139 @@
+// The device loop's states (client-sdk/device_loop.hpp) driven by invented times, server states and
+// scene states, without a network: each way of losing the server or the instrument fades the
+// force the hand feels over the fade time (LocalForceRenderer's gain, checked against the time
+// the fade should take), and each way back drives again.
+#include "viscera/client/device_loop.hpp"
+
+#include <gtest/gtest.h>
+
+using viscera::client::DeviceLoop;
+using viscera::client::DeviceLoopOptions;
+using viscera::client::InstrumentView;
+using viscera::client::ServerState;
+using Action = DeviceLoop::Action;
+
+namespace {
+constexpr double kPeriod = 1e-3;  // [s]
+constexpr std::uint32_t kMe = 21, kConsole = 950, kInstrument = 1;
+
+DeviceLoopOptions options(bool reconnect = false) {
+  DeviceLoopOptions o;
+  o.client_id = kMe;
+  o.instrument = kInstrument;
+  o.fade.fade_s = 0.25;
+  o.fade.stale_after_s = 10;  // models never go stale here: only the loop's decisions fade the force
+  o.reconnect = reconnect;
+  return o;
+}
+
+// A model that pushes with 1 N, as if the server had just answered.
+void feed_model(DeviceLoop& loop, double t) {
+  viscera::protocol::Force f;
+  f.force = {0, 0, 1.0};
+  f.in_contact = true;
+  loop.renderer().update(f, {0, 0, 0}, t);
+}
+
+// Runs periods from t0 while `state` holds, until the loop's action differs from `while_action`
+// or t1 passes; returns the time it stopped and the step there.
+std::pair<double, DeviceLoop::Step> run(DeviceLoop& loop, double t0, double t1, ServerState state, std::optional<InstrumentView> scene,
+                                        Action while_action) {
+  for (double t = t0; t < t1; t += kPeriod) {
+    const auto s = loop.next(t, state, loop.scene_check_due(t) ? scene : std::nullopt);
+    if (s.action != while_action || s.end_after) return {t, s};
+  }
+  return {t1, {}};
+}
+}  // namespace
+
+TEST(DeviceLoop, DrivesWhileTheServerIsThereAndTheInstrumentItsOwn) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  const InstrumentView mine{1, kMe, "liver"};
+  const auto [t, s] = run(loop, 0, 2.0, ServerState::alive, mine, Action::drive);
+  EXPECT_DOUBLE_EQ(t, 2.0) << "stopped driving: " << s.note;
+  EXPECT_EQ(loop.renderer().gain(2.0), 1.0);
+}
+
+TEST(DeviceLoop, AServerGoneFadesTheForceOverTheFadeTimeThenEnds) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  const auto first = loop.next(1.0, ServerState::lost, std::nullopt);
+  EXPECT_EQ(first.action, Action::drive) << "commands still go out while the force fades";
+  EXPECT_NE(first.note.find("the server is gone"), std::string::npos) << first.note;
+  EXPECT_NEAR(loop.renderer().gain(1.125), 0.5, 1e-9);  // half way through 0.25 s
+  double t = 1.0 + kPeriod;
+  for (; t < 3.0; t += kPeriod)
+    if (loop.next(t, ServerState::lost, std::nullopt).action == Action::end) break;
+  EXPECT_NEAR(loop.faded_t_s(), 1.25, 1.5 * kPeriod);
+  EXPECT_NEAR(t, loop.faded_t_s() + kPeriod, 1e-9) << "the period that rendered zero, then the end";
+  EXPECT_TRUE(loop.lost());
+  EXPECT_DOUBLE_EQ(loop.server_lost_t_s(), 1.0);
+}
+
+TEST(DeviceLoop, WithReconnectItWaitsThenClaimsAgainWhenAServerIsBack) {
+  DeviceLoop loop(options(true), 1);
+  feed_model(loop, 0);
+  loop.next(1.0, ServerState::lost, std::nullopt);
+  const auto [t_wait, s_wait] = run(loop, 1.001, 5.0, ServerState::lost, std::nullopt, Action::drive);
+  EXPECT_EQ(t_wait, 5.0) << "a client that reconnects never ends on its own: " << s_wait.note;
+  EXPECT_FALSE(loop.lost());
+  EXPECT_NEAR(loop.faded_t_s(), 1.25, 1.5 * kPeriod);
+  const auto back = loop.next(5.0, ServerState::alive, std::nullopt);
+  ASSERT_EQ(back.action, Action::claim_again);
+  const std::string said = loop.claimed(5.0, true, "", {2, kMe, "liver"});
+  EXPECT_NE(said.find("a server is back: instrument 1 claimed again"), std::string::npos) << said;
+  EXPECT_EQ(loop.server_returns(), 1);
+  EXPECT_EQ(loop.server_lost_t_s(), -1);
+  feed_model(loop, 5.01);
+  const auto [t, s] = run(loop, 5.01, 6.0, ServerState::alive, InstrumentView{2, kMe, "liver"}, Action::drive);
+  EXPECT_EQ(t, 6.0) << s.note;
+}
+
+TEST(DeviceLoop, TakenOverItStandsByWithTheForceFadingAndDrivesAgainWhenHandedBack) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const auto [t_taken, taken] = run(loop, 1.0, 2.0, ServerState::alive, InstrumentView{1, kConsole, "liver"}, Action::drive);
+  EXPECT_LT(t_taken, 1.0 + 0.1 + kPeriod) << "noticed within a scene check (0.1 s)";
+  EXPECT_EQ(taken.action, Action::render_only);
+  EXPECT_NE(taken.note.find("taken over by client 950"), std::string::npos) << taken.note;
+  EXPECT_EQ(loop.taken_over(), 1);
+  EXPECT_NEAR(loop.renderer().gain(t_taken + 0.25), 0.0, 1e-9);
+  const auto [t_stand, stand] = run(loop, t_taken + kPeriod, 3.0, ServerState::alive, InstrumentView{1, kConsole, "liver"}, Action::render_only);
+  EXPECT_EQ(t_stand, 3.0) << "stands by as long as it is taken, never ends: " << stand.note;
+  const auto [t_back, back] = run(loop, 3.0, 4.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::render_only);
+  EXPECT_EQ(back.action, Action::drive);
+  EXPECT_NE(back.note.find("handed back (owner client 21): driving it again"), std::string::npos) << back.note;
+  EXPECT_LT(t_back, 3.0 + 0.1 + kPeriod);
+  EXPECT_EQ(loop.instrument_lost_t_s(), -1) << "a take-over is not a loss";
+}
+
+TEST(DeviceLoop, AnInstrumentShownFreeUnderThisClientFadesOutAndEndsTheRun) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const auto [t_free, free] = run(loop, 1.0, 2.0, ServerState::alive, InstrumentView{1, 0, "liver"}, Action::drive);
+  EXPECT_EQ(free.action, Action::render_only);
+  EXPECT_NE(free.note.find("is no longer this client's"), std::string::npos) << free.note;
+  const auto [t_end, end] = run(loop, t_free + kPeriod, 3.0, ServerState::alive, InstrumentView{1, 0, "liver"}, Action::render_only);
+  EXPECT_TRUE(end.end_after);
+  EXPECT_NEAR(t_end - loop.instrument_lost_t_s(), 0.25, 1.5 * kPeriod) << "the force fades over the fade time, then the run ends";
+  EXPECT_FALSE(loop.lost()) << "the server is still there";
+}
+
+TEST(DeviceLoop, ANewSceneMeansClaimingAgainAndTheNewGenerationThen) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 0.5, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const auto [t, s] = run(loop, 0.5, 1.0, ServerState::alive, InstrumentView{2, 0, "liver-nodule"}, Action::drive);
+  ASSERT_EQ(s.action, Action::claim_again);
+  const std::string said = loop.claimed(t, false, "instrument 1 is held by client 22", {2, 22, "liver-nodule"});
+  EXPECT_NE(said.find("the server loaded scene liver-nodule: instrument 1 could not be claimed again: instrument 1 is held by client 22"),
+            std::string::npos)
+      << said;
+  // Next check, same generation: the instrument is another's, so the device stands by.
+  const auto [t2, s2] = run(loop, t + kPeriod, 2.0, ServerState::alive, InstrumentView{2, 22, "liver-nodule"}, Action::drive);
+  EXPECT_EQ(s2.action, Action::render_only);
+  EXPECT_LT(t2, t + 0.1 + 2 * kPeriod);
+}
