@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/number_text.hpp"
 #include "viscera/protocol/messages.hpp"
 #include "viscera/recording/recording_format.hpp"
 
@@ -15,16 +16,23 @@ namespace {
 std::uint64_t parse_u64(const std::map<std::string, std::string>& m, const std::string& key, const std::string& path, const std::string& record) {
   const auto it = m.find(key);
   if (it == m.end()) throw InputError(path, 0, record + "." + key, "missing");
-  try {
-    std::size_t used = 0;
-    const auto v = std::stoull(it->second, &used);
-    if (used != it->second.size()) throw std::invalid_argument("trailing");
-    return v;
-  } catch (const std::exception&) {
-    throw InputError(path, 0, record + "." + key, "'" + common::printable(it->second) + "' is not a whole number");
-  }
+  std::string why;
+  const auto v = common::read_integer(it->second, &why);
+  if (!v) throw InputError(path, 0, record + "." + key, why);
+  if (*v < 0) throw InputError(path, 0, record + "." + key, common::outside(*v, 0LL, std::numeric_limits<long long>::max()));
+  return static_cast<std::uint64_t>(*v);
 }
 }  // namespace
+
+std::uint32_t Recording::domain_id() const {
+  const auto it = info_.find("domain_id");
+  if (it == info_.end()) return 0;
+  std::string why;
+  const auto v = common::read_integer(it->second, &why);
+  if (!v) throw InputError(path(), 0, "viscera.recording.domain_id", why);
+  if (*v < 0 || *v > 230) throw InputError(path(), 0, "viscera.recording.domain_id", common::outside(*v, 0LL, 230LL));
+  return static_cast<std::uint32_t>(*v);
+}
 
 const RecordedFile* RecordedScene::file(const std::string& role) const {
   for (const auto& f : files)
@@ -49,11 +57,12 @@ Recording::Recording(const std::string& path) : reader_(path) {
       scene.generation = static_cast<std::uint32_t>(parse_u64(m.values, "generation", path, m.name));
       scene.first_tick = parse_u64(m.values, "first_tick", path, m.name);
       scene.log_time_ns = parse_u64(m.values, "log_time_ns", path, m.name);
-      try {
-        scene.sim_time_s = std::stod(m.values.at("sim_time_s"));
-      } catch (const std::exception&) {
-        throw InputError(path, 0, m.name + ".sim_time_s", "missing or not a number");
-      }
+      const auto sim = m.values.find("sim_time_s");
+      if (sim == m.values.end()) throw InputError(path, 0, m.name + ".sim_time_s", "missing");
+      std::string why;
+      const auto sim_time = common::read_number(sim->second, &why);
+      if (!sim_time) throw InputError(path, 0, m.name + ".sim_time_s", why);
+      scene.sim_time_s = *sim_time;
       scene.server_version = m.values.count("server_version") ? m.values.at("server_version") : "";
       scene.settings_json = m.values.count("settings_json") ? m.values.at("settings_json") : "";
       std::vector<std::string> roles{"scene", "mesh", "material"};

@@ -1,9 +1,12 @@
 #include "viscera/common/command_line.hpp"
 
-#include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <sstream>
+
+#include "viscera/common/number_text.hpp"
 
 namespace viscera::common {
 
@@ -84,10 +87,10 @@ std::string CommandLine::text(const std::string& name) const {
 
 namespace {
 double parse_number(const std::string& name, const std::string& t) {
-  double v = 0;
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) throw UsageError("--" + name + ": '" + t + "' is not a finite number");
-  return v;
+  std::string why;
+  const auto v = read_number(t, &why);
+  if (!v) throw UsageError("--" + name + ": " + why);
+  return *v;
 }
 }  // namespace
 
@@ -95,27 +98,22 @@ double CommandLine::number(const std::string& name) const { return parse_number(
 
 double CommandLine::number_in(const std::string& name, double lo, double hi) const {
   const double v = number(name);
-  if (v < lo || v > hi) {
-    std::ostringstream s;
-    s << "--" << name << ": " << v << " is outside [" << lo << ", " << hi << "]";
-    throw UsageError(s.str());
-  }
+  if (v < lo || v > hi) throw UsageError("--" + name + ": " + outside(v, lo, hi));
   return v;
 }
 
 long CommandLine::integer(const std::string& name) const {
-  const std::string t = text(name);
-  long v = 0;
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size()) throw UsageError("--" + name + ": '" + t + "' is not an integer");
-  return v;
+  std::string why;
+  const auto v = read_integer(text(name), &why);
+  if (!v) throw UsageError("--" + name + ": " + why);
+  return static_cast<long>(*v);
 }
 
 std::uint64_t CommandLine::integer_in(const std::string& name, std::uint64_t lo, std::uint64_t hi) const {
-  const double v = number(name);
-  if (v != std::floor(v)) throw UsageError("--" + name + ": '" + text(name) + "' is not a whole number");
-  if (v < static_cast<double>(lo) || v > static_cast<double>(hi) || v > 9007199254740992.0)
-    throw UsageError("--" + name + ": " + text(name) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  const long long v = integer(name);
+  constexpr std::uint64_t kMax = std::numeric_limits<long long>::max();
+  const auto l = static_cast<long long>(std::min(lo, kMax)), h = static_cast<long long>(std::min(hi, kMax));
+  if (v < l || v > h) throw UsageError("--" + name + ": " + outside(v, l, h));
   return static_cast<std::uint64_t>(v);
 }
 

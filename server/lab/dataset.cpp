@@ -12,6 +12,7 @@
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/number_text.hpp"
 
 namespace viscera::lab {
 
@@ -88,12 +89,10 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
     const auto cells = split(*line);
     const auto value = [&](int col, const char* name) {
       if (col >= static_cast<int>(cells.size())) throw InputError(path, row, name, "missing value");
-      const std::string_view c = cells[static_cast<std::size_t>(col)];
-      double v = 0;
-      const auto [end, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
-      if (ec != std::errc() || end != c.data() + c.size()) throw InputError(path, row, name, "'" + common::printable(c) + "' is not a number");
-      if (!std::isfinite(v)) throw InputError(path, row, name, "'" + common::printable(c) + "' is not finite");
-      return v;
+      std::string why;
+      const auto v = common::read_number(cells[static_cast<std::size_t>(col)], &why);
+      if (!v) throw InputError(path, row, name, why);
+      return *v;
     };
     const double time = value(col_t, "time_s"), strain = value(col_e, "strain"), stress = value(col_s, "stress_pa");
     if (!t.time_s.empty() && !(time > t.time_s.back()))

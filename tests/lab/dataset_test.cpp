@@ -50,7 +50,7 @@ TEST(Dataset, BadInputNamesFileLineAndField) {
       {"ok", kJson, kCsv, "no error"},
       {"column", kJson, "time_s,strain\n0,0\n", "a.csv:1: stress_pa: column missing"},
       {"order", kJson, "time_s,strain,stress_pa\n0,0,0\n2,0.01,10\n1,0.02,20\n", "a.csv:4: time_s: 1 s does not increase"},
-      {"nan", kJson, "time_s,strain,stress_pa\n0,0,0\n1,nan,10\n2,0.02,20\n", "a.csv:3: strain: 'nan' is not finite"},
+      {"nan", kJson, "time_s,strain,stress_pa\n0,0,0\n1,nan,10\n2,0.02,20\n", "a.csv:3: strain: 'nan' is not a finite number"},
       {"percent", kJson, "time_s,strain,stress_pa\n0,0,0\n1,10,10\n2,20,20\n", "a.csv:3: strain: 10 cannot be right"},
       {"absurd", kJson, "time_s,strain,stress_pa\n0,0,0\n1,0.01,1e12\n2,0.02,20\n", "a.csv:3: stress_pa: 1e+12 Pa cannot be right"},
       // One test in kPa next to one in Pa (b.csv: 10 Pa at 1% strain, a modulus of 1 kPa; a.csv the same written in kPa).

@@ -24,7 +24,7 @@ expect sim-unknown 2 "unknown option --frobnicate" -- "$sim" --frobnicate 3
 expect sim-missing-mesh 2 "mesh is required" -- "$sim"
 expect sim-no-file 2 "nowhere.msh: cannot open file" -- "$sim" --mesh "$tmp/nowhere.msh"
 expect sim-bad-mesh 2 "bad.msh" -- "$sim" --mesh "$tmp/bad.msh"
-expect sim-bad-number 2 "'abc' is not a finite number" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale abc
+expect sim-bad-number 2 "'abc' is not a number" -- "$sim" --mesh "$src/data/meshes/liver.msh" --scale abc
 expect sim-bad-material 2 "bad.json: elasticity.poisson_ratio: 0.7 is outside" -- "$sim" --mesh "$src/data/meshes/liver.msh" --material "$tmp/bad.json"
 expect sim-bad-model 2 "'fem' is not one of" -- "$sim" --mesh "$src/data/meshes/liver.msh" --model fem
 expect sim-bad-slab 2 "fix-slab: axis 'w'" -- "$sim" --mesh "$src/data/meshes/liver.msh" --fix-slab w,max,0.1
@@ -45,7 +45,7 @@ echo '{"physics_threads": 2, "organ": {"mesh": "x.msh", "material": "m.json"}, "
 expect server-unknown-field 2 "misplaced_scene.json: physics_threads: unknown field (known here: name, " -- "$server" --scene "$tmp/misplaced_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json"}, "instruments": [{"id": 1, "tip_radius": 0.01}]}' >"$tmp/typo_scene.json"
 expect server-misspelt-field 2 "typo_scene.json: instruments\[0\].tip_radius: unknown field" -- "$server" --scene "$tmp/typo_scene.json"
-expect server-bad-duration 2 "viscera-server: --duration: 'soon' is not a finite number" -- "$server" --scene x --duration soon
+expect server-bad-duration 2 "viscera-server: --duration: 'soon' is not a number" -- "$server" --scene x --duration soon
 expect server-bad-scene-dir 2 "--scene-dir: '/nonexistent' is not a directory" -- "$server" --scene x --scene-dir /nonexistent
 expect server-negative-duration 2 "viscera-server: --duration: -1 is outside" -- "$server" --scene x --duration -1
 expect server-unknown 2 "viscera-server: unknown option --sceen" -- "$server" --sceen x
@@ -57,7 +57,7 @@ printf 'time_s,x_m,y_m\n0,0,0\n' >"$tmp/t3.csv"
 printf 'time_s,x_m,y_m,z_m\n0,0,0,0\n1,0,0,-20\n' >"$tmp/t4.csv"
 printf 'time_s,x_m,y_m,z_m,jaw_rad\n0,0,0,0,0.5\n1,0,0,0,7\n' >"$tmp/t5.csv"
 expect hc-traj-missing 2 "nowhere.csv: cannot open file" -- "$hc" --trajectory "$tmp/nowhere.csv"
-expect hc-traj-number 2 "t1.csv:3: column z_m: 'abc' is not a finite number" -- "$hc" --trajectory "$tmp/t1.csv"
+expect hc-traj-number 2 "t1.csv:3: column z_m: 'abc' is not a number" -- "$hc" --trajectory "$tmp/t1.csv"
 expect hc-traj-time 2 "t2.csv:4: column time_s" -- "$hc" --trajectory "$tmp/t2.csv"
 expect hc-traj-header 2 "t3.csv:1: column z_m: missing from the header" -- "$hc" --trajectory "$tmp/t3.csv"
 expect hc-traj-units 2 "t4.csv:3: column z_m: .* are the units metres" -- "$hc" --trajectory "$tmp/t4.csv"
@@ -68,7 +68,7 @@ expect control-two-actions 2 "unexpected argument 'resume'" -- "$build/tools/vis
 expect control-annotate-no-text 2 "annotate needs its argument" -- "$build/tools/viscera-control/viscera-control" annotate
 expect control-load-path 2 "SCENE '../x' is not a scene name" -- "$build/tools/viscera-control/viscera-control" load ../x
 expect control-load-no-name 2 "load needs its argument" -- "$build/tools/viscera-control/viscera-control" load
-expect control-rate-range 2 "rate '5' is not a whole number of hertz in \[10, 10000\]" -- "$build/tools/viscera-control/viscera-control" rate 5
+expect control-rate-range 2 "rate: 5 is outside \[10, 10000\] Hz" -- "$build/tools/viscera-control/viscera-control" rate 5
 expect control-material-empty 2 "material needs at least one of" -- "$build/tools/viscera-control/viscera-control" material
 expect control-material-flag-elsewhere 2 "material flags are for the material action" -- "$build/tools/viscera-control/viscera-control" pause --shear-q 3
 expect control-material-range 2 "poisson-ratio" -- "$build/tools/viscera-control/viscera-control" material --poisson-ratio 0.7

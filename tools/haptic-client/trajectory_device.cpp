@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "viscera/common/number_text.hpp"
+
 namespace viscera::haptic {
 
 namespace {
@@ -57,9 +59,10 @@ std::vector<TrajectoryPoint> read_trajectory(const std::string& path) {
     for (std::size_t k = 0; k < known.size(); ++k) {
       if (column_of[k] < 0) continue;
       const std::string& text = cells[static_cast<std::size_t>(column_of[k])];
-      char* end = nullptr;
-      v[k] = std::strtod(text.c_str(), &end);
-      if (text.empty() || *end != '\0' || !std::isfinite(v[k])) fail(number, known[k], "'" + text + "' is not a finite number");
+      std::string why;
+      const auto x = viscera::common::read_number(text, &why);
+      if (!x) fail(number, known[k], why);
+      v[k] = *x;
     }
     if (v[0] < 0 || (!points.empty() && v[0] <= points.back().t_s))
       fail(number, "time_s", std::to_string(v[0]) + " s is not after the previous row's time (times start at 0 and increase)");

@@ -19,6 +19,7 @@
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/number_text.hpp"
 #include "viscera/common/program_log.hpp"
 #include "viscera/console/access_token.hpp"
 #include "viscera/process/child_process.hpp"
@@ -57,10 +58,11 @@ asio::ip::tcp::endpoint parse_listen(const std::string& s) {
   boost::system::error_code ec;
   const auto address = asio::ip::make_address(host, ec);
   if (ec) throw UsageError("--listen '" + s + "': '" + host + "' is not an IP address");
-  char* end = nullptr;
-  const long port = std::strtol(s.c_str() + colon + 1, &end, 10);
-  if (*end || colon + 1 == s.size() || port < 0 || port > 65535) throw UsageError("--listen '" + s + "': the port is not in [0, 65535]");
-  return {address, static_cast<unsigned short>(port)};
+  std::string why;
+  const auto port = viscera::common::read_integer(std::string_view(s).substr(colon + 1), &why);
+  if (!port) throw UsageError("--listen '" + s + "': port " + why);
+  if (*port < 0 || *port > 65535) throw UsageError("--listen '" + s + "': port " + viscera::common::outside(*port, 0LL, 65535LL));
+  return {address, static_cast<unsigned short>(*port)};
 }
 
 /// The page's files from the web folder the build made (index.html, console.js, console.css).

@@ -16,6 +16,7 @@
 #include "viscera/client/session_limits.hpp"
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/number_text.hpp"
 
 namespace {
 
@@ -115,15 +116,18 @@ Request parse(const viscera::common::CommandLine& cl) {
     throw UsageError("--seed is for the load action");
   }
   if (r.action == "rate") {
-    char* end = nullptr;
-    r.rate_hz = std::strtod(r.argument.c_str(), &end);
-    if (*end || !(r.rate_hz >= 10 && r.rate_hz <= 10000) || r.rate_hz != std::floor(r.rate_hz))
-      throw UsageError("rate '" + r.argument + "' is not a whole number of hertz in [10, 10000]");
+    std::string why;
+    const auto hz = viscera::common::read_integer(r.argument, &why);
+    if (!hz) throw UsageError("rate: " + why + " of hertz");
+    if (*hz < 10 || *hz > 10000) throw UsageError("rate: " + viscera::common::outside(*hz, 10LL, 10000LL) + " Hz");
+    r.rate_hz = static_cast<double>(*hz);
   }
   if (r.action == "seek") {
-    char* end = nullptr;
-    r.seek_s = std::strtod(r.argument.c_str(), &end);
-    if (*end || !(r.seek_s >= 0 && r.seek_s <= 1e9)) throw UsageError("seek '" + r.argument + "' is not a time from the recording's start [s]");
+    std::string why;
+    const auto s = viscera::common::read_number(r.argument, &why);
+    if (!s) throw UsageError("seek: " + why + " (a time from the recording's start [s])");
+    if (*s < 0 || *s > 1e9) throw UsageError("seek: " + viscera::common::outside(*s, 0.0, 1e9) + " s");
+    r.seek_s = *s;
   }
   r.duration_s = cl.number_in("duration", 0.1, 1e6);
   r.timeout = std::chrono::milliseconds(static_cast<long long>(1000 * cl.number_in("timeout", 0.1, 3600)));

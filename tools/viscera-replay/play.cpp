@@ -77,8 +77,7 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
                              seconds(at(o.from_s) - t0) + " is past the recording's end (it spans " + seconds(t_end - t0) + ")");
   const std::uint64_t from = at(o.from_s), to = o.to_s ? std::min(at(*o.to_s), t_end) : t_end;
   if (from > to) throw common::InputError(o.recording, 0, "--from/--to", "the interval is empty (the recording spans " + seconds(t_end - t0) + ")");
-  const std::uint32_t domain =
-      o.domain ? *o.domain : static_cast<std::uint32_t>(std::stoul(recording.info().count("domain_id") ? recording.info().at("domain_id") : "0"));
+  const std::uint32_t domain = o.domain ? *o.domain : recording.domain_id();
 
   client::StreamPublisher publisher(domain, o.partition);
   client::StreamTap requests(domain, o.partition, {proto::Stream::session_request}, 64);

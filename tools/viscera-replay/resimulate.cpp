@@ -50,8 +50,7 @@ int resimulate(const ResimulateOptions& o) {
   const rec::LockstepPlan plan = rec::make_lockstep_plan(recording);
   TempDir dir;
   const rec::ExtractedScenes scenes = rec::extract_scenes(recording, dir.path.string(), o.scene);
-  const std::uint32_t domain =
-      o.domain ? *o.domain : static_cast<std::uint32_t>(std::stoul(recording.info().count("domain_id") ? recording.info().at("domain_id") : "0"));
+  const std::uint32_t domain = o.domain ? *o.domain : recording.domain_id();
   const std::string partition = "viscera-resimulate-" + std::to_string(::getpid()) + "-" + std::to_string(proto::now_ns() % 1000000000);
   const std::uint64_t ticks = plan.last_tick - plan.first_tick + 1;
   if (!o.quiet) {

@@ -9,6 +9,7 @@
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/number_text.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
@@ -46,12 +47,10 @@ std::vector<std::int32_t> fixed_nodes(const viscera::common::CommandLine& cl, co
     const int a = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
     if (a < 0) throw viscera::common::UsageError("--fix-slab: axis '" + axis + "' is not x, y or z");
     if (side != "min" && side != "max") throw viscera::common::UsageError("--fix-slab: side '" + side + "' is not min or max");
-    double fraction = 0;
-    try {
-      fraction = std::stod(spec.substr(c2 + 1));
-    } catch (...) {
-      throw viscera::common::UsageError("--fix-slab: fraction '" + spec.substr(c2 + 1) + "' is not a number");
-    }
+    std::string why;
+    const auto parsed = viscera::common::read_number(std::string_view(spec).substr(c2 + 1), &why);
+    if (!parsed) throw viscera::common::UsageError("--fix-slab: fraction " + why);
+    const double fraction = *parsed;
     if (!(fraction > 0 && fraction <= 1)) throw viscera::common::UsageError("--fix-slab: fraction must lie in (0, 1]");
     Box b = bounding_box(mesh);
     const double extent = b.hi[a] - b.lo[a];

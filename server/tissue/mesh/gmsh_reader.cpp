@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/number_text.hpp"
 #include "viscera/common/plain_name.hpp"
 #include "viscera/tissue/mesh/mesh_builder.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
@@ -95,7 +96,7 @@ void read_elements_v1v2(TextCursor& in, MeshBuilder& b, bool v1, std::string_vie
         const long long tag = in.integer("element tag");
         if (k == 0) {  // the physical group
           if (tag < 0 || tag > kMaxTag)
-            in.fail("element " + std::to_string(id) + " physical tag", std::to_string(tag) + " is out of range [0, " + std::to_string(kMaxTag) + "]");
+            in.fail("element " + std::to_string(id) + " physical tag", common::outside(tag, 0LL, static_cast<long long>(kMaxTag)));
           physical = static_cast<int>(tag);
         }
       }

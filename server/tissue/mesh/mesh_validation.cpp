@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/number_text.hpp"
 #include "viscera/tissue/element/tet_geometry.hpp"
 
 namespace viscera::tissue {
@@ -42,7 +43,8 @@ void validate_mesh(const TetMesh& mesh, const MeshOrigin* origin) {
     const std::string name = element(e);
     const long line = element_line(e);
     for (int k = 0; k < 4; ++k)
-      if (t[k] < 0 || t[k] >= n) fail(name, "vertex index " + std::to_string(t[k]) + " is out of range [0, " + std::to_string(n - 1) + "]", line);
+      if (t[k] < 0 || t[k] >= n)
+        fail(name, "vertex index " + common::outside(static_cast<long long>(t[k]), 0LL, static_cast<long long>(n) - 1), line);
     std::array<std::int32_t, 4> sorted = t;
     std::sort(sorted.begin(), sorted.end());
     if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) fail(name, "repeats a vertex", line);

@@ -1,11 +1,11 @@
 #include "viscera/tissue/mesh/text_cursor.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/number_text.hpp"
 
 namespace viscera::tissue {
 
@@ -62,25 +62,22 @@ std::string_view TextCursor::token(std::string_view field) {
 }
 
 double TextCursor::real(std::string_view field) {
-  const std::string_view t = token(field);
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size()) fail(field, "'" + printable(t) + "' is not a number");
-  if (!std::isfinite(v)) fail(field, "'" + printable(t) + "' is not a finite number");
-  return v;
+  std::string why;
+  const auto v = common::read_number(token(field), &why);
+  if (!v) fail(field, why);
+  return *v;
 }
 
 long long TextCursor::integer(std::string_view field) {
-  const std::string_view t = token(field);
-  long long v = 0;
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size()) fail(field, "'" + printable(t) + "' is not an integer");
-  return v;
+  std::string why;
+  const auto v = common::read_integer(token(field), &why);
+  if (!v) fail(field, why);
+  return *v;
 }
 
 long long TextCursor::integer_in(std::string_view field, long long lo, long long hi) {
   const long long v = integer(field);
-  if (v < lo || v > hi) fail(field, std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  if (v < lo || v > hi) fail(field, common::outside(v, lo, hi));
   return v;
 }
 

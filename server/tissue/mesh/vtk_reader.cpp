@@ -1,14 +1,15 @@
 // VTK readers: legacy ASCII unstructured grid (.vtk, versions 2-4 "CELLS n size" layout and
 // 5.1 "OFFSETS/CONNECTIVITY" layout) and ASCII XML unstructured grid (.vtu).
 #include <algorithm>
-#include <charconv>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include <pugixml.hpp>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
+#include "viscera/common/number_text.hpp"
 #include "viscera/tissue/mesh/mesh_builder.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/mesh/text_cursor.hpp"
@@ -27,10 +28,10 @@ constexpr long long kVtkTetra = 10;
 bool is_other_volume_cell(long long type) { return type == 11 || type == 12 || type == 13 || type == 14 || type == 24 || type == 25 || type == 42; }
 
 long long to_integer(TextCursor& in, std::string_view t, std::string_view field) {
-  long long v = 0;
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec != std::errc() || end != t.data() + t.size()) in.fail(field, "'" + printable(t) + "' is not an integer");
-  return v;
+  std::string why;
+  const auto v = common::read_integer(t, &why);
+  if (!v) in.fail(field, why);
+  return *v;
 }
 
 /// `lines`: each cell's line in the file (empty: `line` for all).
@@ -156,12 +157,15 @@ std::vector<T> parse_ascii_array(const std::string& path, const pugi::xml_node& 
   std::vector<T> out;
   std::string tok;
   while (ss >> tok) {
-    std::istringstream one(tok);
-    T v{};
-    if (!(one >> v) || !one.eof()) throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not a number");
-    if constexpr (std::is_floating_point_v<T>)
-      if (!std::isfinite(v)) throw InputError(path, 0, std::string("DataArray ") + name, "'" + printable(tok) + "' is not finite");
-    out.push_back(v);
+    std::string why;
+    std::optional<T> v;
+    if constexpr (std::is_floating_point_v<T>) {
+      if (const auto x = common::read_number(tok, &why)) v = static_cast<T>(*x);
+    } else {
+      if (const auto x = common::read_integer(tok, &why)) v = static_cast<T>(*x);
+    }
+    if (!v) throw InputError(path, 0, std::string("DataArray ") + name, why);
+    out.push_back(*v);
   }
   return out;
 }

@@ -47,6 +47,9 @@ class Recording {
   const mcap::Summary& summary() const { return summary_; }
   /// Metadata "viscera.recording" (schema_version, domain_id, partition, streams, recorder).
   const std::map<std::string, std::string>& info() const { return info_; }
+  /// The DDS domain it was recorded on (info's domain_id; 0 if absent); throws InputError naming
+  /// the file if it is not a domain id (a whole number in [0, 230]).
+  std::uint32_t domain_id() const;
   /// Metadata "viscera.drops" (absent from a recording that was recovered after a crash).
   const std::optional<std::map<std::string, std::string>>& drops() const { return drops_; }
   const std::map<std::uint16_t, RecordedChannel>& channels() const { return channels_; }
