@@ -179,8 +179,10 @@ LockstepPlan make_lockstep_plan(Recording& recording) {
         break;
       case proto::EventKind::instrument_released:
         // By its owner or by the lease (no lease runs in lockstep: the owner releases it); a scene
-        // replaced releases every instrument by itself.
-        if (e.text.find("scene was replaced") == std::string::npos)
+        // replaced releases every instrument by itself. Recordings older than schema 12 say so
+        // only in the text.
+        if (e.reason != proto::EventReason::scene_replaced &&
+            !(e.reason == proto::EventReason::unspecified && e.text.find("scene was replaced") != std::string::npos))
           s.requests.push_back(proto::encode(request(e.client_id, proto::Action::release_instrument, e.instrument_id)));
         break;
       case proto::EventKind::paused: s.requests.push_back(proto::encode(request(e.client_id, proto::Action::pause))); break;

@@ -128,7 +128,9 @@ void ExerciseScorer::process(const Pending& p) {
 }
 
 void ExerciseScorer::process_event(const proto::Event& e) {
-  if (e.kind == proto::EventKind::scene_loaded && !start_tick_ && e.text.rfind("loaded scene " + exercise_.scene + " (", 0) == 0) {
+  // The scene's name is a field since schema 12; older recordings say it only in the text.
+  const bool this_scene = e.scene.empty() ? e.text.rfind("loaded scene " + exercise_.scene + " (", 0) == 0 : e.scene == exercise_.scene;
+  if (e.kind == proto::EventKind::scene_loaded && !start_tick_ && this_scene) {
     start_tick_ = e.tick;
     last_tick_ = e.tick;
     r_.started = true;

@@ -132,8 +132,9 @@ std::vector<std::uint8_t> encode(const MeshFrame& m) {
 std::vector<std::uint8_t> encode(const Event& e) {
   flatbuffers::FlatBufferBuilder b(128 + e.text.size());
   const auto text = b.CreateString(e.text);
+  const auto scene = e.scene.empty() ? flatbuffers::Offset<flatbuffers::String>() : b.CreateString(e.scene);
   b.Finish(fb::CreateEvent(b, e.source_client_id, static_cast<fb::EventKind>(e.kind), e.instrument_id, e.client_id, e.sim_time_s, e.stamp_ns, text,
-                           e.tick, e.request_seq),
+                           e.tick, e.request_seq, static_cast<fb::EventReason>(e.reason), scene),
            fb::EventIdentifier());
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
@@ -151,6 +152,17 @@ const char* action_name(Action a) {
     case Action::seek: return "seek";
     case Action::take_over: return "take_over";
     case Action::hand_back: return "hand_back";
+  }
+  return "unknown";
+}
+
+const char* event_reason_name(EventReason r) {
+  switch (r) {
+    case EventReason::unspecified: return "unspecified";
+    case EventReason::by_owner: return "by_owner";
+    case EventReason::owner_silent: return "owner_silent";
+    case EventReason::scene_replaced: return "scene_replaced";
+    case EventReason::handed_back: return "handed_back";
   }
   return "unknown";
 }
@@ -473,8 +485,26 @@ std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::stri
     *why = "sim_time_s not finite or negative";
     return std::nullopt;
   }
-  return Event{m->source_client_id(), static_cast<EventKind>(k),         m->instrument_id(), m->client_id(),  m->sim_time_s(),
-               m->stamp_ns(),         m->text() ? m->text()->str() : "", m->tick(),          m->request_seq()};
+  // Reasons this build does not know pass through as kinds do; negative ones are never defined.
+  if (static_cast<int>(m->reason()) < 0) {
+    *why = "negative event reason " + std::to_string(static_cast<int>(m->reason()));
+    return std::nullopt;
+  }
+  if (m->scene() && m->scene()->size() > 64) {
+    *why = "scene name of " + std::to_string(m->scene()->size()) + " bytes (at most 64)";
+    return std::nullopt;
+  }
+  return Event{m->source_client_id(),
+               static_cast<EventKind>(k),
+               m->instrument_id(),
+               m->client_id(),
+               m->sim_time_s(),
+               m->stamp_ns(),
+               m->text() ? m->text()->str() : "",
+               m->tick(),
+               m->request_seq(),
+               static_cast<EventReason>(m->reason()),
+               m->scene() ? m->scene()->str() : ""};
 }
 
 }  // namespace viscera::protocol

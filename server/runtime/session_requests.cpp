@@ -70,7 +70,8 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
       case proto::Action::release_instrument:
         switch (instruments.release(req->instrument_id, req->client_id)) {
           case ReleaseResult::released:
-            event(proto::EventKind::instrument_released, req->instrument_id, req->client_id, "released by its owner");
+            event(proto::EventKind::instrument_released, req->instrument_id, req->client_id, "released by its owner", 0,
+                  proto::EventReason::by_owner);
             changed = true;
             break;
           case ReleaseResult::not_owner: ++rejected_not_owner; break;
@@ -151,7 +152,7 @@ void SimulationServer::Impl::hand_over(const proto::SessionRequest& req, const S
   const bool accepted = h.result == HandoverResult::handed_over || h.result == HandoverResult::already_owner;
   session.record(req, accepted, message);
   if (h.result == HandoverResult::handed_over && !take && h.from == 0) {
-    event(proto::EventKind::instrument_released, req.instrument_id, req.client_id, message, req.request_seq);
+    event(proto::EventKind::instrument_released, req.instrument_id, req.client_id, message, req.request_seq, proto::EventReason::handed_back);
   } else if (h.result == HandoverResult::handed_over) {
     // The new owner's claim names the one it came from; no release in between.
     const std::uint32_t to = take ? req.client_id : h.from;
@@ -174,7 +175,8 @@ void SimulationServer::Impl::conclude(const proto::SessionRequest& req, bool acc
                                 : req.action == proto::Action::load_scene   ? proto::EventKind::scene_loaded
                                 : req.action == proto::Action::set_material ? proto::EventKind::material_changed
                                                                             : proto::EventKind::physics_rate_changed;
-  event(kind, 0, req.client_id, message.substr(0, 1000), req.request_seq);
+  event(kind, 0, req.client_id, message.substr(0, 1000), req.request_seq, proto::EventReason::unspecified,
+        kind == proto::EventKind::scene_loaded ? req.scene_name : std::string());
   if (status)
     status("client " + std::to_string(req.client_id) + " " + proto::action_name(req.action) + ": " + (accepted ? "" : "refused: ") + message);
   publish_scene();
@@ -195,7 +197,8 @@ void SimulationServer::Impl::release_silent(const Status& status) {
       continue;
     }
     if (status) status(id + " released: client " + std::to_string(o.owner) + " silent for more than the lease");
-    event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "owner silent for more than the lease");
+    event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "owner silent for more than the lease", 0,
+          proto::EventReason::owner_silent);
   }
   if (!released.empty()) publish_scene();
 }

@@ -70,7 +70,9 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
     }
     publish_snapshot(ticks_run);
   }
-  for (const auto& o : released) event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "the scene was replaced by " + scene.name);
+  for (const auto& o : released)
+    event(proto::EventKind::instrument_released, o.instrument_id, o.owner, "the scene was replaced by " + scene.name, 0,
+          proto::EventReason::scene_replaced);
   if (new_scene && !lockstep) {
     if (mesh_publisher) {
       mesh_frames_before += mesh_publisher->frames_published();

@@ -179,6 +179,34 @@ TEST(Messages, EventsRoundTripAndBadOnesAreRejected) {
   EXPECT_FALSE(decode_event(encode(good_command()), &why));  // another schema
 }
 
+TEST(Messages, EventsCarryAReasonAndTheSceneForCodeToActOn) {
+  std::string why;
+  Event released{0, EventKind::instrument_released, 1, 31, 2.0, 9, "the scene was replaced by liver-12k"};
+  released.reason = EventReason::scene_replaced;
+  const auto r = decode_event(encode(released), &why);
+  ASSERT_TRUE(r) << why;
+  EXPECT_EQ(r->reason, EventReason::scene_replaced);
+  EXPECT_STREQ(event_reason_name(r->reason), "scene_replaced");
+  Event loaded{0, EventKind::scene_loaded, 0, 900, 3.0, 10, "loaded scene liver-12k (explicit step 0.0005 s)"};
+  loaded.scene = "liver-12k";
+  EXPECT_EQ(decode_event(encode(loaded), &why)->scene, "liver-12k");
+  // An event without them (an older server) reads as unspecified, with no scene.
+  const auto old = decode_event(encode(Event{0, EventKind::paused, 0, 900, 1.0, 3, ""}), &why);
+  ASSERT_TRUE(old) << why;
+  EXPECT_EQ(old->reason, EventReason::unspecified);
+  EXPECT_TRUE(old->scene.empty());
+  // A reason from a newer server passes through as unknown; a negative one is refused.
+  released.reason = static_cast<EventReason>(42);
+  const auto newer = decode_event(encode(released), &why);
+  ASSERT_TRUE(newer) << why;
+  EXPECT_STREQ(event_reason_name(newer->reason), "unknown");
+  released.reason = static_cast<EventReason>(-3);
+  EXPECT_FALSE(decode_event(encode(released), &why));
+  EXPECT_NE(why.find("negative event reason"), std::string::npos) << why;
+  loaded.scene.assign(65, 'a');
+  EXPECT_FALSE(decode_event(encode(loaded), &why));
+}
+
 TEST(Messages, RunTimeControlRequestsRoundTripAndBadOnesAreRejected) {
   std::string why;
   SessionRequest load;

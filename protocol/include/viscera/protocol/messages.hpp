@@ -183,6 +183,10 @@ enum class EventKind : std::int8_t {
 };
 /// The kind's name; "unknown" for kinds added by a newer server (decoders pass them through).
 const char* event_name(EventKind k);
+/// Why an instrument was released (schema 12); code acts on it, the text is for people.
+enum class EventReason : std::int8_t { unspecified = 0, by_owner, owner_silent, scene_replaced, handed_back };
+/// The reason's name; "unknown" for reasons added by a newer server.
+const char* event_reason_name(EventReason r);
 
 /// Something that happened in a session (server events) or a client's annotation.
 struct Event {
@@ -194,6 +198,8 @@ struct Event {
   std::string text;  ///< at most 1024 bytes
   std::uint64_t tick = 0;  ///< schema 7: the tick at whose start it took effect (server events)
   std::uint64_t request_seq = 0;  ///< schema 7: the session request it concludes (0: none)
+  EventReason reason = EventReason::unspecified;  ///< schema 12
+  std::string scene;  ///< schema 12, scene_loaded: the scene loaded (at most 64 bytes)
 };
 
 /// A file the server built its organ from (schema 7).
@@ -233,7 +239,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 11;
+inline constexpr int kSchemaVersion = 12;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);
