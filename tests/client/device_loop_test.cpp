@@ -36,7 +36,7 @@ void feed_model(DeviceLoop& loop, double t) {
 
 // Runs periods from t0 while `state` holds, until the loop's action differs from `while_action`
 // or t1 passes; returns the time it stopped and the step there.
-std::pair<double, DeviceLoop::Step> run(DeviceLoop& loop, double t0, double t1, ServerState state, std::optional<InstrumentView> scene,
+std::pair<double, DeviceLoop::Step> run(DeviceLoop& loop, double t0, double t1, ServerState state, const std::optional<InstrumentView>& scene,
                                         Action while_action) {
   for (double t = t0; t < t1; t += kPeriod) {
     const auto s = loop.next(t, state, loop.scene_check_due(t) ? scene : std::nullopt);
