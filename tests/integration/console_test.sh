@@ -40,7 +40,7 @@ cp "$tmp/token" "$tmp/loose-token"; chmod 644 "$tmp/loose-token"
 timeout 10 "$console" --token-file "$tmp/loose-token" --domain 999 > "$tmp/e5.txt" 2>&1
 check "a token file others may read is warned about" 'grep -q "warning viscera-console: .*loose-token (mode 644) may be read by others" "$tmp/e5.txt"'
 "$console" --token-file "$tmp/token" --listen 127.0.0.1:99999 > "$tmp/e3.txt" 2>&1; rc=$?
-check "a bad --listen is refused" '[ $rc -eq 2 ] && grep -q "port is not in" "$tmp/e3.txt"'
+check "a bad --listen is refused" '[ $rc -eq 2 ] && grep -q "port 99999 is outside \\[0, 65535\\]" "$tmp/e3.txt"'
 check "a token file only its owner reads is not warned about" '! grep -q warning "$tmp/e3.txt"'
 cat "$tmp/e1.txt" "$tmp/e2.txt" "$tmp/e3.txt"
 
