@@ -52,9 +52,9 @@ void SimulationServer::Impl::publish_scene_files() {
 /// A session event for recorders, trainers and consoles (physics thread), stamped with the tick
 /// in progress (the request it concludes, if any).
 void SimulationServer::Impl::event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text,
-                                   std::uint64_t request_seq, proto::EventReason reason, std::string scene) {
+                                   std::uint64_t request_seq, proto::EventReason reason, std::string scene_name) {
   auto payload = proto::encode(proto::Event{0, kind, instrument_id, client_id, sim_time_s, proto::now_ns(), std::move(text), current_tick(),
-                                            request_seq, reason, std::move(scene)});
+                                            request_seq, reason, std::move(scene_name)});
   if (capture)
     capture->events.push_back(std::move(payload));
   else

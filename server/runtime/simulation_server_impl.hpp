@@ -105,7 +105,7 @@ struct SimulationServer::Impl {
   /// A session event for recorders, trainers and consoles (physics thread), stamped with the tick
   /// in progress (the request it concludes, if any).
   void event(proto::EventKind kind, std::uint32_t instrument_id, std::uint32_t client_id, std::string text = {}, std::uint64_t request_seq = 0,
-             proto::EventReason reason = proto::EventReason::unspecified, std::string scene = {});
+             proto::EventReason reason = proto::EventReason::unspecified, std::string scene_name = {});
 
   /// After tick `tick` (physics thread): the command thread answers from this state from now on.
   void publish_snapshot(std::uint64_t tick);
