@@ -75,7 +75,7 @@ LockstepRun run(int threads, std::uint64_t nudge_at = 0) {
   spec.physics_threads = threads;
   MemoryEndpoints endpoints;
   MemoryLockstepLink link;
-  SimulationServer server(spec, endpoints, {}, {}, true);
+  SimulationServer server(spec, endpoints, {}, TickBudget{1e9}, true);  // lockstep: no real time to keep, as viscera-server --lockstep
   LockstepRun r;
   r.scene = endpoints.decoded<proto::Scene>(endpoints.scenes, proto::decode_scene).back();
   std::atomic<bool> stop{false};
@@ -203,7 +203,7 @@ TEST(Lockstep, AStepForAnotherTickIsRefusedWithItsReason) {
   SceneSpec spec = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
   MemoryEndpoints endpoints;
   MemoryLockstepLink link;
-  SimulationServer server(spec, endpoints, {}, {}, true);
+  SimulationServer server(spec, endpoints, {}, TickBudget{1e9}, true);  // lockstep: no real time to keep, as viscera-server --lockstep
   std::atomic<bool> stop{false};
   std::thread t([&] { server.run_lockstep(stop, link, {}); });
   link.push_step({5, 0.0, {}, {}, {}, false});
