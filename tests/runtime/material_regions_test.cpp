@@ -227,8 +227,10 @@ TEST(MaterialRegions, ATaggedElementSetIsTheRegionOfTheElementsTheFileTagged) {
 TEST(MaterialRegions, ARegionOverTheWholeOrganIsTheOrganMadeOfItsMaterial) {
   const std::string q = R"({"shear_q": 4.8, "bulk_q": 20})";
   const std::string soft = isotropic("soft", 5e3, 1060, q), stiff = isotropic("stiff", 40e3, 1100), stiff_ve = isotropic("stiff-ve", 40e3, 1100, q);
-  const auto whole = build_organ(read_scene_file(
-      liver_scene("whole", soft, R"([{"name": "all", "material": ")" + stiff + R"(", "box": {"lo_m": [-9, -9, -9], "hi_m": [9, 9, 9]}}])")), kUntimed);
+  const auto whole =
+      build_organ(read_scene_file(liver_scene(
+                      "whole", soft, R"([{"name": "all", "material": ")" + stiff + R"(", "box": {"lo_m": [-9, -9, -9], "hi_m": [9, 9, 9]}}])")),
+                  kUntimed);
   const auto plain = build_organ(read_scene_file(liver_scene("plain", stiff_ve, "[]")), kUntimed);
   ASSERT_EQ(whole->regions.regions.at(0).elements, whole->mesh->tet_count());
   std::mt19937_64 rng(3);
@@ -249,7 +251,8 @@ TEST(MaterialRegions, ARegionOverTheWholeOrganIsTheOrganMadeOfItsMaterial) {
   const auto nodule =
       build_organ(read_scene_file(liver_scene("nodule", soft,
                                               R"([{"name": "nodule", "material": ")" + stiff +
-                                                  R"(", "sphere": {"radius_m": 0.015, "random_center": {"seed": 11, "depth_m": [0.003, 0.02]}}}])")), kUntimed);
+                                                  R"(", "sphere": {"radius_m": 0.015, "random_center": {"seed": 11, "depth_m": [0.003, 0.02]}}}])")),
+                  kUntimed);
   const RegionLayout& layout = nodule->regions;
   ASSERT_GT(layout.regions.at(0).elements, 0u);
   std::size_t inside_element = 0, outside_element = 0;
@@ -349,7 +352,8 @@ TEST(MaterialRegions, ScenesNameTheRegionFieldThatIsWrong) {
   const std::string soft_q = isotropic("soft-q", 5e3, 1060, R"({"shear_q": 4.8})");
   try {
     build_organ(read_scene_file(
-        liver_scene("q", soft_q, R"([{"name": "n", "material": ")" + other_q + R"(", "box": {"lo_m": [-9,-9,-9], "hi_m": [9,9,9]}}])")), kUntimed);
+                    liver_scene("q", soft_q, R"([{"name": "n", "material": ")" + other_q + R"(", "box": {"lo_m": [-9,-9,-9], "hi_m": [9,9,9]}}])")),
+                kUntimed);
     ADD_FAILURE() << "a region with its own relaxation was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("stiff-q.json: viscoelasticity: differs from the organ's"), std::string::npos) << e.what();
