@@ -10,7 +10,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-20}"
 mkdir -p "$root/bench/results"
 "$root/deploy/build.sh" "$root/build" >/dev/null
-export CYCLONEDDS_URI="file://$root/deploy/cyclonedds.xml"
+export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 tmp="$(mktemp -d)"; pids=()
 trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
 openssl rand -hex 16 > "$tmp/token"

@@ -13,7 +13,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-30}"
 mkdir -p "$root/bench/results"
 "$root/deploy/build.sh" "$root/build" >/dev/null
-export CYCLONEDDS_URI="file://$root/deploy/cyclonedds.xml"
+export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
 ddsperf -D "$((seconds + 2))" pong >/dev/null 2>&1 &
 sleep 0.5

@@ -30,7 +30,7 @@ for b in server/runtime/viscera-server tools/haptic-client/haptic-client tools/v
 done
 mkdir -p "$out"
 tmp="$(mktemp -d)"
-export CYCLONEDDS_URI="file://$root/deploy/cyclonedds.xml"
+export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 domain=$(( (RANDOM % 200) + 1 ))
 # The scene with absolute paths, on a domain of its own, in a scene folder the console can load from.
 sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$root/data/meshes/#; s#\"../materials/#\"$root/data/materials/#" \

@@ -12,7 +12,7 @@ scene="${1:-liver-12k}"; window="${2:-10}"
 [ -f "$root/data/scenes/$scene.json" ] || { echo "thread_cpu.sh: no scene '$scene' in data/scenes" >&2; exit 2; }
 [[ "$window" =~ ^[0-9]+$ ]] && [ "$window" -gt 0 ] || { echo "thread_cpu.sh: SECONDS: '$window' is not a positive whole number" >&2; exit 2; }
 "$root/deploy/build.sh" "$root/build" >/dev/null
-export CYCLONEDDS_URI="file://$root/deploy/cyclonedds.xml"
+export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
 domain=$(( (RANDOM % 200) + 1 ))
 sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$root/data/meshes/#; s#\"../materials/#\"$root/data/materials/#" \

@@ -20,7 +20,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/deploy/build.sh" "$root/build"
 scene="${SCENE:-$root/data/scenes/liver.json}"
 duration="${DURATION:-8}"
-export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$root/deploy/cyclonedds.xml}"
+export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$root/deploy/dds/loopback.xml}"
 domain=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('domain_id', 0))" "$scene")
 bin="$root/build"
 mkdir -p "$root/out"

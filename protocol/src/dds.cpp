@@ -1,9 +1,12 @@
 #include "viscera/protocol/dds.hpp"
 
+#include <cctype>
 #include <cstring>
 
 #include <dds/dds.h>
 
+#include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
 #include "viscera/protocol/streams.hpp"
 
 #include "envelope.h"
@@ -59,7 +62,21 @@ Participant::Participant(std::uint32_t domain_id, std::string partition, std::st
       partition_(std::move(partition)),
       role_(std::move(role)) {}
 
-bool has_partition_wildcard(const std::string& partition) { return partition.find_first_of("*?") != std::string::npos; }
+std::string station_name_problem(const std::string& name) {
+  const std::string shown = "'" + common::printable(name, 80) + "'";
+  if (name.find_first_of("*?") != std::string::npos)
+    return shown + " holds a DDS wildcard ('*' or '?'), which would reach other stations' partitions, live servers' too";
+  if (name.size() > 64) return shown + " is longer than 64 characters";
+  for (const char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.')
+      return shown + " holds a character other than letters, digits, '-', '_' and '.'";
+  return {};
+}
+
+std::string checked_station(const std::string& name) {
+  if (const std::string why = station_name_problem(name); !why.empty()) throw common::UsageError("--station: " + why);
+  return name;
+}
 
 Participant::~Participant() { dds_delete(handle_); }
 

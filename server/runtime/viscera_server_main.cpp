@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
       "viscera-server",
       "Runs the tissue simulation of a scene (organ mesh, material, instruments; docs/SCENE.md) at its physics rate\n"
       "and serves instruments over Cyclone DDS (domain from the scene; configuration from CYCLONEDDS_URI, see\n"
-      "deploy/cyclonedds.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n"
+      "deploy/dds/loopback.xml). Prints physics rate, step times, jitter and forces once a second. SIGINT/SIGTERM stop it.\n"
       "Clients may load another scene of the scene directory, change the material or the physics rate while it runs\n"
       "(viscera-control; docs/PROTOCOL.md). With --lockstep it runs no clock of its own: a driver (viscera-replay\n"
       "resimulate) sends each tick and reads what it produced (docs/RECORDING.md).");
@@ -43,7 +43,10 @@ int main(int argc, char** argv) {
   cl.flag("scene-dir", "DIR", "scenes that clients may load by name (default: the scene file's directory)");
   cl.flag("duration", "S", "stop after S seconds; 0 runs until signalled", "0");
   cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "100");
-  cl.flag("partition", "NAME", "DDS partition of every stream (default: none; a replay or a re-simulation uses its own)", "");
+  cl.flag(
+      "station", "NAME",
+      "this trainee station's name: the DDS partition of every stream, so that several servers share a domain (default: none, the default partition)",
+      "");
   cl.option_switch("lockstep", "ticks advance when a driver says so (deterministic; no tick budget unless --max-tick-ms is given)");
   cl.flag("log-file", "FILE", "append the log's lines to this file too (a service's log)", "");
   cl.option_switch("quiet", "no status lines");
@@ -51,7 +54,7 @@ int main(int argc, char** argv) {
   double duration = 0;
   viscera::runtime::TickBudget budget;
   bool quiet = false, lockstep = false;
-  std::string partition;
+  std::string station;
   try {
     if (!cl.parse(argc, argv)) return 0;
     scene = cl.text("scene");
@@ -63,10 +66,7 @@ int main(int argc, char** argv) {
     budget.max_tick_s = 1e-3 * cl.number_in("max-tick-ms", 0.1, 10000);
     quiet = cl.has("quiet");
     lockstep = cl.has("lockstep");
-    partition = cl.text("partition");
-    if (viscera::protocol::has_partition_wildcard(partition))
-      throw viscera::common::UsageError("--partition: '" + partition +
-                                        "' holds a DDS wildcard ('*' or '?'): the server would take commands from other partitions' replays");
+    station = viscera::protocol::checked_station(cl.text("station"));
     if (lockstep && !cl.given("max-tick-ms")) budget.max_tick_s = 1e9;  // no real time to keep
   } catch (const viscera::common::UsageError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
@@ -85,9 +85,9 @@ int main(int argc, char** argv) {
     // Building a large organ takes seconds (the 96k liver about 3 s): say so before it starts.
     if (!quiet) log->info("loading {}", scene);
     const viscera::runtime::SceneSpec spec = viscera::runtime::read_scene_file(scene);
-    viscera::runtime::DdsEndpoints endpoints(spec.domain_id, partition, lockstep);
+    viscera::runtime::DdsEndpoints endpoints(spec.domain_id, station, lockstep);
     auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget, lockstep);
-    log->info("{}{}", lockstep ? "lockstep, " : "", server->describe());
+    log->info("{}{}{}", lockstep ? "lockstep, " : "", server->describe(), station.empty() ? "" : ", station " + station);
     g_running = true;
     const auto status = [&](const std::string& line) {
       if (!quiet) log->info("{}", line);

@@ -2,7 +2,7 @@
 # domain of the test's own (parallel runs on one machine do not meet) and the liver scene with
 # absolute paths. Sets: tmp, domain, scene. Source it after setting build and src.
 tmp="$(mktemp -d)"
-export CYCLONEDDS_URI="file://$src/deploy/cyclonedds.xml"
+export CYCLONEDDS_URI="file://$src/deploy/dds/loopback.xml"
 domain=$(( (RANDOM % 200) + 1 ))
 scene="$tmp/scene.json"
 sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" \

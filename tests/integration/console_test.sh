@@ -85,7 +85,7 @@ s["physics_rate_hz"] = 200
 s["mesh_rate_hz"] = 10
 json.dump(s, open(sys.argv[2], "w"))
 PY
-"$build/server/runtime/viscera-server" --scene "$tmp/bay2.json" --partition bay-2 > "$tmp/bay2.log" 2>&1 & bay2=$!; pids+=($bay2)
+"$build/server/runtime/viscera-server" --scene "$tmp/bay2.json" --station bay-2 > "$tmp/bay2.log" 2>&1 & bay2=$!; pids+=($bay2)
 wait_for "offered as station bay-2" "$tmp/console.log" 150
 python3 -c "import sys, urllib.request; print(urllib.request.urlopen(sys.argv[1].replace('/?', '/stats?')).read().decode())" "$url" > "$tmp/stats.json"
 kill -INT $bay2; wait $bay2

@@ -126,9 +126,9 @@ sys.exit(0 if cut["messages"] > 1000 and n == cut["messages"] == saved and not c
 PY
 
 # --- Replay at 2x onto a partition of its own, recorded there -------------------------------
-"$rec" --out "$tmp/replayed.mcap" --domain "$domain" --partition replay-test --quiet > "$tmp/rec2.log" 2>&1 & recorder2=$!; pids+=($recorder2)
+"$rec" --out "$tmp/replayed.mcap" --domain "$domain" --station replay-test --quiet > "$tmp/rec2.log" 2>&1 & recorder2=$!; pids+=($recorder2)
 wait_for "recording DDS domain" "$tmp/rec2.log"
-"$replay" play "$tmp/session.mcap" --rate 2 --partition replay-test --domain "$domain" --no-keys --quiet > "$tmp/play.log" 2>&1; rc_play=$?
+"$replay" play "$tmp/session.mcap" --rate 2 --station replay-test --domain "$domain" --no-keys --quiet > "$tmp/play.log" 2>&1; rc_play=$?
 sleep 0.3
 kill -INT "$recorder2"; wait "$recorder2"; rc_rec2=$?
 cat "$tmp/play.log"
@@ -149,15 +149,15 @@ sys.exit(1 if bad else 0)
 PY
 
 # --- A replay steered from a console: pause, seek while paused, resume ---------------------
-"$replay" play "$tmp/session.mcap" --partition replay-ctl --domain "$domain" --no-keys > "$tmp/play-ctl.log" 2>&1 & player=$!; pids+=($player)
+"$replay" play "$tmp/session.mcap" --station replay-ctl --domain "$domain" --no-keys > "$tmp/play-ctl.log" 2>&1 & player=$!; pids+=($player)
 wait_for "playing" "$tmp/play-ctl.log"
 sleep 1
-"$ctl" pause --partition replay-ctl --domain "$domain" > "$tmp/steer.log" 2>&1; rc_pause=$?
-"$ctl" show --partition replay-ctl --domain "$domain" > "$tmp/show-paused.log" 2>&1
-"$ctl" seek 5 --partition replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1; rc_seek=$?
-"$ctl" resume --partition replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1; rc_resume=$?
+"$ctl" pause --station replay-ctl --domain "$domain" > "$tmp/steer.log" 2>&1; rc_pause=$?
+"$ctl" show --station replay-ctl --domain "$domain" > "$tmp/show-paused.log" 2>&1
+"$ctl" seek 5 --station replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1; rc_seek=$?
+"$ctl" resume --station replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1; rc_resume=$?
 sleep 1.5  # a status line or two from where it was sought
-"$ctl" seek 99999 --partition replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1
+"$ctl" seek 99999 --station replay-ctl --domain "$domain" >> "$tmp/steer.log" 2>&1
 wait "$player"; rc_player=$?
 cat "$tmp/steer.log"; tail -4 "$tmp/play-ctl.log"
 check "the replay was paused (rc $rc_pause) and showed it" "[ $rc_pause -eq 0 ] && grep -q 'scene liver: paused' '$tmp/show-paused.log'"
@@ -238,7 +238,7 @@ bad "not MCAP" "not-mcap.mcap" "$replay" resimulate "$tmp/not-mcap.mcap" --domai
 bad "newer schema" "newer viscera" "$replay" play "$tmp/newer.mcap" --domain "$domain" --no-keys --quiet
 bad "another organ's scene" "other-organ.json" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --scene "$tmp/other-organ.json" --quiet
 bad "recover onto itself" "another file" "$rec" recover "$tmp/killed.mcap" "$tmp/killed.mcap"
-bad "play from past the end" "is past the recording" "$replay" play "$tmp/session.mcap" --from 1000 --partition x --domain "$domain" --no-keys --quiet
+bad "play from past the end" "is past the recording" "$replay" play "$tmp/session.mcap" --from 1000 --station x --domain "$domain" --no-keys --quiet
 echo '[1, 2]' > "$tmp/array-scene.json"
 bad "a scene that is an array" "array-scene.json: JSON: [1,2] is not an object" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --scene "$tmp/array-scene.json" --quiet
 
@@ -280,16 +280,16 @@ sys.exit(0 if 0.5 * total < n < total and len(fixed["attachments"]) == len(whole
 PY
 
 # --- A replay never drives a live server ------------------------------------------------------
-"$build/server/runtime/viscera-server" --scene "$scene" --partition live-guard > "$tmp/guard-server.log" 2>&1 & guard=$!; pids+=($guard)
+"$build/server/runtime/viscera-server" --scene "$scene" --station live-guard > "$tmp/guard-server.log" 2>&1 & guard=$!; pids+=($guard)
 wait_for "DDS domain" "$tmp/guard-server.log"
-bad "a replay into a live server's partition" "holds a live viscera-server" "$replay" play "$tmp/session.mcap" --partition live-guard --domain "$domain" --no-keys --quiet
-bad "a replay into every partition" "holds a DDS wildcard" "$replay" play "$tmp/session.mcap" --partition '*' --domain "$domain" --no-keys --quiet
-"$ctl" show --partition live-guard --domain "$domain" > "$tmp/guard-show.log" 2>&1
+bad "a replay into a live server's partition" "holds a live viscera-server" "$replay" play "$tmp/session.mcap" --station live-guard --domain "$domain" --no-keys --quiet
+bad "a replay into every partition" "holds a DDS wildcard" "$replay" play "$tmp/session.mcap" --station '*' --domain "$domain" --no-keys --quiet
+"$ctl" show --station live-guard --domain "$domain" > "$tmp/guard-show.log" 2>&1
 check "the live server's instruments stay free" "grep -q 'instruments: 1 (probe, free)' '$tmp/guard-show.log'"
 # A server that starts in a replay's partition stops the replay.
-"$replay" play "$tmp/session.mcap" --loop --partition late-guard --domain "$domain" --no-keys --quiet > "$tmp/late.log" 2>&1 & late=$!; pids+=($late)
+"$replay" play "$tmp/session.mcap" --loop --station late-guard --domain "$domain" --no-keys --quiet > "$tmp/late.log" 2>&1 & late=$!; pids+=($late)
 sleep 1.5
-"$build/server/runtime/viscera-server" --scene "$scene" --partition late-guard > "$tmp/late-server.log" 2>&1 & late_server=$!; pids+=($late_server)
+"$build/server/runtime/viscera-server" --scene "$scene" --station late-guard > "$tmp/late-server.log" 2>&1 & late_server=$!; pids+=($late_server)
 for _ in $(seq 150); do kill -0 "$late" 2>/dev/null || break; sleep 0.1; done
 wait "$late"; rc_late=$?
 cat "$tmp/late.log"

@@ -44,9 +44,15 @@ TEST(Streams, EachBinarySchemaDefinesTheRootTableTheTableNames) {
 TEST(Streams, StateIsWhatLateJoinersGetAndDroppableIsWhatIsNotRetransmittedOrKeptAll) {
   for (const StreamInfo& info : streams()) {
     EXPECT_EQ(info.state, info.durability == Durability::transient_local) << info.topic;
-    if (info.reliability == Reliability::best_effort) EXPECT_TRUE(info.droppable) << info.topic;
-    if (info.droppable) EXPECT_EQ(info.depth, 1) << info.topic;
-    if (!info.session) EXPECT_EQ(info.depth, 0) << info.topic << ": a re-simulation's streams lose nothing";
+    if (info.reliability == Reliability::best_effort) {
+      EXPECT_TRUE(info.droppable) << info.topic;
+    }
+    if (info.droppable) {
+      EXPECT_EQ(info.depth, 1) << info.topic;
+    }
+    if (!info.session) {
+      EXPECT_EQ(info.depth, 0) << info.topic << ": a re-simulation's streams lose nothing";
+    }
   }
 }
 

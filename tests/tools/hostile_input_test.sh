@@ -7,7 +7,7 @@
 set -u
 build="$1"; src="$(cd "$2" && pwd)"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
-export CYCLONEDDS_URI="file://$src/deploy/cyclonedds.xml"
+export CYCLONEDDS_URI="file://$src/deploy/dds/loopback.xml"
 server="$build/server/runtime/viscera-server"; trainer="$build/tools/viscera-trainer/viscera-trainer"
 rec="$build/tools/viscera-record/viscera-record"; replay="$build/tools/viscera-replay/viscera-replay"
 ctl="$build/tools/viscera-control/viscera-control"; lab="$build/tools/viscera-lab/viscera-lab"; hc="$build/tools/haptic-client/haptic-client"
@@ -83,10 +83,16 @@ printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n1,0,0,0\n' > "$tmp/t.csv"; cp "$tmp/t.cs
 expect hc-report-over-trajectory 2 "is the same file as" -- "$hc" --trajectory "$tmp/t.csv" --report "$tmp/t.csv"
 unchanged hc-report "$tmp/t.csv" "$tmp/t.copy"
 
-# 5. DDS wildcards as partitions: a replay or a server would reach other partitions' live sessions.
-expect replay-wildcard 2 "holds a DDS wildcard" -- "$replay" play "$tmp/in.mcap" --partition '*' --no-keys
-expect replay-wildcard-q 2 "holds a DDS wildcard" -- "$replay" play "$tmp/in.mcap" --partition 'viscera-?eplay' --no-keys
-expect server-wildcard 2 "holds a DDS wildcard" -- "$server" --scene "$tmp/scenes/liver.json" --partition '*'
+# 5. Station names are DDS partitions: a wildcard would reach other stations' live sessions, and
+#    every program that joins a station checks the name before it touches the network.
+expect replay-wildcard 2 "holds a DDS wildcard" -- "$replay" play "$tmp/in.mcap" --station '*' --no-keys
+expect replay-wildcard-q 2 "holds a DDS wildcard" -- "$replay" play "$tmp/in.mcap" --station 'viscera-?eplay' --no-keys
+expect server-wildcard 2 "holds a DDS wildcard" -- "$server" --scene "$tmp/scenes/liver.json" --station '*'
+expect hc-wildcard 2 "--station: '*' holds a DDS wildcard" -- "$hc" --station '*'
+expect trainer-wildcard 2 "--station: 'bay?' holds a DDS wildcard" -- "$trainer" run "$src/data/exercises/palpation.json" --station 'bay?'
+expect record-space 2 "--station: 'bay 1' holds a character other than" -- "$rec" --out "$tmp/s.mcap" --station 'bay 1'
+expect control-long 2 "is longer than 64 characters" -- "$ctl" show --station "$(printf 'b%.0s' $(seq 65))"
+expect server-slash 2 "--station: 'a/b' holds a character other than" -- "$server" --scene "$tmp/scenes/liver.json" --station 'a/b'
 
 echo "hostile_input_test: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

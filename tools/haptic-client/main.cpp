@@ -23,6 +23,7 @@
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
+#include "viscera/protocol/dds.hpp"
 
 #include "palpating_device.hpp"
 #include "scripted_device.hpp"
@@ -109,7 +110,7 @@ struct Options {
   double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, hold_s = -1, force_n = 1.0, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100,
          duration_s = 4;
   viscera::client::FadePolicy fade;
-  std::string script, frame, report;
+  std::string station, script, frame, report;
   std::vector<viscera::haptic::TrajectoryPoint> trajectory;
   std::string trajectory_file;
   bool quiet = false, watch_mesh = false, reconnect = false;
@@ -118,6 +119,7 @@ struct Options {
 Options parse(viscera::common::CommandLine& cl) {
   Options o;
   o.domain = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
+  o.station = viscera::protocol::checked_station(cl.text("station"));
   o.client_id = static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000));
   o.instrument = static_cast<std::uint32_t>(cl.integer_in("instrument", 1, 1000000));
   o.rate_hz = cl.number_in("rate", 1, 20000);
@@ -260,6 +262,7 @@ int main(int argc, char** argv) {
       "Exit status: 0 done, 2 bad arguments, 3 no server or instrument not claimed, 4 the server went away, 5 the instrument was\n"
       "released by another client (another process under this client id?), 1 other errors.");
   cl.flag("domain", "ID", "DDS domain", "0");
+  cl.flag("station", "NAME", "the trainee station whose server to use: its DDS partition (viscera-server --station)", "");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");
   cl.flag("instrument", "ID", "instrument to claim", "1");
   cl.flag("duration", "S", "length of the run [s] (default: 4 for scripts, the trajectory's length for --trajectory)");
@@ -283,10 +286,10 @@ int main(int argc, char** argv) {
   try {
     if (!cl.parse(argc, argv)) return 0;
     const Options o = parse(cl);
-    viscera::client::Client client(o.domain, o.client_id);
+    viscera::client::Client client(o.domain, o.client_id, o.station);
     const auto scene = client.wait_for_scene(std::chrono::seconds(10));
     if (!scene) {
-      std::fprintf(stderr, "haptic-client: no viscera-server found in 10 s (same domain and CYCLONEDDS_URI?)\n");
+      std::fprintf(stderr, "haptic-client: no viscera-server found in 10 s (same domain, --station and CYCLONEDDS_URI?)\n");
       return 3;
     }
     if (const auto claim = client.claim(o.instrument, std::chrono::seconds(5)); !claim) {

@@ -192,7 +192,7 @@ int main(int argc, char** argv) {
         const std::string log = (std::filesystem::path(log_dir) / (partition + ".log")).string();
         try {
           replays.push_back(std::make_unique<viscera::process::ChildProcess>(
-              std::vector<std::string>{replayer, "play", recordings_dir + "/" + file, "--partition", partition, "--domain", std::to_string(domain),
+              std::vector<std::string>{replayer, "play", recordings_dir + "/" + file, "--station", partition, "--domain", std::to_string(domain),
                                        "--no-keys", "--quiet"},
               log));
         } catch (const std::exception& e) {

@@ -17,6 +17,7 @@
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/number_text.hpp"
+#include "viscera/protocol/dds.hpp"
 
 namespace {
 
@@ -221,16 +222,19 @@ int main(int argc, char** argv) {
       "  load SCENE      load a scene of the server's scene directory (show lists them); instruments are released\n"
       "  material        change material parameters (the flags below; the organ keeps its deformation)\n"
       "  rate HZ         change the physics rate [Hz]\n"
-      "  seek S          a replay (viscera-replay play, with --partition): jump to S seconds from the recording's start\n"
+      "  seek S          a replay (viscera-replay play, with --station): jump to S seconds from the recording's start\n"
       "  show            print the scene state\n"
       "  health          print the server's health reports (physics rate, step times, late ticks, missed slots,\n"
       "                  rejected messages) for --duration seconds, then what changed over them\n"
       "  events          print the session's events and annotations for --duration seconds\n"
       "  annotate TEXT   a note for recorders and consoles\n"
       "Exit status: 0 done, 1 refused or not confirmed, 2 bad arguments, 3 no server, 4 the server went away (health, events).");
-  cl.usage("viscera-control ACTION [ARGUMENT] [--domain ID] [--partition NAME] [--duration S] [material flags]");
+  cl.usage("viscera-control ACTION [ARGUMENT] [--domain ID] [--station NAME] [--duration S] [material flags]");
   cl.flag("domain", "ID", "DDS domain", "0");
-  cl.flag("partition", "NAME", "DDS partition: none for live servers, a replay's (viscera-replay play --partition) to follow and steer it", "");
+  cl.flag("station", "NAME",
+          "the station to act on: a live server's (viscera-server --station) or a replay's (viscera-replay play --station) to follow and steer it "
+          "(default: none, the default partition)",
+          "");
   cl.flag("client-id", "N", "this client's id (non-zero)", "900");
   cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
   cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
@@ -240,11 +244,12 @@ int main(int argc, char** argv) {
   try {
     if (!cl.parse(argc, argv)) return 0;
     const Request r = parse(cl);
+    const std::string station = viscera::protocol::checked_station(cl.text("station"));
     viscera::client::Client client(static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230)),
-                                   static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000)), cl.text("partition"));
+                                   static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000)), station);
     auto scene = client.wait_for_scene(std::chrono::seconds(10));
     if (!scene) {
-      std::fprintf(stderr, "viscera-control: no viscera-server (or replay) found in 10 s (same domain, partition and CYCLONEDDS_URI?)\n");
+      std::fprintf(stderr, "viscera-control: no viscera-server (or replay) found in 10 s (same domain, --station and CYCLONEDDS_URI?)\n");
       return 3;
     }
     if (r.action == "events") return follow_events(client, *scene, r.duration_s);

@@ -14,6 +14,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/mcap/mcap_reader.hpp"
+#include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/messages.hpp"
 #include "viscera/recording/payload_verification.hpp"
 #include "viscera/recording/recording.hpp"
@@ -58,7 +59,7 @@ std::string megabytes(std::uint64_t bytes) {
 int record(const viscera::common::CommandLine& cl) {
   rec::RecordingInfo info;
   info.domain_id = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
-  info.partition = cl.text("partition");
+  info.partition = proto::checked_station(cl.text("station"));
   info.streams = parse_topics(cl.text("topics"));
   info.recorder = "viscera-record, protocol schema " + std::to_string(proto::kSchemaVersion);
   viscera::mcap::WriterOptions options;
@@ -78,7 +79,7 @@ int record(const viscera::common::CommandLine& cl) {
   rec::RecordingWriter writer(out, info, options);
   viscera::client::StreamTap tap(info.domain_id, info.partition, info.streams, depth);
   std::printf("viscera-record: recording DDS domain %u%s%s to %s (%s chunks of %.1f MiB or %.1f s)%s\n", info.domain_id,
-              info.partition.empty() ? "" : ", partition ", info.partition.c_str(), out.c_str(),
+              info.partition.empty() ? "" : ", station ", info.partition.c_str(), out.c_str(),
               options.compression.empty() ? "uncompressed" : options.compression.c_str(), static_cast<double>(options.chunk_bytes) / 1048576.0,
               1e-9 * static_cast<double>(options.chunk_ns), duration > 0 ? "" : "; Ctrl-C stops");
   std::fflush(stdout);
@@ -159,7 +160,7 @@ int info(const std::vector<std::string>& args, bool verify) {
   const auto& s = r.summary();
   std::printf("%s: viscera recording, protocol schema %s, DDS domain %s%s%s, by %s\n", shown(r.path()).c_str(),
               shown(r.info().at("schema_version")).c_str(), r.info().count("domain_id") ? shown(r.info().at("domain_id")).c_str() : "?",
-              r.info().count("partition") && !r.info().at("partition").empty() ? ", partition " : "",
+              r.info().count("partition") && !r.info().at("partition").empty() ? ", station " : "",
               r.info().count("partition") ? shown(r.info().at("partition")).c_str() : "",
               r.info().count("recorder") ? shown(r.info().at("recorder")).c_str() : "?");
   const std::uint64_t span = r.end_ns() - r.start_ns();
@@ -245,7 +246,7 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "stop after S seconds; 0: until SIGINT/SIGTERM", "0");
   cl.flag("topics", "a,b,...", "streams to record (default: all; names as in docs/PROTOCOL.md, e.g. force_feedback,event)", "");
   cl.flag("domain", "ID", "DDS domain", "0");
-  cl.flag("partition", "NAME", "DDS partition (default: none, where live servers are)", "");
+  cl.flag("station", "NAME", "the station to record: its DDS partition (default: none, the default partition)", "");
   cl.flag("compression", "NAME", "zstd | lz4 | none", "zstd");
   cl.flag("chunk-mb", "MIB", "close a chunk at this much data [MiB]", "4");
   cl.flag("chunk-s", "S", "or when its messages span this long [s] (the most a killed recorder loses)", "1");

@@ -22,22 +22,22 @@ int main(int argc, char** argv) {
   viscera::common::CommandLine cl(
       "viscera-replay",
       "Plays a session recording (viscera-record) back, or re-simulates it (docs/RECORDING.md).\n"
-      "  play FILE.mcap         publishes the recording again at its original pace times --rate, onto DDS partition\n"
-      "                         --partition (never the live one: a replay must not drive a live server's instruments).\n"
-      "                         Follow it with viscera-control --partition NAME. Space pauses and resumes, left and\n"
+      "  play FILE.mcap         publishes the recording again at its original pace times --rate, as the station\n"
+      "                         --station (never a live one: a replay must not drive a live server's instruments).\n"
+      "                         Follow it with viscera-control --station NAME. Space pauses and resumes, left and\n"
       "                         right seek 5 s, q quits (on a terminal); pause, resume and seek session requests sent\n"
-      "                         to the replayer do the same (viscera-control pause|resume|seek S --partition NAME).\n"
+      "                         to the replayer do the same (viscera-control pause|resume|seek S --station NAME).\n"
       "  resimulate FILE.mcap   starts a fresh viscera-server in lockstep on the recorded scene (or --scene), feeds it\n"
       "                         the recorded commands and requests at the ticks the original applied them, and compares\n"
       "                         every force, event and surface frame. Exit 0: bit-identical; 1: diverged (the first\n"
       "                         divergence is named: tick, topic, field, recorded and recomputed values).\n"
       "Exit status 2: bad arguments or a recording that cannot be used (one line says why); 3: DDS or the server failed.");
-  cl.usage("viscera-replay play FILE.mcap [--rate R] [--loop] [--from S] [--to S] [--partition NAME] | resimulate FILE.mcap [--report OUT.json]");
+  cl.usage("viscera-replay play FILE.mcap [--rate R] [--loop] [--from S] [--to S] [--station NAME] | resimulate FILE.mcap [--report OUT.json]");
   cl.flag("rate", "R", "play: pace, times the original", "1");
   cl.option_switch("loop", "play: start again at --from after --to");
   cl.flag("from", "S", "play: from this time of the recording [s]", "0");
   cl.flag("to", "S", "play: to this time of the recording [s] (default: its end)");
-  cl.flag("partition", "NAME", "play: DDS partition to publish in", "viscera-replay");
+  cl.flag("station", "NAME", "play: the station (DDS partition) to publish as, never a live server's", "viscera-replay");
   cl.flag("domain", "ID", "DDS domain (default: the recording's)");
   cl.option_switch("no-keys", "play: ignore the terminal's keys");
   cl.flag("report", "OUT.json", "resimulate: write the report here");
@@ -61,11 +61,8 @@ int main(int argc, char** argv) {
       o.loop = cl.has("loop");
       o.from_s = cl.number_in("from", 0, 1e9);
       if (cl.has("to")) o.to_s = cl.number_in("to", 0, 1e9);
-      o.partition = cl.text("partition");
-      if (o.partition.empty()) throw UsageError("--partition: a replay publishes in a partition of its own, not the live one");
-      if (viscera::protocol::has_partition_wildcard(o.partition))  // the SDK's StreamPublisher refuses it too
-        throw UsageError("--partition: '" + o.partition +
-                         "' holds a DDS wildcard ('*' or '?'), which would reach other partitions, live servers' too");
+      o.partition = viscera::protocol::checked_station(cl.text("station"));  // the SDK's StreamPublisher refuses the same
+      if (o.partition.empty()) throw UsageError("--station: a replay publishes as a station of its own, not in the default partition");
       o.domain = domain;
       o.keys = !cl.has("no-keys");
       o.quiet = cl.has("quiet");
@@ -86,7 +83,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "viscera-replay: %s\n", e.what());
     return 2;
   } catch (const std::invalid_argument& e) {  // a partition the SDK refuses to replay into
-    std::fprintf(stderr, "viscera-replay: --partition: %s\n", e.what());
+    std::fprintf(stderr, "viscera-replay: --station: %s\n", e.what());
     return 2;
   } catch (const viscera::protocol::DdsError& e) {
     std::fprintf(stderr, "viscera-replay: %s\n", e.what());

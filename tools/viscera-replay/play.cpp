@@ -88,8 +88,8 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
   for (const auto& [s, _] : streams) publisher.open(s);
   publisher.wait_for_readers(std::chrono::milliseconds(static_cast<long long>(o.discovery_s * 1000)));
   const std::string live_server =
-      "partition '" + common::printable(o.partition, 80) + "' holds a live viscera-server: a replay never drives one (choose a partition of its own)";
-  if (publisher.live_server()) throw common::InputError("--partition", 0, "", live_server);
+      "station '" + common::printable(o.partition, 80) + "' holds a live viscera-server: a replay never drives one (choose a station name of its own)";
+  if (publisher.live_server()) throw common::InputError("--station", 0, "", live_server);
 
   // The scene state the replay shows: the recording's newest, with the playback's pause and the
   // outcomes of the requests sent to the replayer.
@@ -126,7 +126,7 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
 
   RawTerminal terminal(o.keys);
   if (!o.quiet) {
-    std::printf("viscera-replay: playing %s (%s) from %s to %s at %gx onto DDS domain %u, partition '%s'%s\n", o.recording.c_str(),
+    std::printf("viscera-replay: playing %s (%s) from %s to %s at %gx onto DDS domain %u, station '%s'%s\n", o.recording.c_str(),
                 seconds(t_end - t0).c_str(), seconds(from - t0).c_str(), seconds(to - t0).c_str(), o.rate, domain, o.partition.c_str(),
                 terminal.active() ? "; keys: space pause/resume, left/right seek 5 s, q quit" : "");
     std::fflush(stdout);

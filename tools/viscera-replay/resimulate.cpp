@@ -66,7 +66,7 @@ int resimulate(const ResimulateOptions& o) {
 
   client::LockstepDriver driver(domain, partition);
   process::ChildProcess server(
-      {o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--partition", partition, "--quiet"},
+      {o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--station", partition, "--quiet"},
       (dir.path / "server.log").string());
   const auto fail = [&](const std::string& what) -> int {
     const std::string tail = server.log_tail();

@@ -16,6 +16,7 @@
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
+#include "viscera/protocol/dds.hpp"
 #include "viscera/recording/recording.hpp"
 #include "viscera/training/exercise_scorer.hpp"
 
@@ -71,12 +72,13 @@ int score(const Exercise& exercise, const std::string& path, const std::string& 
   return conclude(scorer.report(), dir);
 }
 
-int run(const Exercise& exercise, std::uint32_t domain, std::optional<std::uint64_t> seed, std::uint32_t client_id, const std::string& dir) {
+int run(const Exercise& exercise, std::uint32_t domain, const std::string& station, std::optional<std::uint64_t> seed, std::uint32_t client_id,
+        const std::string& dir) {
   viscera::client::StreamTap tap(
-      domain, "", {proto::Stream::instrument_command, proto::Stream::force_feedback, proto::Stream::event, proto::Stream::scene_state});
-  viscera::client::Client client(domain, client_id);
+      domain, station, {proto::Stream::instrument_command, proto::Stream::force_feedback, proto::Stream::event, proto::Stream::scene_state});
+  viscera::client::Client client(domain, client_id, station);
   if (!client.wait_for_scene(std::chrono::seconds(10))) {
-    std::fprintf(stderr, "viscera-trainer: no viscera-server found in 10 s (same domain and CYCLONEDDS_URI?)\n");
+    std::fprintf(stderr, "viscera-trainer: no viscera-server found in 10 s (same domain, --station and CYCLONEDDS_URI?)\n");
     return 3;
   }
   ExerciseScorer scorer(exercise);
@@ -152,6 +154,7 @@ int main(int argc, char** argv) {
       "Exit status: 0 passed, 1 failed, 2 bad arguments or files (one line says why), 3 no server.");
   cl.usage("viscera-trainer run EXERCISE.json [--seed N] [--report-dir DIR] | score EXERCISE.json FILE.mcap [--report-dir DIR]");
   cl.flag("domain", "ID", "run: DDS domain", "0");
+  cl.flag("station", "NAME", "run: the trainee station whose server to score: its DDS partition (viscera-server --station)", "");
   cl.flag("seed", "N", "run: the seed that places the scene's drawn regions (a palpation's hidden nodule)");
   cl.flag("client-id", "N", "run: this client's id (non-zero)", "800");
   cl.flag("report-dir", "DIR", "write the report here as EXERCISE.json and EXERCISE.md", "");
@@ -179,7 +182,7 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, on_signal);
     std::optional<std::uint64_t> seed;
     if (cl.has("seed")) seed = cl.integer_in("seed", 0, 9007199254740991);
-    return run(exercise, static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230)), seed,
+    return run(exercise, static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230)), viscera::protocol::checked_station(cl.text("station")), seed,
                static_cast<std::uint32_t>(cl.integer_in("client-id", 1, 4000000000)), cl.text("report-dir"));
   } catch (const UsageError& e) {
     std::fprintf(stderr, "viscera-trainer: %s\n", e.what());

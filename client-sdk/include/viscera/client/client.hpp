@@ -41,7 +41,7 @@ struct LatencyStats {
 class Client {
  public:
   /// `partition`: the DDS partition to work in ("" : the default, where live servers are; a replay
-  /// publishes in a partition of its own, viscera-replay --partition).
+  /// publishes in a partition of its own, viscera-replay play --station).
   Client(std::uint32_t domain_id, std::uint32_t client_id, const std::string& partition = {});
   ~Client();
 

@@ -69,8 +69,13 @@ class Participant {
 
 /// The role of a viscera-server's writers (live or lockstep).
 inline constexpr const char* kServerRole = "viscera-server";
-/// Whether a partition name holds a DDS wildcard ('*' or '?'), which matches other partitions.
-bool has_partition_wildcard(const std::string& partition);
+/// A station (one trainee's server and its clients) is a DDS partition of that name; "" is the
+/// default partition. Why `name` cannot name one, or "" if it can: a DDS wildcard ('*', '?') would
+/// reach other stations' partitions, and only letters, digits, '-', '_' and '.' (at most 64) fit the
+/// partition lists of DDS Security permissions and a log line (docs/DEPLOY.md).
+std::string station_name_problem(const std::string& name);
+/// A program's --station value: `name`, or common::UsageError("--station: <the problem>").
+std::string checked_station(const std::string& name);
 
 struct Received {
   std::uint32_t source_id;
