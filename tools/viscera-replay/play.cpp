@@ -87,8 +87,8 @@ int play(const PlayOptions& o, const std::atomic<bool>& stop) {
   for (const auto& [id, ch] : recording.channels()) streams[ch.stream] = true;
   for (const auto& [s, _] : streams) publisher.open(s);
   publisher.wait_for_readers(std::chrono::milliseconds(static_cast<long long>(o.discovery_s * 1000)));
-  const std::string live_server =
-      "station '" + common::printable(o.partition, 80) + "' holds a live viscera-server: a replay never drives one (choose a station name of its own)";
+  const std::string live_server = "station '" + common::printable(o.partition, 80) +
+                                  "' holds a live viscera-server: a replay never drives one (choose a station name of its own)";
   if (publisher.live_server()) throw common::InputError("--station", 0, "", live_server);
 
   // The scene state the replay shows: the recording's newest, with the playback's pause and the
