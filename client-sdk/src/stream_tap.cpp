@@ -57,7 +57,8 @@ struct StreamPublisher::Impl {
 
 namespace {
 const std::string& own_partition(const std::string& partition) {
-  if (partition.empty()) throw std::invalid_argument("a replay publishes as a station of its own, not in the default partition where live servers are");
+  if (partition.empty())
+    throw std::invalid_argument("a replay publishes as a station of its own, not in the default partition where live servers are");
   if (const std::string why = proto::station_name_problem(partition); !why.empty()) throw std::invalid_argument(why);
   return partition;
 }
