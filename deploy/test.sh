@@ -32,7 +32,7 @@ sanitized_tests() {
   (cd "$root/build-sanitize" && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --output-on-failure -j "$(nproc)" -L 'unit|lab|tools' -E "$lab_numerics")
 }
-threads="server_threads_test parallel_forces_test session_control_test instrument_table_test"
+threads="server_threads_test parallel_forces_test session_control_test instrument_table_test client_binding_test"
 tsan_tests() {
   for t in $threads; do
     echo "ThreadSanitizer: $t"

@@ -26,7 +26,14 @@ const char* to_string(ServerState s) {
 
 struct Client::Impl {
   proto::Participant participant;
-  proto::Writer commands, sessions;
+  proto::Writer sessions;
+  // Made on the first claim or command: a participant whose DDS Security permissions do not grant
+  // instrument commands (a trainer, a recorder's identity) still makes session requests.
+  std::unique_ptr<proto::Writer> commands;
+  proto::Writer& command_writer() {
+    if (!commands) commands = std::make_unique<proto::Writer>(participant, proto::Stream::instrument_command);
+    return *commands;
+  }
   proto::TypedReader<proto::Stream::force_feedback> forces;
   proto::TypedReader<proto::Stream::scene_state> scene;
   std::optional<proto::Scene> last_scene;
@@ -45,11 +52,7 @@ struct Client::Impl {
   std::mutex callback_mutex;
   std::function<void(ServerState)> callback;
   Impl(std::uint32_t domain, const std::string& partition)
-      : participant(domain, partition),
-        commands(participant, proto::Stream::instrument_command),
-        sessions(participant, proto::Stream::session_request),
-        forces(participant),
-        scene(participant) {
+      : participant(domain, partition), sessions(participant, proto::Stream::session_request), forces(participant), scene(participant) {
     scene.raw().on_alive_writers_changed([this](int alive) { liveliness(alive); });
     liveliness(scene.alive_writers());  // a server discovered before the listener was set
   }
@@ -97,6 +100,7 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
   // Shown as this id's before this client asked for it: another process runs under this client id
   // and holds it. Not asked for (a claim would renew that process's lease) until it lets it go.
   bool another_owner_seen = impl_->claimed.count(instrument_id) > 0;
+  impl_->command_writer();  // discovered by the server's reader while the claim goes through
   while (std::chrono::steady_clock::now() < end) {
     impl_->take_scene();
     if (const auto& s = impl_->last_scene) {
@@ -119,7 +123,7 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
         impl_->claimed.insert(instrument_id);
         // Before the first command: every reader of commands (the server's, a recorder's) knows
         // this client's writer, or the first commands are lost to the one that learns of it last.
-        impl_->commands.wait_for_settled_readers(std::chrono::milliseconds(100), std::chrono::milliseconds(500));
+        impl_->command_writer().wait_for_settled_readers(std::chrono::milliseconds(100), std::chrono::milliseconds(500));
         return {true, {}};
       }
       // Taken: keep asking until the timeout, its owner may release it (or lose it to the lease).
@@ -222,7 +226,7 @@ void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, do
   c.tip_position = tip;
   c.jaw_opening = jaw_opening_rad;
   c.buttons = buttons;
-  impl_->commands.write(instrument_id, proto::encode(c));
+  impl_->command_writer().write(instrument_id, proto::encode(c));
 }
 
 std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {

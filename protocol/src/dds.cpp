@@ -1,7 +1,13 @@
 #include "viscera/protocol/dds.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstring>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string_view>
 
 #include <dds/dds.h>
 
@@ -18,6 +24,40 @@ int32_t check(int32_t rc, const char* what) {
   if (rc < 0) throw DdsError(what, rc);
   return rc;
 }
+
+// Cyclone logs why a call failed (a missing certificate, a permissions document that does not
+// verify) on the calling thread before it returns the bare code. While a viscera call creates an
+// entity, its thread keeps that line for the error instead of printing it: one line per failure.
+// Everything else Cyclone logs goes to stderr as before.
+thread_local bool t_capturing = false;
+thread_local std::string t_cyclone_said;
+
+void log_sink(void*, const dds_log_data_t* d) {
+  std::string_view m(d->message, d->size);
+  if (t_capturing && (d->priority & (DDS_LC_FATAL | DDS_LC_ERROR | DDS_LC_WARNING)) != 0) {
+    while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.remove_suffix(1);
+    if (t_cyclone_said.empty()) t_cyclone_said = m;
+    return;
+  }
+  std::fprintf(stderr, "DDS: %.*s%s", static_cast<int>(m.size()), m.data(), m.empty() || m.back() != '\n' ? "\n" : "");
+}
+
+/// Runs `create` with Cyclone's errors kept; a failure throws DdsError naming `what`, Cyclone's
+/// reason and, where security refused it, what the identity's permissions must grant.
+int32_t created(const std::function<int32_t()>& create, const std::string& what, const std::string& refused_by_security = {}) {
+  static std::once_flag sink;
+  std::call_once(sink, [] { dds_set_log_sink(log_sink, nullptr); });
+  t_capturing = true;
+  t_cyclone_said.clear();
+  const int32_t rc = create();
+  t_capturing = false;
+  if (rc >= 0) return rc;
+  std::string detail = rc == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY ? refused_by_security : std::string();
+  if (!t_cyclone_said.empty()) detail += (detail.empty() ? "" : "; ") + common::printable(t_cyclone_said, 300);
+  throw DdsError(what, rc, detail);
+}
+
+std::string shown_partition(const std::string& partition) { return partition.empty() ? "the default partition" : "station '" + partition + "'"; }
 
 dds_qos_t* qos_for(Stream s, const std::string& partition, const std::string& role = {}) {
   dds_qos_t* q = dds_create_qos();
@@ -42,7 +82,8 @@ dds_qos_t* qos_for(Stream s, const std::string& partition, const std::string& ro
 }
 }  // namespace
 
-DdsError::DdsError(const std::string& what, int32_t code) : std::runtime_error("DDS: " + what + ": " + dds_strretcode(code)) {}
+DdsError::DdsError(const std::string& what, int32_t code, const std::string& detail)
+    : std::runtime_error("DDS: " + what + ": " + dds_strretcode(code) + (detail.empty() ? "" : ": " + detail)) {}
 
 const char* topic_name(Stream s) { return stream_info(s).topic; }
 
@@ -58,7 +99,8 @@ bool parse_stream(const std::string& name, Stream* out) {
 }
 
 Participant::Participant(std::uint32_t domain_id, std::string partition, std::string role)
-    : handle_(check(dds_create_participant(domain_id, nullptr, nullptr), "create participant")),
+    : handle_(
+          created([&] { return dds_create_participant(domain_id, nullptr, nullptr); }, "create participant (the configuration in CYCLONEDDS_URI)")),
       partition_(std::move(partition)),
       role_(std::move(role)) {}
 
@@ -82,15 +124,17 @@ Participant::~Participant() { dds_delete(handle_); }
 
 int32_t Participant::topic(Stream s) {
   int32_t& t = topics_[static_cast<int>(s)];
-  if (t == 0) t = check(dds_create_topic(handle_, &viscera_Envelope_desc, topic_name(s), nullptr, nullptr), topic_name(s));
+  if (t == 0)
+    t = created([&] { return dds_create_topic(handle_, &viscera_Envelope_desc, topic_name(s), nullptr, nullptr); },
+                std::string("create topic ") + topic_name(s));
   return t;
 }
 
 Writer::Writer(Participant& p, Stream s) {
-  dds_qos_t* q = qos_for(s, p.partition(), p.role());
-  handle_ = dds_create_writer(p.handle(), p.topic(s), q, nullptr);
-  dds_delete_qos(q);
-  check(handle_, "create writer");
+  const std::unique_ptr<dds_qos_t, void (*)(dds_qos_t*)> q(qos_for(s, p.partition(), p.role()), dds_delete_qos);
+  handle_ = created([&] { return dds_create_writer(p.handle(), p.topic(s), q.get(), nullptr); },
+                    std::string("create writer of ") + topic_name(s) + " in " + shown_partition(p.partition()),
+                    "DDS Security: this identity's permissions document does not grant publishing it");
 }
 
 Writer::~Writer() { dds_delete(handle_); }
@@ -143,11 +187,11 @@ bool Writer::wait_for_acks(std::chrono::milliseconds timeout) const {
 }
 
 Reader::Reader(Participant& p, Stream s, ReaderOptions options) {
-  dds_qos_t* q = qos_for(s, p.partition());
-  if (options.history_depth > 0) dds_qset_history(q, DDS_HISTORY_KEEP_LAST, options.history_depth);
-  handle_ = dds_create_reader(p.handle(), p.topic(s), q, nullptr);
-  dds_delete_qos(q);
-  check(handle_, "create reader");
+  const std::unique_ptr<dds_qos_t, void (*)(dds_qos_t*)> q(qos_for(s, p.partition()), dds_delete_qos);
+  if (options.history_depth > 0) dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, options.history_depth);
+  handle_ = created([&] { return dds_create_reader(p.handle(), p.topic(s), q.get(), nullptr); },
+                    std::string("create reader of ") + topic_name(s) + " in " + shown_partition(p.partition()),
+                    "DDS Security: this identity's permissions document does not grant subscribing to it");
   waitset_ = check(dds_create_waitset(p.handle()), "create waitset");
   condition_ = check(dds_create_readcondition(handle_, DDS_ANY_STATE), "create read condition");
   check(dds_waitset_attach(waitset_, condition_, handle_), "attach");
@@ -171,13 +215,28 @@ int Reader::take(const std::function<void(const Received&)>& f) {
     for (int32_t k = 0; k < n; ++k) {
       if (!infos[k].valid_data) continue;
       const auto* e = static_cast<const viscera_Envelope*>(samples[k]);
-      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}, infos[k].publication_handle});
+      const std::uint64_t writer = infos[k].publication_handle;
+      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}, writer, participant_of(writer)});
       ++total;
     }
     dds_return_loan(handle_, samples, n);
     if (n < kMax) break;
   }
   return total;
+}
+
+std::uint64_t Reader::participant_of(std::uint64_t writer) {
+  if (const auto it = participants_.find(writer); it != participants_.end()) return it->second;
+  std::uint64_t hash = 0;
+  if (dds_builtintopic_endpoint_t* ep = dds_get_matched_publication_data(handle_, writer)) {
+    hash = 1469598103934665603ull;  // FNV-1a over the participant's 16-byte GUID
+    for (const unsigned char b : ep->participant_key.v) hash = (hash ^ b) * 1099511628211ull;
+    dds_builtintopic_free_endpoint(ep);
+  }
+  if (hash == 0) return 0;  // not known (yet): asked again next time
+  if (participants_.size() >= 4096) participants_.clear();  // writers come and go; keep the cache small
+  participants_.emplace(writer, hash);
+  return hash;
 }
 
 PartitionDiscovery::PartitionDiscovery(Participant& p, Stream s, std::string role)

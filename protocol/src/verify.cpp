@@ -110,7 +110,7 @@ std::vector<std::uint8_t> encode(const TelemetryReport& t) {
   flatbuffers::FlatBufferBuilder b(128);
   return finish(b, fb::CreateTelemetry(b, t.server_stamp_ns, t.steps, t.physics_rate_hz, t.step_p50_us, t.step_p99_us, t.step_max_us, t.jitter_p99_us,
                                        t.late_ticks, t.rejected_messages, t.missed_slots, t.rejected_malformed, t.rejected_not_owner,
-                                       t.rejected_unknown_instrument));
+                                       t.rejected_unknown_instrument, t.rejected_other_participant));
 }
 
 std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
@@ -351,7 +351,8 @@ std::optional<TelemetryReport> decode_telemetry(std::span<const std::uint8_t> by
                     m->missed_slots(),
                     m->rejected_malformed(),
                     m->rejected_not_owner(),
-                    m->rejected_unknown_instrument()};
+                    m->rejected_unknown_instrument(),
+                    m->rejected_other_participant()};
   const std::pair<const char*, double> figures[] = {{"physics_rate_hz", t.physics_rate_hz},
                                                     {"step_time_p50_us", t.step_p50_us},
                                                     {"step_time_p99_us", t.step_p99_us},

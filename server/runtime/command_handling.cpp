@@ -37,7 +37,13 @@ void SimulationServer::Impl::answer_new_commands() {
   std::lock_guard world(organ_mutex);  // the organ and the responder's queries stay while we answer
   endpoints.take_commands([&](const proto::Received& r) {
     const auto c = decode_counted(r.payload);
-    if (c && offer_counted(*c, proto::now_ns())) updated.push_back({c->instrument_id, c->client_id, *c});
+    if (!c) return;
+    const std::int64_t now = proto::now_ns();
+    if (!clients.admit(c->client_id, r.participant, now)) {
+      ++rejected_other_participant;
+      return;
+    }
+    if (offer_counted(*c, now)) updated.push_back({c->instrument_id, c->client_id, *c});
   });
   for (const auto& u : updated) {
     std::uint64_t tick = 0;

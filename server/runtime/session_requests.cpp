@@ -19,11 +19,20 @@ using common::InputError;
 /// trainer).
 void SimulationServer::Impl::take_sessions(const Status& status, const proto::LockstepStep* step) {
   bool changed = false;
-  const auto take = [&](std::span<const std::uint8_t> payload) {
+  // `participant`: the sender (live only; a lockstep step's requests were admitted live).
+  const auto take = [&](std::span<const std::uint8_t> payload, std::optional<std::uint64_t> participant) {
     std::string why;
     const auto req = proto::decode_session_request(payload, &why);
     if (!req) {
       ++rejected_malformed;
+      return;
+    }
+    // What acts on an instrument is bound to the participant that holds the client id (pause,
+    // scenes and materials are any client's: DDS Security's permissions decide who may send them).
+    const bool on_instrument = req->action == proto::Action::claim_instrument || req->action == proto::Action::release_instrument ||
+                               req->action == proto::Action::take_over || req->action == proto::Action::hand_back;
+    if (participant && on_instrument && !clients.admit(req->client_id, *participant, proto::now_ns())) {
+      ++rejected_other_participant;
       return;
     }
     const std::string who = "client " + std::to_string(req->client_id);
@@ -81,9 +90,9 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
     }
   };
   if (step)
-    for (const auto& payload : step->requests) take(payload);
+    for (const auto& payload : step->requests) take(payload, std::nullopt);
   else
-    endpoints.take_session_requests([&](const proto::Received& r) { take(r.payload); });
+    endpoints.take_session_requests([&](const proto::Received& r) { take(r.payload, r.participant); });
   if (changed) publish_scene();
 }
 

@@ -206,7 +206,8 @@ void SimulationServer::Impl::collect_counts() {
   stats.rejected_malformed = rejected_malformed;
   stats.rejected_not_owner = rejected_not_owner;
   stats.rejected_unknown_instrument = rejected_unknown_instrument;
-  stats.rejected = stats.rejected_malformed + stats.rejected_not_owner + stats.rejected_unknown_instrument;
+  stats.rejected_other_participant = rejected_other_participant;
+  stats.rejected = stats.rejected_malformed + stats.rejected_not_owner + stats.rejected_unknown_instrument + stats.rejected_other_participant;
   stats.forces_sent = forces_sent;
   stats.mesh_frames = mesh_frames_before + (mesh_publisher ? mesh_publisher->frames_published() : 0);
   stats.mesh_frames_skipped = mesh_skipped_before + (mesh_publisher ? mesh_publisher->frames_skipped() : 0);

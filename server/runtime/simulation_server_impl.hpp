@@ -4,6 +4,7 @@
 // the commands the command thread answers (command_handling.cpp), and the session requests the
 // physics thread takes between ticks (session_requests.cpp).
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -17,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/protocol/messages.hpp"
+#include "viscera/runtime/client_binding.hpp"
 #include "viscera/runtime/command_responder.hpp"
 #include "viscera/runtime/instrument_table.hpp"
 #include "viscera/runtime/mesh_publisher.hpp"
@@ -71,7 +73,9 @@ struct SimulationServer::Impl {
   SessionControl session;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread
   std::uint64_t mesh_frames_before = 0, mesh_skipped_before = 0;  // of the publishers of earlier scenes
-  std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, forces_sent{0};
+  std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, rejected_other_participant{0},
+      forces_sent{0};
+  ClientBinding clients{std::chrono::nanoseconds(proto::kLivelinessLease).count()};  // both threads (thread-safe)
   ServerStats stats;  // physics thread
 
   Impl(const SceneSpec& s, ServerEndpoints& e, std::string dir, const TickBudget& b, bool lockstep_mode);

@@ -46,31 +46,21 @@ sleep 0.8
 "$ctl" resume --domain "$domain" >> "$tmp/control.log" 2>&1; rc_resume=$?
 wait $presser; rc_presser=$?
 sleep 0.5; kill "$watcher"; wait "$watcher" 2>/dev/null
-# Two runs under one client id: the second cannot claim what the first holds; a release sent under
-# that id takes the instrument from the first, which notices within 0.1 s, fades and says so.
-"$hc" --domain "$domain" --client-id 7 --instrument 2 --duration 20 --depth 0.01 --quiet --report "$tmp/twin-a.json" > "$tmp/twin-a.log" 2>&1 &
+# Two runs under one client id: the second cannot claim what the first holds, and a release sent
+# under that id by another participant (the hostile publisher) is refused: the server binds a client
+# id to the DDS participant that acts on instruments under it (schema 13). The first run keeps its
+# instrument to its end.
+"$hc" --domain "$domain" --client-id 7 --instrument 2 --duration 8 --depth 0.01 --quiet --report "$tmp/twin-a.json" > "$tmp/twin-a.log" 2>&1 &
 twin_a=$!
 for _ in $(seq 100); do grep -q "claimed" "$tmp/twin-a.log" && break; sleep 0.05; done
 "$hc" --domain "$domain" --client-id 7 --instrument 2 --duration 1 --quiet > "$tmp/twin-b.log" 2>&1; rc_twin_b=$?
 "$build/tests/integration/hostile_publisher" "$domain" release 2 7 > "$tmp/twin-release.log" 2>&1
-for _ in $(seq 50); do kill -0 "$twin_a" 2>/dev/null || break; sleep 0.1; done
 wait "$twin_a"; rc_twin_a=$?
 cat "$tmp/twin-b.log" "$tmp/twin-a.log"
 check "a second run under one client id is refused its claim (rc $rc_twin_b)" \
   "[ $rc_twin_b -eq 3 ] && grep -q 'held under this client id (7) by another client' '$tmp/twin-b.log'"
-check "the first run notices its instrument was released under it and ends (rc $rc_twin_a, want 5)" \
-  "[ $rc_twin_a -eq 5 ] && grep -q 'no longer this client' '$tmp/twin-a.log'"
-pycheck "$tmp/twin-a.json" "$tmp/twin-release.log" <<'PY'
-import json, re, sys
-r = json.load(open(sys.argv[1]))
-released = float(re.search(r"released at ([0-9.]+)", open(sys.argv[2]).read()).group(1))
-noticed = r["start_epoch_s"] + r["instrument_lost_t_s"]
-faded = r["faded_t_s"] - r["instrument_lost_t_s"]
-last = max(x["t_s"] for x in r["samples"])
-print(f"[ figure ] an instrument released under its client: noticed {1000 * (noticed - released):.0f} ms after the release, "
-      f"force faded to zero {faded:.2f} s later; last force answer at t = {last:.2f} s, loss noticed at {r['instrument_lost_t_s']:.2f} s")
-sys.exit(0 if r["instrument_lost_t_s"] > 0 and noticed - released < 0.15 and 0 < faded <= r["fade"]["stale_after_s"] + r["fade"]["fade_s"] + 0.05 else 1)
-PY
+check "another participant's release under the first run's id is refused: it keeps its instrument to its end (rc $rc_twin_a)" \
+  "[ $rc_twin_a -eq 0 ] && ! grep -q 'no longer this client' '$tmp/twin-a.log'"
 kill -INT "$server"; wait "$server"; rc_server=$?
 cat "$tmp/control.log" "$tmp/ctl.log" "$tmp/events.log"
 check "annotation sent (rc $rc_note)" "[ $rc_note -eq 0 ]"
@@ -130,10 +120,11 @@ check "server logged the release" "grep -q 'instrument 1 released' '$tmp/server.
 check "server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
 rejected=$(sed -n 's/.* \([0-9]*\) messages rejected.*/\1/p' "$tmp/server.log" | tail -1)
 check "server rejected and counted hostile payloads ($rejected)" "[ -n '$rejected' ] && [ '$rejected' -gt 1000 ]"
-# Counted by reason: the hostile publisher sends all three kinds (4 malformed, 1 not owned, 1 unknown instrument per round).
-reasons=$(grep 'stopped after' "$tmp/server.log" | grep -o 'malformed [0-9]*, not owner [0-9]*, unknown instrument [0-9]*')
+# Counted by reason: the hostile publisher sends all three kinds (4 malformed, 1 not owned, 1 unknown
+# instrument per round), and one release under another participant's client id (above).
+reasons=$(grep 'stopped after' "$tmp/server.log" | grep -o "malformed [0-9]*, not owner [0-9]*, unknown instrument [0-9]*, another participant's client id [0-9]*" | tr -d "'")
 echo "[ figure ] rejected by reason: $reasons"
-check "rejections counted by reason ($reasons)" "python3 -c \"import re,sys; m,o,u=map(int,re.findall(r'\\d+','$reasons')); sys.exit(not (m > 3*o > 0 and u > 0 and m + o + u == $rejected))\""
+check "rejections counted by reason ($reasons)" "python3 -c \"import re,sys; m,o,u,p=map(int,re.findall(r'\\d+','$reasons')); sys.exit(not (m > 3*o > 0 and u > 0 and p >= 1 and m + o + u + p == $rejected))\""
 pycheck "$tmp/a.json" "$tmp/b.json" "$(python3 -c "print($claimed_at - $killed_at)")" <<'PY'
 import json, sys
 for path in sys.argv[1:3]:

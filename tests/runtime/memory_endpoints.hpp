@@ -7,6 +7,7 @@
 #include <deque>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "viscera/protocol/messages.hpp"
@@ -26,8 +27,9 @@ class MemoryEndpoints final : public ServerEndpoints {
     MemoryEndpoints& e_;
   };
 
-  void push_command(const proto::Command& c) { push(commands_, proto::encode(c)); }
-  void push_request(const proto::SessionRequest& r) { push(sessions_, proto::encode(r)); }
+  /// `participant`: the sending DDS participant (Received::participant), one unless a test says.
+  void push_command(const proto::Command& c, std::uint64_t participant = 1) { push(commands_, proto::encode(c), participant); }
+  void push_request(const proto::SessionRequest& r, std::uint64_t participant = 1) { push(sessions_, proto::encode(r), participant); }
 
   int take_commands(const Take& f) override { return take(commands_, f); }
   bool wait_commands(std::chrono::nanoseconds timeout) override {
@@ -56,21 +58,22 @@ class MemoryEndpoints final : public ServerEndpoints {
   std::atomic<int> topologies{0}, frames{0};
 
  private:
-  void push(std::deque<std::vector<std::uint8_t>>& q, std::vector<std::uint8_t> p) {
+  using Sent = std::pair<std::vector<std::uint8_t>, std::uint64_t>;  // payload, participant
+  void push(std::deque<Sent>& q, std::vector<std::uint8_t> p, std::uint64_t participant) {
     {
       std::lock_guard lock(mutex_);
-      q.push_back(std::move(p));
+      q.emplace_back(std::move(p), participant);
     }
     cv_.notify_all();
   }
-  int take(std::deque<std::vector<std::uint8_t>>& q, const Take& f) {
-    std::deque<std::vector<std::uint8_t>> taken;
+  int take(std::deque<Sent>& q, const Take& f) {
+    std::deque<Sent> taken;
     {
       std::lock_guard lock(mutex_);
       taken.swap(q);
     }
     std::uint64_t seq = 0;
-    for (const auto& p : taken) f({1, ++seq, 0, p});
+    for (const auto& [p, participant] : taken) f({1, ++seq, 0, p, participant, participant});
     return static_cast<int>(taken.size());
   }
   void keep(std::vector<std::vector<std::uint8_t>>& v, std::span<const std::uint8_t> p) {
@@ -79,7 +82,7 @@ class MemoryEndpoints final : public ServerEndpoints {
   }
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<std::vector<std::uint8_t>> commands_, sessions_;
+  std::deque<Sent> commands_, sessions_;
 };
 
 /// A lockstep driver in memory: steps pushed, results kept.

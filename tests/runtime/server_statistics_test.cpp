@@ -44,18 +44,21 @@ TEST(ServerStatistics, TelemetryAndStatusCarryTheCounts) {
   s.rejected_malformed = 5;
   s.rejected_not_owner = 2;
   s.rejected_unknown_instrument = 1;
-  s.rejected = 8;
+  s.rejected_other_participant = 4;
+  s.rejected = 12;
   s.rate_hz = 999;
   const auto t = telemetry_report(s, 42);
   EXPECT_EQ(t.server_stamp_ns, 42);
   EXPECT_EQ(t.steps, 12345u);
   EXPECT_EQ(t.late_ticks, 7u);
   EXPECT_EQ(t.missed_slots, 3u);
-  EXPECT_EQ(t.rejected_messages, 8u);
-  EXPECT_EQ(t.rejected_malformed + t.rejected_not_owner + t.rejected_unknown_instrument, t.rejected_messages);
+  EXPECT_EQ(t.rejected_messages, 12u);
+  EXPECT_EQ(t.rejected_other_participant, 4u);
+  EXPECT_EQ(t.rejected_malformed + t.rejected_not_owner + t.rejected_unknown_instrument + t.rejected_other_participant, t.rejected_messages);
   const std::string line = status_line(s, true, 2, 1.25);
   EXPECT_NE(line.find("999 Hz physics (paused)"), std::string::npos) << line;
-  EXPECT_NE(line.find("late ticks 7, missed slots 3, 2 instruments in use, |F| 1.250 N, rejected 8 (malformed 5, not owner 2, unknown instrument 1)"),
+  EXPECT_NE(line.find("late ticks 7, missed slots 3, 2 instruments in use, |F| 1.250 N, rejected 12 (malformed 5, not owner 2, unknown instrument 1, "
+                      "another participant's client id 4)"),
             std::string::npos)
       << line;
 }

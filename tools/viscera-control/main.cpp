@@ -50,11 +50,13 @@ int watch_health(viscera::client::Client& client, const viscera::protocol::Scene
       last = t;
       std::printf(
           "t +%.4f s: %.0f Hz physics, %llu ticks (%llu late, %llu slots missed), step p50 %.0f us p99 %.0f us max %.0f us, "
-          "tick jitter p99 %.0f us, %llu messages rejected (%llu malformed, %llu not from the owner, %llu for unknown instruments)\n",
+          "tick jitter p99 %.0f us, %llu messages rejected (%llu malformed, %llu not from the owner, %llu for unknown instruments, %llu under "
+          "another participant's client id)\n",
           1e-9 * static_cast<double>(t.server_stamp_ns - first->server_stamp_ns), t.physics_rate_hz, static_cast<unsigned long long>(t.steps),
           static_cast<unsigned long long>(t.late_ticks), static_cast<unsigned long long>(t.missed_slots), t.step_p50_us, t.step_p99_us, t.step_max_us,
           t.jitter_p99_us, static_cast<unsigned long long>(t.rejected_messages), static_cast<unsigned long long>(t.rejected_malformed),
-          static_cast<unsigned long long>(t.rejected_not_owner), static_cast<unsigned long long>(t.rejected_unknown_instrument));
+          static_cast<unsigned long long>(t.rejected_not_owner), static_cast<unsigned long long>(t.rejected_unknown_instrument),
+          static_cast<unsigned long long>(t.rejected_other_participant));
       std::fflush(stdout);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -10,13 +10,15 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace viscera::protocol {
 
 class DdsError : public std::runtime_error {
  public:
-  DdsError(const std::string& what, int32_t code);
+  /// "DDS: <what>: <the code's name>[: <detail>]"
+  DdsError(const std::string& what, int32_t code, const std::string& detail = {});
 };
 
 /// The streams of the protocol; each is one topic of Envelope with its own QoS.
@@ -83,6 +85,9 @@ struct Received {
   std::int64_t stamp_ns;
   std::span<const std::uint8_t> payload;  ///< valid during the callback only
   std::uint64_t writer = 0;  ///< the writing DDS entity (its instance handle), for counting its sequence gaps
+  /// The writer's DDS participant (a hash of its GUID; 0: not known): who sent it. Under DDS
+  /// Security a participant is an authenticated identity.
+  std::uint64_t participant = 0;
 };
 
 /// A reader's history, for a reader that must keep every sample (a recorder) rather than the
@@ -134,10 +139,13 @@ class Reader {
   void on_alive_writers_changed(std::function<void(int)> f);
 
  private:
+  /// The participant of a writer (Received::participant), looked up once per writer.
+  std::uint64_t participant_of(std::uint64_t writer);
   int32_t handle_;
   int32_t waitset_;
   int32_t condition_;
   std::function<void(int)> on_alive_;
+  std::unordered_map<std::uint64_t, std::uint64_t> participants_;  // writer -> participant; take()'s thread
 };
 
 /// The partitions in which writers of a stream have appeared on the domain (DDS discovery: the

@@ -141,8 +141,9 @@ struct TelemetryReport {
   std::uint64_t rejected_messages = 0;
   double physics_rate_hz = 0, step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0;
   std::uint64_t missed_slots = 0;  ///< slots that passed with no tick (schema 5; 0 from older servers)
-  /// rejected_messages by reason (schema 6; all 0 from older servers)
-  std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0;
+  /// rejected_messages by reason (schema 6; all 0 from older servers; the last, schema 13: under a
+  /// client id another DDS participant holds)
+  std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0, rejected_other_participant = 0;
 };
 
 /// An organ's boundary surface, sent once per mesh_id; frames list positions in its vertex order.
@@ -239,7 +240,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 12;
+inline constexpr int kSchemaVersion = 13;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -13,8 +13,9 @@ namespace viscera::runtime {
 struct ServerStats {
   std::uint64_t ticks = 0, rejected = 0, forces_sent = 0;
   /// rejected, by reason: failed verification; from a client that does not own the instrument;
-  /// naming an instrument the scene does not have
-  std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0;
+  /// naming an instrument the scene does not have; naming a client id another DDS participant
+  /// holds (ClientBinding)
+  std::uint64_t rejected_malformed = 0, rejected_not_owner = 0, rejected_unknown_instrument = 0, rejected_other_participant = 0;
   std::uint64_t late_ticks = 0;  ///< ticks that ended after their 1/rate slot (the next one starts at once)
   std::uint64_t missed_slots = 0;  ///< slots of the fixed-rate grid that passed with no tick
   std::uint64_t physics_resets = 0;  ///< organ reset to rest after an integration failure
