@@ -1,9 +1,10 @@
 // Writes hostile payloads on the command and session topics: garbage, truncated commands,
 // another schema, NaN positions, commands for an instrument the sender does not own, and commands
 // and releases for an instrument the scene does not have.
-// Usage: hostile_publisher DOMAIN SECONDS
-//        hostile_publisher DOMAIN release INSTRUMENT CLIENT   (a release under another process's
-//        client id, as a second run of a client under one id sends it; prints when, Unix seconds)
+// Usage: hostile_publisher DOMAIN SECONDS [--station NAME]
+//        hostile_publisher DOMAIN release INSTRUMENT CLIENT [--station NAME]   (a release under
+//        another process's client id, as a second run of a client under one id sends it; prints
+//        when, Unix seconds)
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,12 +18,17 @@
 
 using namespace viscera::protocol;
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
+  std::string station;
+  if (argc > 3 && std::string(argv[argc - 2]) == "--station") {
+    station = argv[argc - 1];
+    argc -= 2;
+  }
   if (argc != 3 && !(argc == 5 && std::string(argv[2]) == "release")) {
-    std::fprintf(stderr, "usage: hostile_publisher DOMAIN SECONDS | DOMAIN release INSTRUMENT CLIENT\n");
+    std::fprintf(stderr, "usage: hostile_publisher DOMAIN SECONDS | DOMAIN release INSTRUMENT CLIENT [--station NAME]\n");
     return 2;
   }
-  Participant p(static_cast<std::uint32_t>(std::atoi(argv[1])));
+  Participant p(static_cast<std::uint32_t>(std::atoi(argv[1])), station);
   Writer commands(p, Stream::instrument_command), sessions(p, Stream::session_request);
   if (argc == 5) {
     SessionRequest r;
@@ -66,4 +72,13 @@ int main(int argc, char** argv) {
   }
   std::printf("hostile_publisher: sent %ld hostile payloads\n", sent);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const DdsError& e) {  // e.g. DDS Security refused a writer
+    std::fprintf(stderr, "hostile_publisher: %s\n", e.what());
+    return 3;
+  }
 }
