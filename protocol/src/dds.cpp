@@ -115,8 +115,8 @@ std::string station_name_problem(const std::string& name) {
   return {};
 }
 
-std::string checked_station(const std::string& name) {
-  if (const std::string why = station_name_problem(name); !why.empty()) throw common::UsageError("--station: " + why);
+std::string checked_station(const std::string& name, const std::string& flag) {
+  if (const std::string why = station_name_problem(name); !why.empty()) throw common::UsageError(flag + ": " + why);
   return name;
 }
 

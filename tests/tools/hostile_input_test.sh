@@ -92,6 +92,8 @@ expect hc-wildcard 2 "--station: '*' holds a DDS wildcard" -- "$hc" --station '*
 expect trainer-wildcard 2 "--station: 'bay?' holds a DDS wildcard" -- "$trainer" run "$src/data/exercises/palpation.json" --station 'bay?'
 expect record-space 2 "--station: 'bay 1' holds a character other than" -- "$rec" --out "$tmp/s.mcap" --station 'bay 1'
 expect control-long 2 "is longer than 64 characters" -- "$ctl" show --station "$(printf 'b%.0s' $(seq 65))"
+openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
+expect console-wildcard 2 "--stations: 'b*' holds a DDS wildcard" -- "$build/tools/viscera-console/viscera-console" --stations 'bay-1,b*' --token-file "$tmp/token"
 expect server-slash 2 "--station: 'a/b' holds a character other than" -- "$server" --scene "$tmp/scenes/liver.json" --station 'a/b'
 
 echo "hostile_input_test: $passed passed, $failures failed"

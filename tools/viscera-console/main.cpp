@@ -159,7 +159,8 @@ int main(int argc, char** argv) {
             return w != nullptr && w->wants_raw();
           }};
     };
-    const auto partitions = split(cl.text("stations"), ',');
+    auto partitions = split(cl.text("stations"), ',');
+    for (auto& p : partitions) p = viscera::protocol::checked_station(p, "--stations");
     for (std::size_t k = 0; k < partitions.size(); ++k) {
       stations.push_back(std::make_unique<viscera::console::Station>(domain, partitions[k], client_id, force_period_s, make_sink(k)));
       station_list.push_back(stations.back().get());

@@ -76,8 +76,8 @@ inline constexpr const char* kServerRole = "viscera-server";
 /// reach other stations' partitions, and only letters, digits, '-', '_' and '.' (at most 64) fit the
 /// partition lists of DDS Security permissions and a log line (docs/DEPLOY.md).
 std::string station_name_problem(const std::string& name);
-/// A program's --station value: `name`, or common::UsageError("--station: <the problem>").
-std::string checked_station(const std::string& name);
+/// A program's --station value: `name`, or common::UsageError("<flag>: <the problem>").
+std::string checked_station(const std::string& name, const std::string& flag = "--station");
 
 struct Received {
   std::uint32_t source_id;
