@@ -30,8 +30,9 @@ struct Client::Impl {
   // Made on the first claim or command: a participant whose DDS Security permissions do not grant
   // instrument commands (a trainer, a recorder's identity) still makes session requests.
   std::unique_ptr<proto::Writer> commands;
+  std::once_flag commands_made;  // a claim on one thread and commands on another may both make it
   proto::Writer& command_writer() {
-    if (!commands) commands = std::make_unique<proto::Writer>(participant, proto::Stream::instrument_command);
+    std::call_once(commands_made, [this] { commands = std::make_unique<proto::Writer>(participant, proto::Stream::instrument_command); });
     return *commands;
   }
   proto::TypedReader<proto::Stream::force_feedback> forces;

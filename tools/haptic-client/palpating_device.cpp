@@ -118,7 +118,16 @@ client::DeviceSample PalpatingDevice::read(double t) {
       }
       break;
     case Phase::press: {
-      if (magnitude(force_) > kSafeForceN && !marking_) {
+      if (magnitude(force_) > kSafeForceN && marking_) {
+        // The marking press stops where the tissue pushes back this hard and marks there: touching,
+        // and never pressing past the safe force (a CI run marked 4.4 N deep without this stop).
+        phase_ = Phase::dwell;
+        phase_t_ = t;
+        settle_sum_ = {};
+        settle_samples_ = 0;
+        break;
+      }
+      if (magnitude(force_) > kSafeForceN) {
         // The tissue pushes back hard enough to stop the press. Past the hold at half the depth,
         // the point is judged by the force held there (the tissue is firm); before it, by
         // nothing: a force that high so soon is the surface still moving from the last press,

@@ -27,6 +27,9 @@ Station::Station(std::uint32_t domain, std::string partition, std::uint32_t clie
       client_id_(client_id),
       force_period_s_(force_period_s),
       sink_(std::move(sink)) {
+  // One participant for the requests and the taken-over instruments' commands: the server binds
+  // the console's client id to the participant that acts on instruments under it.
+  client_ = std::make_unique<client::Client>(domain_, client_id_, partition_);
   streams_ = std::thread([this] { stream_loop(); });
   worker_ = std::thread([this] { request_loop(); });
   driver_ = std::thread([this] { drive_loop(); });
@@ -172,7 +175,7 @@ bool Station::move(std::uint32_t instrument, const proto::Vector3& delta, std::s
 }
 
 void Station::drive_loop() {
-  client::Client driver(domain_, client_id_, partition_);
+  client::Client& driver = *client_;
   auto next = std::chrono::steady_clock::now();
   while (!stop_) {
     std::map<std::uint32_t, proto::Vector3> held;
@@ -187,7 +190,7 @@ void Station::drive_loop() {
 }
 
 void Station::request_loop() {
-  client::Client client(domain_, client_id_, partition_);
+  client::Client& client = *client_;
   while (true) {
     std::pair<BrowserRequest, std::function<void(nlohmann::json)>> job;
     {

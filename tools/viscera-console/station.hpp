@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "viscera/client/client.hpp"
 #include "viscera/console/browser_request.hpp"
 #include "viscera/console/outbox.hpp"
 #include "viscera/protocol/dds.hpp"
@@ -77,12 +78,13 @@ class Station {
   StationSnapshot snapshot_;
   std::map<std::uint32_t, protocol::Vector3> tips_;  ///< each instrument's newest commanded tip [m]
   protocol::Vector3 bounds_min_{}, bounds_max_{};  ///< the organ's, from the scene state [m]
-  std::map<std::uint32_t, protocol::Vector3> held_;
-  std::deque<double> frame_delays_ms_;  ///< instruments the console drives, at these tips
+  std::map<std::uint32_t, protocol::Vector3> held_;  ///< instruments the console drives, at these tips
+  std::deque<double> frame_delays_ms_;  ///< the last 1000 surface frames' delays to the bridge [ms]
   std::deque<std::pair<BrowserRequest, std::function<void(nlohmann::json)>>> requests_;
   std::condition_variable requests_cv_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> rejected_{0};
+  std::unique_ptr<client::Client> client_;  // the worker's requests and the driver's commands (thread-safe for that)
   std::thread streams_, worker_, driver_;
 };
 

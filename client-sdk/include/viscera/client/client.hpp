@@ -23,7 +23,9 @@ namespace viscera::client {
 enum class ServerState { waiting, alive, lost };
 const char* to_string(ServerState s);
 
-/// The protocol's clock [ns] (monotonic; the stamps of commands and forces are on it).
+/// The protocol's clock [ns]: DDS's time, the wall clock (since the Unix epoch; not monotonic, a
+/// clock step moves it). The stamps of commands and forces are on it: a round trip on one host is
+/// two readings of it; across hosts the clocks must be synchronised (docs/DEPLOY.md).
 std::int64_t now_ns();
 
 /// What became of a claim.
@@ -38,6 +40,9 @@ struct LatencyStats {
   double p50_us = 0, p99_us = 0, max_us = 0;
 };
 
+/// One client of a server: one DDS participant under one client id (the server binds the id to
+/// that participant for what acts on instruments). Calls are made from one thread, except that one
+/// thread may send tips (send_tip) while another makes requests (the console does).
 class Client {
  public:
   /// `partition`: the DDS partition to work in ("" : the default, where live servers are; a replay
