@@ -88,6 +88,7 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
         }
       const auto rendered = loop.renderer().render(in.tip_m, t);
       device.render(rendered.force, f->in_contact);
+      device.model_age(loop.renderer().model_age_s(t));
       run.clamps += rendered.clamped;
       if (hooks.period) hooks.period({t, in, *f, rendered, loop.renderer().model_age_s(t), seq - f->command_seq});
     }

@@ -15,6 +15,7 @@ constexpr double kCentreRadius = 1.5 * kFine;  // the stiff area's centre is wei
 constexpr double kMargin = 0.15;  // of the organ's extent kept clear at its sides
 constexpr double kSafeForceN = 2.0;  // a press stops here
 constexpr double kMinVerticalShare = 0.8;  // F_z / |F| of a press that counts
+constexpr double kLateS = 0.005;  // the server's newest answer older than this: hold still [s]
 
 double magnitude(const protocol::Vector3& f) { return std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]); }
 }  // namespace
@@ -88,6 +89,13 @@ client::DeviceSample PalpatingDevice::read(double t) {
   if (phase_ == Phase::done) {
     z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
     return {{x_, y_, z_}, 0.5, 0, z_ >= safe_z_};
+  }
+  // The server is late (a stalled process, a lost packet): where the tip touches or may touch,
+  // going on would press blind; it holds still, and a hold's clock waits for fresh answers.
+  const bool touching_phase = phase_ == Phase::descend || phase_ == Phase::press || phase_ == Phase::settle || phase_ == Phase::dwell;
+  if (model_age_s_ > kLateS && touching_phase) {
+    phase_t_ += dt;
+    return {{x_, y_, z_}, 0.5, buttons_, false};
   }
   Probe& p = probes_[current_];
   switch (phase_) {

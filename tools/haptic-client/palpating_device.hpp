@@ -26,6 +26,9 @@ class PalpatingDevice : public client::Device {
   std::string name() const override { return "scripted palpate"; }
   client::DeviceSample read(double t_s) override;
   void render(const protocol::Vector3& force_n, bool in_contact) override;
+  /// While the server's newest answer is over 5 ms old, the search holds still where it touches
+  /// the tissue (and a hold's clock stops): it never presses on blind.
+  void model_age(double age_s) override { model_age_s_ = age_s; }
 
  private:
   enum class Phase { travel, descend, press, settle, dwell, lift, done };
@@ -52,6 +55,7 @@ class PalpatingDevice : public client::Device {
   protocol::Vector3 force_{};
   protocol::Vector3 settle_sum_{};  // force summed over the end of the hold at DEPTH / 2 [N]
   int settle_samples_ = 0;
+  double model_age_s_ = 0;
   bool contact_ = false, verbose_ = false;
   std::uint32_t buttons_ = 0;
 };
