@@ -31,12 +31,16 @@ int32_t check(int32_t rc, const char* what) {
 // Everything else Cyclone logs goes to stderr as before.
 thread_local bool t_capturing = false;
 thread_local std::string t_cyclone_said;
+thread_local bool t_cyclone_error = false;  // t_cyclone_said is an error, not a warning
 
 void log_sink(void*, const dds_log_data_t* d) {
   std::string_view m(d->message, d->size);
   if (t_capturing && (d->priority & (DDS_LC_FATAL | DDS_LC_ERROR | DDS_LC_WARNING)) != 0) {
     while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.remove_suffix(1);
-    if (t_cyclone_said.empty()) t_cyclone_said = m;
+    // Why it failed is an error; a warning (a deprecated element) is kept only until one comes.
+    const bool error = (d->priority & (DDS_LC_FATAL | DDS_LC_ERROR)) != 0;
+    if (t_cyclone_said.empty() || (error && !t_cyclone_error)) t_cyclone_said = m;
+    t_cyclone_error = t_cyclone_error || error;
     return;
   }
   std::fprintf(stderr, "DDS: %.*s%s", static_cast<int>(m.size()), m.data(), m.empty() || m.back() != '\n' ? "\n" : "");
@@ -49,6 +53,7 @@ int32_t created(const std::function<int32_t()>& create, const std::string& what,
   std::call_once(sink, [] { dds_set_log_sink(log_sink, nullptr); });
   t_capturing = true;
   t_cyclone_said.clear();
+  t_cyclone_error = false;
   const int32_t rc = create();
   t_capturing = false;
   if (rc >= 0) return rc;

@@ -86,8 +86,11 @@ def main():
             frame = peer.recv(65536)
             if not frame:
                 break
-            os.write(tap, frame)
-            received += 1
+            try:
+                os.write(tap, frame)
+                received += 1
+            except OSError:  # our TAP is not up yet (or going down): the frame is lost, as on a cable
+                dropped += 1
     print(f"link_relay: {o.tap}: sent {sent} frames, dropped {dropped}, received {received}", flush=True)
 
 

@@ -56,12 +56,12 @@ ip netns exec "$bridge" python3 "$src/tests/deploy/link_relay.py" "t${tag}b" "$t
 relays+=($!)
 set +e
 wait_for "linked" "$tmp/relay-l.log" 50 && wait_for "linked" "$tmp/relay-b.log" 50 || exit 1
-set -e
+set -e  # the bridge's side first: frames from host l then find it up
+ip netns exec "$bridge" ip link set "t${tag}b" master br0
+ip netns exec "$bridge" ip link set "t${tag}b" up
 ip netns exec "v${tag}l" ip addr add "$net.4/24" dev "t${tag}l"
 ip netns exec "v${tag}l" ip link set "t${tag}l" up
 ip netns exec "v${tag}l" ip link set lo up
-ip netns exec "$bridge" ip link set "t${tag}b" master br0
-ip netns exec "$bridge" ip link set "t${tag}b" up
 set +e
 peers="$net.1,$net.2,$net.3,$net.4"
 # The prefix that runs a command as host s, h or r (number 1, 2, 3), with lan.xml on its own link.
