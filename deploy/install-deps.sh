@@ -20,10 +20,11 @@ packages=(
   clang libclang-rt-14-dev # libFuzzer for the message-decoder fuzz target
   clang-format clang-tidy  # lint tests: the layout of every C++ file, clang-tidy on recent changes
   libzstd-dev liblz4-dev   # MCAP chunk compression (zstd, lz4) in session recordings
-  libssl-dev               # SHA-256 of the files a scene was built from (recordings name them)
+  libssl-dev               # SHA-256 of the files a scene was built from (recordings name them); the console's HTTPS and WSS
   libboost-dev             # Boost.Beast: the console's HTTP and WebSocket server (header-only)
   chromium                 # the browser tests of the console page (headless, driven by playwright-core)
-  openssl                  # the console's access token (openssl rand)
+  openssl                  # the console's access token (openssl rand), the test PKI (deploy/dds/make-test-pki.sh)
+  libnss3-tools            # certutil: the browser test trusts the test CA in Chromium's certificate store (no ignored errors)
 )
 # Node.js and npm: the official MCAP reader (@mcap/core) that judges recordings in the tests. Debian's
 # packages, unless a node and an npm are on the PATH already (a NodeSource install bundles npm).

@@ -13,8 +13,11 @@
 #               every station; reads every station
 #   recorder    reads every station; publishes nothing
 #   replay      publishes every stream, in replay and re-simulation stations only (viscera-replay*)
+# And for the console's web page (HTTPS and WSS; a TLS server certificate, not a DDS identity):
+#   console-web.pem, console-web.key  for localhost, 127.0.0.1, ::1 and the host names or addresses
+#                                     in VISCERA_CONSOLE_HOSTS (space-separated)
 # A real site keeps its CA key offline and issues identities from its own CA (docs/DEPLOY.md).
-# Usage: deploy/dds/make-test-pki.sh OUT_DIR [STATION...]
+# Usage: [VISCERA_CONSOLE_HOSTS="console.lab 10.1.2.3"] deploy/dds/make-test-pki.sh OUT_DIR [STATION...]
 set -euo pipefail
 if [ $# -lt 1 ] || [ "$1" = "--help" ] || [ "$1" = "-h" ]; then
   sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'
@@ -25,6 +28,12 @@ stations=("$@"); [ ${#stations[@]} -gt 0 ] || stations=(bay-1 bay-2)
 for s in "${stations[@]}"; do
   if ! [[ "$s" =~ ^[A-Za-z0-9._-]{1,64}$ ]]; then
     echo "make-test-pki: station '$s': only letters, digits, '-', '_' and '.' (at most 64), as viscera --station" >&2; exit 2
+  fi
+done
+read -ra console_hosts <<< "${VISCERA_CONSOLE_HOSTS:-}"
+for h in "${console_hosts[@]}"; do
+  if ! [[ "$h" =~ ^[A-Za-z0-9.:-]{1,253}$ ]]; then
+    echo "make-test-pki: VISCERA_CONSOLE_HOSTS: '$h' is not a host name or an IP address" >&2; exit 2
   fi
 done
 if [ -e "$out/ca.key" ]; then echo "make-test-pki: $out/ca.key exists: a PKI is there already (remove the folder to make a new one)" >&2; exit 2; fi
@@ -131,5 +140,15 @@ identity recorder
 permissions recorder "$(rule subscribe "*" "${stations[*]}")"
 identity replay
 permissions replay "$(rule publish "*" "viscera-replay* viscera-resimulate-*")" "$(rule subscribe "*" "viscera-replay* viscera-resimulate-*")"
-rm -f openssl.err ca.srl
+# The console's HTTPS certificate: names in subjectAltName (browsers ignore the common name).
+san="DNS:localhost,IP:127.0.0.1,IP:::1"
+for h in "${console_hosts[@]}"; do
+  if [[ "$h" =~ ^[0-9.]+$ || "$h" == *:* ]]; then san+=",IP:$h"; else san+=",DNS:$h"; fi
+done
+printf 'basicConstraints=critical,CA:FALSE\nkeyUsage=critical,digitalSignature\nextendedKeyUsage=serverAuth\nsubjectAltName=%s\n' "$san" > console-web.ext
+quiet openssl ecparam -name prime256v1 -genkey -noout -out console-web.key
+chmod 600 console-web.key
+quiet openssl req -new -key console-web.key -subj "/C=CH/O=$org/CN=viscera console" -out console-web.csr
+quiet openssl x509 -req -in console-web.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 825 -sha256 -extfile console-web.ext -out console-web.pem
+rm -f console-web.csr console-web.ext openssl.err ca.srl
 echo "make-test-pki: a TEST CA and ${#stations[@]} station(s) (${stations[*]}) in $out: $(ls "$out"/*.pem | wc -l) certificates; use with VISCERA_PKI=$out VISCERA_IDENTITY=NAME (deploy/dds/secure.xml)"

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string_view>
 
 #include <dds/dds.h>
@@ -221,7 +224,8 @@ int Reader::take(const std::function<void(const Received&)>& f) {
       if (!infos[k].valid_data) continue;
       const auto* e = static_cast<const viscera_Envelope*>(samples[k]);
       const std::uint64_t writer = infos[k].publication_handle;
-      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}, writer, participant_of(writer)});
+      const Sender s = sender_of(writer);
+      f({e->source_id, e->seq, e->stamp_ns, {e->payload._buffer, e->payload._length}, writer, s.participant, s.identity});
       ++total;
     }
     dds_return_loan(handle_, samples, n);
@@ -230,18 +234,48 @@ int Reader::take(const std::function<void(const Received&)>& f) {
   return total;
 }
 
-std::uint64_t Reader::participant_of(std::uint64_t writer) {
-  if (const auto it = participants_.find(writer); it != participants_.end()) return it->second;
-  std::uint64_t hash = 0;
+Reader::Sender Reader::sender_of(std::uint64_t writer) {
+  if (const auto it = senders_.find(writer); it != senders_.end()) return it->second;
+  Sender s{0, 0};
   if (dds_builtintopic_endpoint_t* ep = dds_get_matched_publication_data(handle_, writer)) {
-    hash = 1469598103934665603ull;  // FNV-1a over the participant's 16-byte GUID
-    for (const unsigned char b : ep->participant_key.v) hash = (hash ^ b) * 1099511628211ull;
+    s.participant = 1469598103934665603ull;  // FNV-1a over the participant's 16-byte GUID
+    for (const unsigned char b : ep->participant_key.v) s.participant = (s.participant ^ b) * 1099511628211ull;
+    for (int k = 0; k < 6; ++k) s.identity = (s.identity << 8) | ep->participant_key.v[k];  // the GUID prefix's first 6 bytes
     dds_builtintopic_free_endpoint(ep);
   }
-  if (hash == 0) return 0;  // not known (yet): asked again next time
-  if (participants_.size() >= 4096) participants_.clear();  // writers come and go; keep the cache small
-  participants_.emplace(writer, hash);
-  return hash;
+  if (s.participant == 0) return s;  // not known (yet): asked again next time
+  if (senders_.size() >= 4096) senders_.clear();  // writers come and go; keep the cache small
+  senders_.emplace(writer, s);
+  return s;
+}
+
+bool security_configured() {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (uri == nullptr) return false;
+  // Cyclone reads a list of files (file://PATH) and inline XML, separated by commas; element
+  // names are not case-sensitive. Security is configured by a <Security> (or older <DDSSecurity>)
+  // element in any of them.
+  const auto lower = [](std::string t) {
+    for (char& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return t;
+  };
+  const auto has_security = [](const std::string& xml) {
+    return xml.find("<security>") != std::string::npos || xml.find("<security ") != std::string::npos ||
+           xml.find("<ddssecurity") != std::string::npos;
+  };
+  std::stringstream items(uri);
+  for (std::string item; std::getline(items, item, ',');) {
+    std::string text = item;
+    if (item.rfind("file://", 0) == 0) {
+      std::ifstream in(item.substr(7));
+      std::stringstream content;
+      content << in.rdbuf();
+      text = content.str();
+    }
+    for (auto c = text.find("<!--"); c != std::string::npos; c = text.find("<!--", c)) text.erase(c, text.find("-->", c) - c);  // comments
+    if (has_security(lower(text))) return true;
+  }
+  return false;
 }
 
 PartitionDiscovery::PartitionDiscovery(Participant& p, Stream s, std::string role)

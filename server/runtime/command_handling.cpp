@@ -39,7 +39,7 @@ void SimulationServer::Impl::answer_new_commands() {
     const auto c = decode_counted(r.payload);
     if (!c) return;
     const std::int64_t now = proto::now_ns();
-    if (!clients.admit(c->client_id, r.participant, now)) {
+    if (!clients.admit(c->client_id, {r.participant, r.identity}, now)) {
       ++rejected_other_participant;
       return;
     }

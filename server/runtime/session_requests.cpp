@@ -20,7 +20,7 @@ using common::InputError;
 void SimulationServer::Impl::take_sessions(const Status& status, const proto::LockstepStep* step) {
   bool changed = false;
   // `participant`: the sender (live only; a lockstep step's requests were admitted live).
-  const auto take = [&](std::span<const std::uint8_t> payload, std::optional<std::uint64_t> participant) {
+  const auto take = [&](std::span<const std::uint8_t> payload, std::optional<Sender> participant) {
     std::string why;
     const auto req = proto::decode_session_request(payload, &why);
     if (!req) {
@@ -92,7 +92,7 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
   if (step)
     for (const auto& payload : step->requests) take(payload, std::nullopt);
   else
-    endpoints.take_session_requests([&](const proto::Received& r) { take(r.payload, r.participant); });
+    endpoints.take_session_requests([&](const proto::Received& r) { take(r.payload, Sender{r.participant, r.identity}); });
   if (changed) publish_scene();
 }
 

@@ -30,7 +30,8 @@ SimulationServer::Impl::Impl(const SceneSpec& s, ServerEndpoints& e, std::string
           std::move(dir), [b](const SceneSpec& spec) { return std::shared_ptr<Organ>(build_organ(spec, b)); },
           [b](const std::shared_ptr<const Organ>& current, const proto::MaterialChange& change, double rate_hz) {
             return std::shared_ptr<Organ>(rebuild_with_material(*current, change, rate_hz, b));
-          }) {
+          }),
+      clients(std::chrono::nanoseconds(proto::kLivelinessLease).count(), e.authenticated()) {
   adopt(build_organ(s, budget), true);
   publish_scene();
   publish_scene_files();

@@ -75,7 +75,7 @@ struct SimulationServer::Impl {
   std::uint64_t mesh_frames_before = 0, mesh_skipped_before = 0;  // of the publishers of earlier scenes
   std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, rejected_other_participant{0},
       forces_sent{0};
-  ClientBinding clients{std::chrono::nanoseconds(proto::kLivelinessLease).count()};  // both threads (thread-safe)
+  ClientBinding clients;  // both threads (thread-safe)
   ServerStats stats;  // physics thread
 
   Impl(const SceneSpec& s, ServerEndpoints& e, std::string dir, const TickBudget& b, bool lockstep_mode);

@@ -88,6 +88,8 @@ int main(int argc, char** argv) {
     viscera::runtime::DdsEndpoints endpoints(spec.domain_id, station, lockstep);
     auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget, lockstep);
     log->info("{}{}{}", lockstep ? "lockstep, " : "", server->describe(), station.empty() ? "" : ", station " + station);
+    log->info("client ids bound to {}", endpoints.authenticated() ? "the certificate that first uses each (DDS Security in CYCLONEDDS_URI)"
+                                                                  : "the DDS participant using each while it talks (no DDS Security configured)");
     g_running = true;
     const auto status = [&](const std::string& line) {
       if (!quiet) log->info("{}", line);

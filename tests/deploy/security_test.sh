@@ -7,7 +7,9 @@
 #    subject of the station's haptic identity), find no server and move nothing;
 #  - an identity whose permissions do not grant it cannot act: the recorder cannot publish, the
 #    trainer cannot command an instrument, bay-2's haptic station cannot join bay-1;
-#  - an authorized participant cannot act under another client's id (the server binds it);
+#  - an authorized participant cannot act under another client's id (the server binds ids to the
+#    certificate that first used them), also once that client has gone silent; the client's own
+#    certificate, restarted, takes its id back;
 #  - the round trip with authentication and encryption, against the same press without them.
 # Usage: security_test.sh BUILD_DIR SOURCE_DIR
 set -u
@@ -97,15 +99,25 @@ cat "$tmp/impostor.log" "$tmp/holder.log"
 check "the console's identity may publish in bay-1 (rc $rc_impostor)" "[ $rc_impostor -eq 0 ]"
 check "its release under another client's id was refused: the holder kept its instrument (rc $rc_holder)" \
   "[ $rc_holder -eq 0 ] && ! grep -q 'no longer this client' '$tmp/holder.log'"
+# Client 21 has gone silent (its process ended): its id stays with its certificate. The console's
+# identity still cannot claim as client 21; the haptic station's certificate, restarted, can.
+sleep 1
+as console "$hc" --domain "$domain" --station bay-1 --client-id 21 --instrument 2 --duration 1 --quiet > "$tmp/console-as-21.log" 2>&1; rc_console21=$?
+as haptic-bay-1 "$hc" --domain "$domain" --station bay-1 --client-id 21 --instrument 2 --duration 1 --depth 0.01 --quiet > "$tmp/again-21.log" 2>&1; rc_again21=$?
+cat "$tmp/console-as-21.log" "$tmp/again-21.log"
+check "another certificate cannot take a silent client's id (rc $rc_console21)" "[ $rc_console21 -eq 3 ] && grep -q 'instrument 2 not claimed' '$tmp/console-as-21.log'"
+check "the id's own certificate, restarted, takes it back (rc $rc_again21)" "[ $rc_again21 -eq 0 ] && grep -q 'instrument 2 claimed' '$tmp/again-21.log'"
+check "the server binds client ids to certificates here" "grep -q 'client ids bound to the certificate' '$tmp/server.log'"
 
 wait $recorder; rc_rec=$?
 kill -INT $server; wait $server; rc_server=$?; server=
 tail -2 "$tmp/server.log"
 check "the recorder recorded the station (rc $rc_rec)" "[ $rc_rec -eq 0 ] && grep -q 'force_feedback' '$tmp/rec.log'"
 check "the server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
-# Nothing of the unauthenticated traffic arrived: the server's only refusals are the impostor's.
-check "no unauthenticated message reached the server, the impostor's release was counted" \
-  "grep 'stopped after' '$tmp/server.log' | grep -q \"(malformed 0, not owner 0, unknown instrument 0, another participant's client id 1)\""
+# Nothing of the unauthenticated traffic arrived: the server's only refusals are the impostors'
+# (the release, and the console's claims and commands as client 21).
+check "no unauthenticated message reached the server, the impostors' messages were counted" \
+  "grep 'stopped after' '$tmp/server.log' | grep -qE \"\\(malformed 0, not owner 0, unknown instrument 0, another participant's client id ([2-9]|[1-9][0-9]+)\\)\""
 pycheck "$tmp/plain.json" "$tmp/secure.json" <<'PY'
 import json, sys
 p, s = (json.load(open(f)) for f in sys.argv[1:3])

@@ -23,29 +23,47 @@ using testing::MemoryEndpoints;
 constexpr std::int64_t kLease = 500'000'000;  // ns
 
 TEST(ClientBinding, AnIdBelongsToItsFirstParticipantWhileItTalks) {
-  ClientBinding b(kLease);
-  EXPECT_TRUE(b.admit(7, 100, 0));
-  EXPECT_TRUE(b.admit(7, 100, 400'000'000));
-  EXPECT_FALSE(b.admit(7, 200, 800'000'000)) << "the holder spoke 0.4 s ago, within the lease";
-  EXPECT_FALSE(b.admit(7, 200, 900'000'000)) << "a refusal does not count as the holder's silence";
-  EXPECT_TRUE(b.admit(8, 200, 900'000'000)) << "another id is free";
-  EXPECT_TRUE(b.admit(7, 100, 900'000'000));
+  ClientBinding b(kLease, false);
+  EXPECT_TRUE(b.admit(7, {100, 1}, 0));
+  EXPECT_TRUE(b.admit(7, {100, 1}, 400'000'000));
+  EXPECT_FALSE(b.admit(7, {200, 1}, 800'000'000)) << "the holder spoke 0.4 s ago, within the lease";
+  EXPECT_FALSE(b.admit(7, {200, 1}, 900'000'000)) << "a refusal does not count as the holder's silence";
+  EXPECT_TRUE(b.admit(8, {200, 1}, 900'000'000)) << "another id is free";
+  EXPECT_TRUE(b.admit(7, {100, 1}, 900'000'000));
 }
 
 TEST(ClientBinding, ASilentHoldersIdPassesOnAndTheOldHolderIsThenRefused) {
-  ClientBinding b(kLease);
-  EXPECT_TRUE(b.admit(7, 100, 0));
-  EXPECT_FALSE(b.admit(7, 200, kLease));  // silent exactly the lease: still held
-  EXPECT_TRUE(b.admit(7, 200, kLease + 1));
-  EXPECT_FALSE(b.admit(7, 100, kLease + 2)) << "the id now belongs to participant 200";
+  ClientBinding b(kLease, false);
+  EXPECT_TRUE(b.admit(7, {100, 1}, 0));
+  EXPECT_FALSE(b.admit(7, {200, 1}, kLease));  // silent exactly the lease: still held
+  EXPECT_TRUE(b.admit(7, {200, 1}, kLease + 1));
+  EXPECT_FALSE(b.admit(7, {100, 1}, kLease + 2)) << "the id now belongs to participant 200";
 }
 
 TEST(ClientBinding, ASprayOfIdsDoesNotGrowTheTableWithoutBound) {
-  ClientBinding b(kLease);
-  for (std::uint32_t id = 1; id <= 5000; ++id) ASSERT_TRUE(b.admit(id, 100, 0));
+  ClientBinding b(kLease, false);
+  for (std::uint32_t id = 1; id <= 5000; ++id) ASSERT_TRUE(b.admit(id, {100, 1}, 0));
   EXPECT_EQ(b.held(), 5000u);  // all within the lease: each is still held
-  for (std::uint32_t id = 5001; id <= 10000; ++id) ASSERT_TRUE(b.admit(id, 100, 2 * kLease));
+  for (std::uint32_t id = 5001; id <= 10000; ++id) ASSERT_TRUE(b.admit(id, {100, 1}, 2 * kLease));
   EXPECT_LE(b.held(), 5000u) << "the silent ones were forgotten";
+}
+
+// Under DDS Security: an id stays with the certificate (identity) that first used it, while a
+// restarted client of that certificate (a new participant) takes it back after the lease.
+TEST(ClientBinding, BoundByIdentityAnIdStaysWithItsCertificate) {
+  constexpr std::uint64_t kHaptic = 0xb6ea9485ce15, kConsole = 0x95a861549b7a;  // two certificates' identities
+  ClientBinding b(kLease, true);
+  EXPECT_TRUE(b.admit(7, {100, kHaptic}, 0));
+  EXPECT_FALSE(b.admit(7, {200, kConsole}, 10 * kLease)) << "another certificate, however long the holder has been silent";
+  EXPECT_FALSE(b.admit(7, {300, kHaptic}, kLease)) << "the same certificate, another process: within the lease, refused";
+  EXPECT_TRUE(b.admit(7, {300, kHaptic}, kLease + 1)) << "the holder's certificate, restarted, after the lease";
+  EXPECT_FALSE(b.admit(7, {100, kHaptic}, kLease + 2)) << "the id now belongs to the new participant";
+  EXPECT_FALSE(b.admit(7, {200, kConsole}, 100 * kLease));
+  EXPECT_TRUE(b.admit(8, {200, kConsole}, 100 * kLease)) << "another id is free";
+  // The same history bound by participant: the silent holder's id passes to any participant.
+  ClientBinding p(kLease, false);
+  EXPECT_TRUE(p.admit(7, {100, kHaptic}, 0));
+  EXPECT_TRUE(p.admit(7, {200, kConsole}, 10 * kLease));
 }
 
 // The whole server in one process: client 7 (participant 1) claims instrument 1 and presses; an

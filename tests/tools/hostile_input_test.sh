@@ -94,6 +94,11 @@ expect record-space 2 "--station: 'bay 1' holds a character other than" -- "$rec
 expect control-long 2 "is longer than 64 characters" -- "$ctl" show --station "$(printf 'b%.0s' $(seq 65))"
 openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 expect console-wildcard 2 "--stations: 'b*' holds a DDS wildcard" -- "$build/tools/viscera-console/viscera-console" --stations 'bay-1,b*' --token-file "$tmp/token"
+# The console's TLS files: a device, a folder, a FIFO are refused at once, never read without end.
+mkfifo "$tmp/tls-fifo"
+for f in /dev/zero "$tmp" "$tmp/tls-fifo"; do
+  expect "console-tls-key-$(basename "$f")" 2 "$f: " -- "$build/tools/viscera-console/viscera-console" --token-file "$tmp/token" --tls-cert "$f" --tls-key "$f"
+done
 expect server-slash 2 "--station: 'a/b' holds a character other than" -- "$server" --scene "$tmp/scenes/liver.json" --station 'a/b'
 
 echo "hostile_input_test: $passed passed, $failures failed"

@@ -25,13 +25,13 @@ std::string read_token_file(const std::string& path) {
   return token;
 }
 
-std::string token_file_warning(const std::string& path) {
+std::string token_file_warning(const std::string& path, std::string_view risk) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || (st.st_mode & (S_IRWXG | S_IRWXO)) == 0) return {};
   char mode[8];
   std::snprintf(mode, sizeof mode, "%03o", static_cast<unsigned>(st.st_mode & 0777));
-  return common::printable(path, 200) + " (mode " + mode +
-         ") may be read by others than its owner: anyone who reads it commands the session (chmod 600 " + common::printable(path, 200) + ")";
+  return common::printable(path, 200) + " (mode " + mode + ") may be read by others than its owner: " + std::string(risk) + " (chmod 600 " +
+         common::printable(path, 200) + ")";
 }
 
 bool origin_allowed(std::string_view origin, std::string_view host, const std::vector<std::string>& allowed) {

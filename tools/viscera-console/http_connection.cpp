@@ -1,5 +1,6 @@
 #include <cstring>
 
+#include <boost/beast/core/detect_ssl.hpp>
 #include <boost/beast/websocket.hpp>
 
 #include "viscera/common/input_error.hpp"
@@ -29,14 +30,54 @@ const char* content_type(const std::string& path) {
 /// One HTTP connection: requests for the page's files, /stats, or the upgrade to a WebSocket.
 class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
  public:
-  HttpConnection(tcp::socket socket, std::shared_ptr<WebServer::Impl> server) : stream_(std::move(socket)), server_(std::move(server)) {}
+  HttpConnection(Transport stream, std::shared_ptr<WebServer::Impl> server) : stream_(std::move(stream)), server_(std::move(server)) {}
+
+  /// A console with TLS: the first bytes say whether the client speaks TLS; a plain HTTP request
+  /// is told where to go, a TLS client gets the handshake (10 s at most), then its requests are read.
+  void handshake() {
+    auto& plain = std::get<PlainStream>(stream_);
+    plain.expires_after(std::chrono::seconds(10));
+    beast::async_detect_ssl(plain, buffer_, [self = shared_from_this()](beast::error_code ec, bool tls) {
+      if (ec) return;
+      if (!tls) return self->refuse_plain();
+      auto& server = *self->server_;
+      PlainStream tcp_stream = std::move(std::get<PlainStream>(self->stream_));
+      self->stream_.emplace<TlsStream>(std::move(tcp_stream), *server.opt.tls);
+      std::get<TlsStream>(self->stream_)
+          .async_handshake(asio::ssl::stream_base::server, self->buffer_.data(), [self](beast::error_code e, std::size_t used) {
+            self->buffer_.consume(used);
+            if (e) {
+              ++self->server_->counters.tls_failed;  // a client that refused the certificate, or a timeout
+              return;
+            }
+            self->read();
+          });
+    });
+  }
+
+  /// A plain HTTP request on a console that speaks HTTPS only.
+  void refuse_plain() {
+    ++server_->counters.plain_refused;
+    parser_.emplace();
+    parser_->header_limit(8 * 1024);
+    parser_->body_limit(16 * 1024);
+    http::async_read(std::get<PlainStream>(stream_), buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) return;
+      const auto req = self->parser_->release();
+      self->respond(req, http::status::bad_request, "text/plain", "this console speaks HTTPS only: open its address with https://\n", false);
+    });
+  }
 
   void read() {
     parser_.emplace();
     parser_->header_limit(8 * 1024);
     parser_->body_limit(16 * 1024);
-    stream_.expires_after(std::chrono::seconds(30));
-    http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+    std::visit(
+        [this](auto& s) {
+          beast::get_lowest_layer(s).expires_after(std::chrono::seconds(30));
+          http::async_read(s, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+        },
+        stream_);
   }
 
  private:
@@ -63,7 +104,7 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
       if (path != "/ws" && path != "/") return respond(req, http::status::not_found, "text/plain", "no WebSocket here (/ws)\n", false);
       if (server_->browsers.size() >= server_->opt.max_browsers)
         return respond(req, http::status::service_unavailable, "text/plain", "too many browsers\n", false);
-      stream_.expires_never();
+      std::visit([](auto& s) { beast::get_lowest_layer(s).expires_never(); }, stream_);
       // A Foxglove client asks for its subprotocol; ?station=NAME picks the station (default: the first).
       const auto protocols = req.find(http::field::sec_websocket_protocol);
       const bool foxglove = protocols != req.end() && protocols->value().find(kFoxgloveSubprotocol) != beast::string_view::npos;
@@ -74,7 +115,7 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
         if (server_->stations[k]->name() == wanted) station = k;
       if (!wanted.empty() && server_->stations[station]->name() != wanted)
         return respond(req, http::status::not_found, "text/plain", "no station '" + wanted.substr(0, 64) + "'\n", false);
-      open_browser(stream_.release_socket(), server_, std::move(req), station, foxglove);
+      open_browser(std::move(stream_), server_, std::move(req), station, foxglove);
       return;
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
@@ -102,21 +143,36 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     res->set(http::field::content_type, type);
     res->set(http::field::cache_control, "no-store");
     res->set("X-Content-Type-Options", "nosniff");
-    if (set_cookie) res->set(http::field::set_cookie, "viscera_token=" + server_->opt.token + "; HttpOnly; SameSite=Strict; Path=/");
+    if (set_cookie)
+      res->set(http::field::set_cookie,
+               "viscera_token=" + server_->opt.token + "; HttpOnly; SameSite=Strict; Path=/" + (server_->opt.tls ? "; Secure" : ""));
     res->keep_alive(req.keep_alive() && status == http::status::ok);
     res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
     res->prepare_payload();
-    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
-      if (ec || !res->keep_alive()) {
-        beast::error_code ignored;
-        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-        return;
-      }
-      self->read();
-    });
+    std::visit(
+        [this, res](auto& s) {
+          http::async_write(s, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+            if (ec || !res->keep_alive()) return self->close();
+            self->read();
+          });
+        },
+        stream_);
   }
 
-  beast::tcp_stream stream_;
+  /// The end of the conversation: TLS says so first (close_notify, 5 s at most), then TCP.
+  void close() {
+    const auto tcp_close = [](PlainStream& s) {
+      beast::error_code ignored;
+      s.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    };
+    if (auto* plain = std::get_if<PlainStream>(&stream_)) return tcp_close(*plain);
+    auto& tls = std::get<TlsStream>(stream_);
+    beast::get_lowest_layer(tls).expires_after(std::chrono::seconds(5));
+    tls.async_shutdown(
+        [self = shared_from_this(), tcp_close](beast::error_code) { tcp_close(beast::get_lowest_layer(std::get<TlsStream>(self->stream_))); });
+  }
+
+  Transport stream_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<WebServer::Impl> server_;
@@ -125,7 +181,12 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
 }  // namespace
 
 void serve_http(tcp::socket socket, std::shared_ptr<WebServer::Impl> server) {
-  std::make_shared<HttpConnection>(std::move(socket), std::move(server))->read();
+  const bool tls = server->opt.tls != nullptr;
+  auto c = std::make_shared<HttpConnection>(Transport(std::in_place_type<PlainStream>, std::move(socket)), std::move(server));
+  if (tls)
+    c->handshake();
+  else
+    c->read();
 }
 
 }  // namespace viscera::console

@@ -22,6 +22,7 @@
 #include "viscera/common/number_text.hpp"
 #include "viscera/common/program_log.hpp"
 #include "viscera/console/access_token.hpp"
+#include "viscera/console/tls_context.hpp"
 #include "viscera/process/child_process.hpp"
 #include "viscera/protocol/dds.hpp"
 
@@ -96,8 +97,11 @@ int main(int argc, char** argv) {
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("stations", "P1,P2", "the stations to offer, as DDS partitions (a trainee station's server in each; empty: the default partition)", "");
   cl.option_switch("discover", "also offer a station for every partition in which a viscera server appears on the domain (looked for every second)");
-  cl.flag("listen", "ADDRESS:PORT", "where browsers connect (port 0: any free one); another address than loopback makes the console remote",
+  cl.flag("listen", "ADDRESS:PORT",
+          "where browsers connect (port 0: any free one); another address than loopback makes the console remote, and needs --tls-cert",
           "127.0.0.1:8080");
+  cl.flag("tls-cert", "FILE", "serve HTTPS and WSS with this PEM certificate chain (the console's certificate first; plain HTTP: loopback only)");
+  cl.flag("tls-key", "FILE", "the private key of --tls-cert (PEM; mode 600)");
   cl.flag("token-file", "FILE", "the access token's file (one line, at least 32 characters: openssl rand -hex 16 > FILE)");
   cl.flag("web-root", "DIR", "the page's files (built by the project's build)", VISCERA_CONSOLE_WEB_DIR);
   cl.flag("client-id", "N", "the console's client id on the domain", "950");
@@ -122,11 +126,25 @@ int main(int argc, char** argv) {
     if (!cl.parse(argc, argv)) return 0;
     if (!cl.has("token-file")) throw UsageError("--token-file is required (the access token: openssl rand -hex 16 > FILE)");
     const auto listen = parse_listen(cl.text("listen"));
-    logger = viscera::common::program_log("viscera-console", cl.text("log-file"), {cl.text("token-file")});
+    if (cl.has("tls-cert") != cl.has("tls-key")) throw UsageError("--tls-cert and --tls-key go together (the certificate and its private key)");
+    const bool tls = cl.has("tls-cert");
+    // The token travels in every request: beyond this host only encrypted.
+    if (!tls && !listen.address().is_loopback())
+      throw UsageError("--listen " + cl.text("listen") +
+                       " is not a loopback address: a console other hosts reach serves HTTPS only (--tls-cert FILE --tls-key FILE; "
+                       "deploy/dds/make-test-pki.sh makes a test pair, docs/DEPLOY.md)");
+    std::vector<std::string> inputs{cl.text("token-file")};
+    if (tls) inputs.insert(inputs.end(), {cl.text("tls-cert"), cl.text("tls-key")});
+    logger = viscera::common::program_log("viscera-console", cl.text("log-file"), inputs);
     viscera::console::WebOptions options;
     options.token = viscera::console::read_token_file(cl.text("token-file"));
     if (const auto w = viscera::console::token_file_warning(cl.text("token-file")); !w.empty()) logger->warn("{}", w);
     const std::string token = options.token;
+    if (tls) {
+      options.tls = viscera::console::make_tls_context(cl.text("tls-cert"), cl.text("tls-key"));
+      if (const auto w = viscera::console::token_file_warning(cl.text("tls-key"), "anyone who reads it can pose as this console"); !w.empty())
+        logger->warn("{}", w);
+    }
     options.files = read_page(cl.text("web-root"));
     options.allowed_origins = split(cl.text("allow-origin"), ',');
     options.outbox_bytes = static_cast<std::size_t>(1024 * cl.number_in("outbox-kib", 64, 1 << 20));
@@ -219,7 +237,7 @@ int main(int argc, char** argv) {
     web = server.get();
     const auto ep = server->endpoint();
     const std::string host = ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
-    logger->info("domain {}, {} station(s); open http://{}:{}/?token={}", domain, stations.size(), host, ep.port(), token);
+    logger->info("domain {}, {} station(s); open {}://{}:{}/?token={}", domain, stations.size(), tls ? "https" : "http", host, ep.port(), token);
 
     // --discover: a station for every partition where a server's scene state appears (DDS
     // discovery), unless one is offered already (given, a replay opened here, or found before).

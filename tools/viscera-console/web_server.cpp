@@ -42,18 +42,18 @@ std::string field_value(std::string_view list, std::string_view key, char separa
 /// One browser's WebSocket.
 class Browser : public std::enable_shared_from_this<Browser> {
  public:
-  Browser(tcp::socket socket, std::shared_ptr<WebServer::Impl> server, std::uint64_t id)
-      : ws_(std::move(socket)),
+  Browser(Transport&& stream, std::shared_ptr<WebServer::Impl> server, std::uint64_t id)
+      : ws_(std::visit([](auto& s) { return Socket(std::in_place_type<websocket::stream<std::decay_t<decltype(s)>>>, std::move(s)); }, stream)),
         server_(std::move(server)),
         id_(id),
         outbox_(server_->opt.outbox_bytes),
         limit_(server_->opt.requests_per_s, server_->opt.request_burst) {
     beast::error_code ec;
-    address_ = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec).address().to_string();
+    address_ = socket().remote_endpoint(ec).address().to_string();
     // A small kernel send buffer: what a slow browser has not taken waits in its outbox, where the
     // newest frame replaces an older one, not in a socket buffer that grows to megabytes of stale
     // frames.
-    beast::get_lowest_layer(ws_).socket().set_option(asio::socket_base::send_buffer_size(128 * 1024), ec);
+    socket().set_option(asio::socket_base::send_buffer_size(128 * 1024), ec);
   }
 
   ~Browser() {
@@ -67,21 +67,25 @@ class Browser : public std::enable_shared_from_this<Browser> {
     foxglove_ = foxglove;
     auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
     timeouts.idle_timeout = std::chrono::seconds(30);  // a browser that answers no ping for 30 s is gone
-    ws_.set_option(timeouts);
-    ws_.read_message_max(kMaxRequestBytes);
-    ws_.set_option(websocket::stream_base::decorator([foxglove](websocket::response_type& r) {
-      r.set(http::field::server, "viscera-console");
-      if (foxglove) r.set(http::field::sec_websocket_protocol, kFoxgloveSubprotocol);
-    }));
-    ws_.async_accept(upgrade_, [self = shared_from_this()](beast::error_code ec) {
-      if (ec) return;
-      self->server_->browsers[self->id_] = self;
-      ++self->server_->counters.browsers_opened;
-      self->accepted_ = true;
-      if (self->foxglove_) ++self->server_->foxglove_browsers;
-      self->hello();
-      self->read();
-    });
+    std::visit(
+        [&](auto& ws) {
+          ws.set_option(timeouts);
+          ws.read_message_max(kMaxRequestBytes);
+          ws.set_option(websocket::stream_base::decorator([foxglove](websocket::response_type& r) {
+            r.set(http::field::server, "viscera-console");
+            if (foxglove) r.set(http::field::sec_websocket_protocol, kFoxgloveSubprotocol);
+          }));
+          ws.async_accept(upgrade_, [self = shared_from_this()](beast::error_code ec) {
+            if (ec) return;
+            self->server_->browsers[self->id_] = self;
+            ++self->server_->counters.browsers_opened;
+            self->accepted_ = true;
+            if (self->foxglove_) ++self->server_->foxglove_browsers;
+            self->hello();
+            self->read();
+          });
+        },
+        ws_);
   }
 
   std::size_t station() const { return station_; }
@@ -131,8 +135,8 @@ class Browser : public std::enable_shared_from_this<Browser> {
     if (closing_) return;
     closing_ = true;
     beast::error_code ec;
-    beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
-    beast::get_lowest_layer(ws_).socket().close(ec);
+    socket().shutdown(tcp::socket::shutdown_both, ec);
+    socket().close(ec);
     leave();
   }
 
@@ -169,7 +173,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
   }
 
   void read() {
-    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+    std::visit([this](auto& ws) { ws.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); }); }, ws_);
   }
 
   void on_read(beast::error_code ec) {
@@ -190,7 +194,7 @@ class Browser : public std::enable_shared_from_this<Browser> {
         return;
       }
       error(0, "rate limit: at most " + std::to_string(static_cast<int>(server_->opt.requests_per_s)) + " requests a second");
-    } else if (!ws_.got_text()) {
+    } else if (!std::visit([](auto& ws) { return ws.got_text(); }, ws_)) {
       refused_in_a_row_ = 0;
       ++server_->counters.malformed;
       error(0, "binary messages are not requests (send JSON text)");
@@ -310,22 +314,32 @@ class Browser : public std::enable_shared_from_this<Browser> {
     if (!m) return;
     writing_ = true;
     current_ = std::move(m->data);
-    ws_.binary(m->binary);
-    ws_.async_write(asio::buffer(*current_), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
-      self->writing_ = false;
-      self->current_.reset();
-      if (ec) {
-        if (!self->closing_) self->leave();
-        self->closing_ = true;
-        return;
-      }
-      self->bytes_sent_ += n;
-      ++self->messages_sent_;
-      self->pump();
-    });
+    std::visit(
+        [&](auto& ws) {
+          ws.binary(m->binary);
+          ws.async_write(asio::buffer(*current_), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+            self->writing_ = false;
+            self->current_.reset();
+            if (ec) {
+              if (!self->closing_) self->leave();
+              self->closing_ = true;
+              return;
+            }
+            self->bytes_sent_ += n;
+            ++self->messages_sent_;
+            self->pump();
+          });
+        },
+        ws_);
   }
 
-  websocket::stream<beast::tcp_stream> ws_;
+  /// The TCP socket under the WebSocket (and TLS).
+  tcp::socket& socket() {
+    return std::visit([](auto& ws) -> tcp::socket& { return beast::get_lowest_layer(ws).socket(); }, ws_);
+  }
+
+  using Socket = std::variant<websocket::stream<PlainStream>, websocket::stream<TlsStream>>;
+  Socket ws_;
   http::request<http::string_body> upgrade_;
   std::shared_ptr<WebServer::Impl> server_;
   std::uint64_t id_;
@@ -342,10 +356,10 @@ class Browser : public std::enable_shared_from_this<Browser> {
   std::chrono::steady_clock::time_point opened_ = std::chrono::steady_clock::now();
 };
 
-void open_browser(tcp::socket socket, std::shared_ptr<WebServer::Impl> server, http::request<http::string_body>&& upgrade, std::size_t station,
+void open_browser(Transport&& stream, std::shared_ptr<WebServer::Impl> server, http::request<http::string_body>&& upgrade, std::size_t station,
                   bool foxglove) {
   const std::uint64_t id = server->next_id++;
-  std::make_shared<Browser>(std::move(socket), std::move(server), id)->start(std::move(upgrade), station, foxglove);
+  std::make_shared<Browser>(std::move(stream), std::move(server), id)->start(std::move(upgrade), station, foxglove);
 }
 
 void WebServer::Impl::accept() {
@@ -401,7 +415,10 @@ nlohmann::json WebServer::Impl::stats() const {
           {"closed_oversized", counters.oversized},
           {"closed_slow", counters.closed_slow},
           {"closed_flood", counters.closed_flood},
-          {"busy_refusals", counters.busy}};
+          {"busy_refusals", counters.busy},
+          {"tls", opt.tls != nullptr},
+          {"tls_handshakes_failed", counters.tls_failed},
+          {"plain_http_refused", counters.plain_refused}};
 }
 
 WebServer::WebServer(asio::io_context& io, const tcp::endpoint& listen, WebOptions options, std::vector<Station*> stations)

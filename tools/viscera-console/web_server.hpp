@@ -1,6 +1,6 @@
 #pragma once
-// The bridge's side toward browsers: an HTTP server (Boost.Beast) that serves the page's files
-// and a WebSocket at /ws. Access needs the token (in the address, ?token=..., or the cookie the
+// The bridge's side toward browsers: an HTTP server (Boost.Beast, over TLS where given a
+// certificate) that serves the page's files and a WebSocket at /ws. Access needs the token (in the address, ?token=..., or the cookie the
 // page is given), checked before anything is served or upgraded. Each browser has a bounded
 // outbox (outbox.hpp), a rate limit on its requests and a size limit on its messages; everything
 // runs on one thread (the io_context's), stations hand their messages over by posting to it.
@@ -13,6 +13,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ssl/context.hpp>
 #include <nlohmann/json.hpp>
 
 #include "viscera/console/outbox.hpp"
@@ -24,6 +25,7 @@ class Station;
 
 struct WebOptions {  // NOLINT(bugprone-exception-escape): its defaults do not throw
   std::string token;
+  std::shared_ptr<boost::asio::ssl::context> tls;  ///< HTTPS and WSS with it (make_tls_context); null: plain HTTP
   std::map<std::string, std::string> files;  ///< path ("/console.js") -> content
   std::size_t outbox_bytes = 4u << 20;  ///< per browser
   double requests_per_s = 20, request_burst = 40;

@@ -85,10 +85,18 @@ struct Received {
   std::int64_t stamp_ns;
   std::span<const std::uint8_t> payload;  ///< valid during the callback only
   std::uint64_t writer = 0;  ///< the writing DDS entity (its instance handle), for counting its sequence gaps
-  /// The writer's DDS participant (a hash of its GUID; 0: not known): who sent it. Under DDS
-  /// Security a participant is an authenticated identity.
+  /// The writer's DDS participant (a hash of its GUID; 0: not known): who sent it.
   std::uint64_t participant = 0;
+  /// The first 48 bits of that participant's GUID (0: not known). Under DDS Security they are
+  /// derived from the subject name of its certificate and checked in the authentication handshake
+  /// (DDS Security 1.1, 9.3.3), so every participant of one certificate has the same identity and
+  /// no other can take it; without security they are random for each process.
+  std::uint64_t identity = 0;
 };
+
+/// Whether the Cyclone configuration of this process (CYCLONEDDS_URI: its files and inline XML)
+/// configures DDS Security, so that Received::identity names a certificate.
+bool security_configured();
 
 /// A reader's history, for a reader that must keep every sample (a recorder) rather than the
 /// stream's own (keep last 1 for the 1 kHz streams).
@@ -139,13 +147,16 @@ class Reader {
   void on_alive_writers_changed(std::function<void(int)> f);
 
  private:
-  /// The participant of a writer (Received::participant), looked up once per writer.
-  std::uint64_t participant_of(std::uint64_t writer);
+  struct Sender {
+    std::uint64_t participant, identity;
+  };
+  /// The participant of a writer (Received::participant, ::identity), looked up once per writer.
+  Sender sender_of(std::uint64_t writer);
   int32_t handle_;
   int32_t waitset_;
   int32_t condition_;
   std::function<void(int)> on_alive_;
-  std::unordered_map<std::uint64_t, std::uint64_t> participants_;  // writer -> participant; take()'s thread
+  std::unordered_map<std::uint64_t, Sender> senders_;  // writer -> its participant; take()'s thread
 };
 
 /// The partitions in which writers of a stream have appeared on the domain (DDS discovery: the

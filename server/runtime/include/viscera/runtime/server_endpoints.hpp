@@ -39,6 +39,9 @@ class ServerEndpoints {
   /// The files the organ was built from (schema 7, SceneFiles).
   virtual void write_scene_files(std::span<const std::uint8_t> payload) = 0;
   virtual std::unique_ptr<MeshStream> open_mesh_stream() = 0;
+  /// Whether the senders' identities are authenticated (DDS Security): client ids are then bound
+  /// to the certificate that first used them (ClientBinding).
+  virtual bool authenticated() const { return false; }
 };
 
 /// A lockstep driver's ticks (LockstepStep payloads) and the server's answers (LockstepResult).
@@ -64,6 +67,7 @@ class DdsEndpoints final : public ServerEndpoints, public LockstepLink {
   void write_event(std::span<const std::uint8_t> p) override { events_.write(0, p); }
   void write_scene_files(std::span<const std::uint8_t> p) override { scene_files_.write(0, p); }
   std::unique_ptr<MeshStream> open_mesh_stream() override;
+  bool authenticated() const override { return authenticated_; }
   /// Lockstep only (constructed with `lockstep`).
   int take_steps(std::chrono::nanoseconds timeout, const std::function<void(std::span<const std::uint8_t>)>& f) override;
   void write_result(std::span<const std::uint8_t> p) override;
@@ -74,6 +78,7 @@ class DdsEndpoints final : public ServerEndpoints, public LockstepLink {
   protocol::Writer forces_, scene_, telemetry_, events_, scene_files_;
   std::unique_ptr<protocol::Reader> steps_;
   std::unique_ptr<protocol::Writer> results_;
+  bool authenticated_ = protocol::security_configured();
 };
 
 }  // namespace viscera::runtime

@@ -15,8 +15,9 @@ inline constexpr std::size_t kMaxTokenChars = 256;
 /// first line, trimmed of surrounding blanks; printable ASCII without spaces, kMinTokenChars to
 /// kMaxTokenChars. Throws common::InputError naming the file otherwise.
 std::string read_token_file(const std::string& path);
-/// A warning when others than the file's owner may read the token file (empty otherwise).
-std::string token_file_warning(const std::string& path);
+/// A warning when others than the file's owner may read a secret's file, the token's or the TLS
+/// key's (empty otherwise); `risk` says what a reader could do.
+std::string token_file_warning(const std::string& path, std::string_view risk = "anyone who reads it commands the session");
 
 /// Whether a WebSocket upgrade with this Origin header may open: none (not a browser: the token
 /// still decides), the console's own address (`host`, the request's Host header, as http:// or
