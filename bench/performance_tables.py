@@ -100,14 +100,19 @@ def record(path):
 
 def console(path):
     r = json.load(open(path))
-    rows = ["| clients | frames | server -> client p50 / p99 [ms] | the DDS leg alone, server -> bridge, p50 / p99 [ms] | bytes/s per client | bridge CPU [% of one core] |",
-            "|---|---|---|---|---|---|"]
-    for k in ("one", "four"):
-        x = r[k]
-        rows.append(f"| {x['clients']} WebSocket client{'s' if x['clients'] > 1 else ''} | {x['frames']} | {x['delay_ms']['p50']:.2f} / {x['delay_ms']['p99']:.2f} | "
-                    f"{x['dds_leg_ms']['p50']:.2f} / {x['dds_leg_ms']['p99']:.2f} | {x['bytes_per_s_per_client'] / 1000:.0f} kB/s | {100 * x['bridge_cpu_fraction_of_one_core']:.1f} |")
-    p = r["page"]
-    rows.append(f"| the page in headless Chromium (software WebGL) | {p['frames']} | {p['delay_ms']['p50']:.1f} / {p['delay_ms']['p99']:.1f} | | | |")
+    rows = ["| clients | transport | frames | server -> client p50 / p99 [ms] | the DDS leg alone, server -> bridge, p50 / p99 [ms] | bytes/s per client | bridge CPU [% of one core] |",
+            "|---|---|---|---|---|---|---|"]
+    for plain, tls in (("one", "tls_one"), ("four", "tls_four")):
+        for k, name in ((plain, "ws"), (tls, "wss")):
+            if k not in r:
+                continue
+            x = r[k]
+            rows.append(f"| {x['clients']} WebSocket client{'s' if x['clients'] > 1 else ''} | {name} | {x['frames']} | {x['delay_ms']['p50']:.2f} / {x['delay_ms']['p99']:.2f} | "
+                        f"{x['dds_leg_ms']['p50']:.2f} / {x['dds_leg_ms']['p99']:.2f} | {x['bytes_per_s_per_client'] / 1000:.0f} kB/s | {100 * x['bridge_cpu_fraction_of_one_core']:.1f} |")
+    for k, name in (("page", "http, ws"), ("tls_page", "https, wss")):
+        if k in r:
+            p = r[k]
+            rows.append(f"| the page in headless Chromium (software WebGL) | {name} | {p['frames']} | {p['delay_ms']['p50']:.1f} / {p['delay_ms']['p99']:.1f} | | | |")
     return f"Run of {r['date_utc']} UTC (`bench/console.sh {r['seconds']:g}`), {r['machine']}:\n\n" + "\n".join(rows) + "\n"
 
 
