@@ -1,7 +1,7 @@
-// A client id belongs to the DDS participant that uses it while that participant keeps talking:
-// on a made-up clock (ClientBinding), and through the whole server in one process, where a second
-// participant reusing a client's id can neither steer nor release that client's instrument until
-// the holder has been silent for the lease.
+// A client id belongs to the DDS participant that uses it while that participant keeps talking
+// (and, under DDS Security, to its certificate): on a made-up clock (ClientBinding), and through
+// the whole server in one process, where a second participant reusing a client's id can neither
+// steer nor release that client's instrument until the holder has been silent for the lease.
 #include "viscera/runtime/client_binding.hpp"
 
 #include <algorithm>
@@ -9,15 +9,13 @@
 
 #include <gtest/gtest.h>
 
-#include "viscera/runtime/scene_file.hpp"
-#include "viscera/runtime/simulation_server.hpp"
-
 #include "memory_endpoints.hpp"
 
 namespace viscera::runtime {
 namespace {
 
 namespace proto = viscera::protocol;
+using testing::LiveServer;
 using testing::MemoryEndpoints;
 
 constexpr std::int64_t kLease = 500'000'000;  // ns
@@ -70,12 +68,8 @@ TEST(ClientBinding, BoundByIdentityAnIdStaysWithItsCertificate) {
 // impostor (participant 2) sends commands and a release under id 7. Only participant 1 is heard
 // until it goes silent; then the instrument and the id come free and the impostor may claim them.
 TEST(ClientBinding, AnotherParticipantCannotSteerOrReleaseAClientsInstrumentUnderItsId) {
-  SceneSpec scene = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
-  MemoryEndpoints endpoints;
-  SimulationServer server(scene, endpoints);
-  std::atomic<bool> stop{false};
-  ServerStats stats;
-  std::thread physics([&] { stats = server.run(stop, 0, {}); });
+  LiveServer live(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  MemoryEndpoints& endpoints = live.endpoints;
   const auto owner = [&] {
     const auto scenes = endpoints.decoded<proto::Scene>(endpoints.scenes, proto::decode_scene);
     return scenes.empty() ? 0u : scenes.back().instruments.at(0).owner_client_id;
@@ -114,9 +108,7 @@ TEST(ClientBinding, AnotherParticipantCannotSteerOrReleaseAClientsInstrumentUnde
   ASSERT_EQ(wait_for_owner(0), 0u);
   endpoints.push_request({7, proto::Action::claim_instrument, 1}, 2);
   EXPECT_EQ(wait_for_owner(7), 7u) << "the id passed to participant 2 once its holder was silent";
-  stop = true;
-  physics.join();
-  EXPECT_GE(stats.rejected_other_participant, 301u);  // 300 commands and the release
+  EXPECT_GE(live.stop().rejected_other_participant, 301u);  // 300 commands and the release
 }
 
 }  // namespace

@@ -7,11 +7,14 @@
 #include <deque>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "viscera/protocol/messages.hpp"
+#include "viscera/runtime/scene_file.hpp"
 #include "viscera/runtime/server_endpoints.hpp"
+#include "viscera/runtime/simulation_server.hpp"
 
 namespace viscera::runtime::testing {
 
@@ -124,6 +127,31 @@ class MemoryLockstepLink final : public LockstepLink {
   std::condition_variable cv_;
   std::deque<std::vector<std::uint8_t>> steps_;
   std::vector<proto::LockstepResult> results_;
+};
+
+/// The whole server in one process on endpoints in memory, stepping in real time on a thread of
+/// its own from construction until stop() (or destruction).
+struct LiveServer {
+  explicit LiveServer(const std::string& scene_file)
+      : scene(read_scene_file(scene_file)), server(scene, endpoints), physics([this] { stats = server.run(stopping, 0, {}); }) {}
+  ~LiveServer() { stop(); }
+  LiveServer(const LiveServer&) = delete;
+  LiveServer& operator=(const LiveServer&) = delete;
+  /// Stops the physics thread; the run's statistics.
+  const ServerStats& stop() {
+    if (physics.joinable()) {
+      stopping = true;
+      physics.join();
+    }
+    return stats;
+  }
+
+  SceneSpec scene;
+  MemoryEndpoints endpoints;
+  SimulationServer server;
+  std::atomic<bool> stopping{false};
+  ServerStats stats;
+  std::thread physics;  // last: started once the rest exists
 };
 
 }  // namespace viscera::runtime::testing

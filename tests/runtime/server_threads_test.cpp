@@ -4,18 +4,13 @@
 // by deploy/test.sh (the snapshot hand-over, the instrument table, the run-time control), and
 // under ASan + UBSan with the other unit tests.
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <deque>
-#include <mutex>
+#include <iostream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
 #include "viscera/protocol/messages.hpp"
-#include "viscera/runtime/scene_file.hpp"
-#include "viscera/runtime/simulation_server.hpp"
 
 #include "memory_endpoints.hpp"
 
@@ -23,15 +18,12 @@ namespace viscera::runtime {
 namespace {
 
 namespace proto = viscera::protocol;
+using testing::LiveServer;
 using testing::MemoryEndpoints;
 
 TEST(ServerThreads, CommandsAnsweredWhileThePhysicsStepsAndAMaterialIsBuilt) {
-  SceneSpec scene = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
-  MemoryEndpoints endpoints;
-  SimulationServer server(scene, endpoints);
-  std::atomic<bool> stop{false};
-  ServerStats stats;
-  std::thread physics([&] { stats = server.run(stop, 0, {}); });
+  LiveServer live(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  MemoryEndpoints& endpoints = live.endpoints;
 
   proto::SessionRequest claim{7, proto::Action::claim_instrument, 1};
   endpoints.push_request(claim);
@@ -73,8 +65,7 @@ TEST(ServerThreads, CommandsAnsweredWhileThePhysicsStepsAndAMaterialIsBuilt) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  stop = true;
-  physics.join();
+  const ServerStats& stats = live.stop();
 
   const auto forces = endpoints.decoded<proto::Force>(endpoints.forces, proto::decode_force);
   std::size_t answers = 0, in_contact = 0;
