@@ -52,7 +52,9 @@ mkdir -p "$tmp/recordings"
 wait_for "open http" "$tmp/console.log" || exit 1
 url=$(grep -o "http://[^ ]*" "$tmp/console.log")
 sleep 1
-"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script hold --force 1.2 --duration 150 --quiet \
+# --reconnect, as a station's client runs (docs/DEPLOY.md): a stall of the loaded machine (Chromium
+# draws in software beside everything) that looks like a lost server is ridden through.
+"$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script hold --force 1.2 --duration 150 --reconnect --quiet \
   > "$tmp/haptic.log" 2>&1 & pids+=($!)
 shots="${SHOTS:-$tmp}"; mkdir -p "$shots"
 node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
@@ -110,5 +112,10 @@ d = json.load(open(sys.argv[1]))
 l = d["frame_delay_ms"]
 print(f"frame delay, server to page: p50 {l['p50']:.1f} ms, p99 {l['p99']:.1f} ms over {d['frames']} frames")
 PY
+if [ "$failures" -gt 0 ]; then  # what the failing checks need to be understood
+  echo "--- haptic client:"; cat "$tmp/haptic.log"
+  echo "--- server (last 15 lines):"; tail -15 "$tmp/server.log"
+  echo "--- console (last 15 lines):"; tail -15 "$tmp/console.log"
+fi
 echo "passed $passed, failed $failures"
 [ "$failures" -eq 0 ]
