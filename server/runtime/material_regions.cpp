@@ -31,10 +31,15 @@ Vec3 vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
 std::string field(std::size_t k, const std::string& rest) { return "organ.regions[" + std::to_string(k) + "]" + rest; }
 
-/// Whether p lies in an element of the mesh.
+/// Whether p lies in an element of the mesh. An element whose bounding box does not hold p is
+/// passed over without solving for p's barycentric coordinates (a sphere's centre is drawn up to
+/// kDraws times, each draw tried against every element).
 bool inside(const tissue::TetMesh& mesh, const Vec3& p) {
   for (const auto& t : mesh.tets) {
     const Vec3& a = mesh.nodes[t[0]];
+    const Vec3 lo = a.cwiseMin(mesh.nodes[t[1]]).cwiseMin(mesh.nodes[t[2]]).cwiseMin(mesh.nodes[t[3]]);
+    const Vec3 hi = a.cwiseMax(mesh.nodes[t[1]]).cwiseMax(mesh.nodes[t[2]]).cwiseMax(mesh.nodes[t[3]]);
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
     Eigen::Matrix3d M;
     M << mesh.nodes[t[1]] - a, mesh.nodes[t[2]] - a, mesh.nodes[t[3]] - a;
     const Vec3 w = M.partialPivLu().solve(p - a);
