@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -16,6 +15,7 @@
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 #include "viscera/protocol/streams.hpp"
 
 #include "envelope.h"
@@ -267,12 +267,16 @@ bool security_configured() {
   for (std::string item; std::getline(items, item, ',');) {
     std::string text = item;
     if (item.rfind("file://", 0) == 0) {
-      std::ifstream in(item.substr(7));
-      std::stringstream content;
-      content << in.rdbuf();
-      text = content.str();
+      try {
+        text = common::read_text_file(item.substr(7), 1u << 20);  // a regular file, bounded: never a FIFO read without end
+      } catch (const common::InputError&) {
+        continue;  // Cyclone itself names a configuration it cannot read
+      }
     }
-    for (auto c = text.find("<!--"); c != std::string::npos; c = text.find("<!--", c)) text.erase(c, text.find("-->", c) - c);  // comments
+    for (auto c = text.find("<!--"); c != std::string::npos; c = text.find("<!--", c)) {  // comments
+      const auto end = text.find("-->", c);
+      text.erase(c, end == std::string::npos ? std::string::npos : end + 3 - c);
+    }
     if (has_security(lower(text))) return true;
   }
   return false;

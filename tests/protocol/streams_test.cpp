@@ -5,13 +5,18 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <thread>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "viscera/protocol/binary_schemas.hpp"
+#include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/typed_reader.hpp"
 
 using namespace viscera::protocol;
@@ -111,4 +116,33 @@ TEST(Streams, ATypedReaderHandsOverWhatDecodesAndCountsWhatDoesNotWithTheReason)
   EXPECT_EQ(got.size(), 1u);
   EXPECT_EQ(rejected.last_reason.rfind("force_feedback: ", 0), 0u) << rejected.last_reason;
   EXPECT_GT(rejected.last_reason.size(), std::string("force_feedback: ").size()) << "no reason given";
+}
+
+// Whether CYCLONEDDS_URI configures DDS Security (client ids are then bound to certificates): in
+// files and inline XML, not in comments; a configuration file that is a FIFO or missing is passed
+// over at once (Cyclone names it), never read without end.
+TEST(SecurityConfigured, ReadsTheConfigurationsFilesAndInlineXmlButNotComments) {
+  const char* before = std::getenv("CYCLONEDDS_URI");
+  const std::string saved = before ? before : "";
+  const std::string dir = ::testing::TempDir();
+  const std::string loopback = std::string("file://") + VISCERA_SOURCE_DIR + "/deploy/dds/loopback.xml";
+  const std::string secure = std::string("file://") + VISCERA_SOURCE_DIR + "/deploy/dds/secure.xml";
+  const auto with = [](const std::string& uri) {
+    ::setenv("CYCLONEDDS_URI", uri.c_str(), 1);
+    return security_configured();
+  };
+  EXPECT_FALSE(with(loopback));
+  EXPECT_TRUE(with(loopback + "," + secure)) << "deploy/dds/secure.xml holds <Security>";
+  EXPECT_TRUE(with("<CycloneDDS><Domain><SECURITY><Authentication/></SECURITY></Domain></CycloneDDS>")) << "names are not case-sensitive";
+  EXPECT_FALSE(with("<CycloneDDS><Domain><!-- <Security> one day --></Domain></CycloneDDS>"));
+  EXPECT_FALSE(with("<CycloneDDS><!-- an unclosed comment <Security>"));
+  EXPECT_FALSE(with("file://" + dir + "/no-such-config.xml"));
+  const std::string fifo = dir + "/viscera-config-fifo";
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_FALSE(with("file://" + fifo)) << "passed over, not read";
+  ::unlink(fifo.c_str());
+  ::unsetenv("CYCLONEDDS_URI");
+  EXPECT_FALSE(security_configured());
+  if (before) ::setenv("CYCLONEDDS_URI", saved.c_str(), 1);
 }
