@@ -7,19 +7,19 @@ Eigen::Quaterniond SimulatedTool::orientation() const {
   return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
 }
 
-void SimulatedTool::begin_tick(bool active, std::uint32_t owner, const protocol::Command& command) {
+bool SimulatedTool::begin_tick(bool active, std::uint32_t owner, const protocol::Command& command) {
   const bool was_active = active_;
   active_ = active;
   owner_ = owner;
   if (!active_) {
     held_ = {};  // released, or its client silent: a grasper lets go
-    return;
+    return false;
   }
   command_ = command;
-  if (!was_active) {
-    position_ = Vec3(command.tip_position[0], command.tip_position[1], command.tip_position[2]);
-    velocity_ = Vec3::Zero();
-  }
+  if (was_active) return false;
+  position_ = Vec3(command.tip_position[0], command.tip_position[1], command.tip_position[2]);
+  velocity_ = Vec3::Zero();
+  return true;
 }
 
 void SimulatedTool::move(double dt_s, double max_speed_m_s) {

@@ -90,7 +90,19 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
 /// The organ back at rest (memory variables relaxed); graspers let go.
 void SimulationServer::Impl::reset_organ() {
   state = State::at_rest(*organ->mesh);
-  for (auto& [id, t] : tools) t.tool.let_go();
+  for (auto& [id, t] : tools) {
+    t.tool.let_go();
+    if (t.tool.active()) start_outside(t);
+  }
+}
+
+void SimulationServer::Impl::start_outside(Tool& t) const {
+  const BoundaryConditions::FieldEvaluation look{.x = state.x, .v = {}, .f = {}, .stiffness = {}, .damping = {}, .dt_s = 0.0};
+  for (int k = 0; k < 4; ++k) {  // the contact's normal is the touched triangles' mean: a few passes
+    const ContactResult r = t.contact->apply(t.tool.position(), Vec3::Zero(), look);
+    if (!r.in_contact) return;
+    t.tool.withdraw(r.depth_m * r.normal);
+  }
 }
 
 /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
@@ -135,7 +147,8 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
     command_in_lockstep(step->commands);
   else
     release_silent(status);
-  for (const TickCommand& c : instruments.tick_commands()) tools.at(c.instrument_id).tool.begin_tick(c.active, c.owner, c.command);
+  for (const TickCommand& c : instruments.tick_commands())
+    if (Tool& t = tools.at(c.instrument_id); t.tool.begin_tick(c.active, c.owner, c.command)) start_outside(t);
   const auto t0 = std::chrono::steady_clock::now();
   if (!paused) {
     for (auto& [id, t] : tools) {

@@ -58,7 +58,10 @@ check "the scene state lists the loadable scenes, not the broken one" "grep -q '
 check "material change accepted (rc $rc_material)" "[ $rc_material -eq 0 ] && grep -q 'changed to material youngs_modulus_pa 10000' '$tmp/material.log'"
 check "the scene state shows the new modulus" "grep -q 'E 10000 Pa' '$tmp/material.log'"
 check "physics rate change accepted (rc $rc_rate)" "[ $rc_rate -eq 0 ] && grep -q 'physics rate 250 Hz (was 1000 Hz)' '$tmp/rate.log'"
-check "the server holds the new rate" "grep -Eq ': 2(4[5-9]|5[0-5]) Hz physics' '$tmp/server.log'"
+# The rate took effect: a one-second window of about 250 ticks, not 1000 (a busy two-core machine
+# misses a few of the 4 ms slots: 233-246 Hz seen beside the clients on the project's machine).
+# Only the windows between the rate change and the request for the 12k scene count.
+check "the server holds the new rate" "sed -n '/set_physics_rate/,/asked for scene liver-12k/p' '$tmp/server.log' | grep -Eq ': 2([0-4][0-9]|5[0-5]) Hz physics'"
 check "unknown scene refused, naming what exists (rc $rc_nope)" "[ $rc_nope -eq 1 ] && grep -q \"no scene 'nope'.*available: liver, liver-12k\" '$tmp/nope.log'"
 check "broken scene refused, naming file and field (rc $rc_broken)" "[ $rc_broken -eq 1 ] && grep -q 'broken.json.*contact_stiffness_n_per_m' '$tmp/broken.log'"
 check "12k scene loaded (rc $rc_load)" "[ $rc_load -eq 0 ] && grep -q 'loaded scene liver-12k' '$tmp/load.log'"

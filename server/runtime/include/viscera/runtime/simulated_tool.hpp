@@ -40,8 +40,14 @@ class SimulatedTool {
 
   /// The tick's command (the newest of its owner), or inactive: an instrument without an owner or
   /// command exerts nothing, and a grasper lets go. A tool that becomes active starts at its
-  /// commanded tip.
-  void begin_tick(bool active, std::uint32_t owner, const protocol::Command& command);
+  /// commanded tip; returns true in that tick.
+  bool begin_tick(bool active, std::uint32_t owner, const protocol::Command& command);
+  /// Moves the tool by `offset` [m] at once, at rest: a tool that appears inside the tissue is
+  /// withdrawn to its surface and enters at the speed limit.
+  void withdraw(const Vec3& offset) {
+    position_ += offset;
+    velocity_ = Vec3::Zero();
+  }
   /// Moves toward the commanded tip by at most `max_speed_m_s` x `dt_s`.
   void move(double dt_s, double max_speed_m_s);
   /// A grasper closes on the surface nodes of `surface` within its grasp radius when its jaws close
