@@ -11,6 +11,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/lab/decimation.hpp"
 #include "viscera/lab/fit.hpp"
+#include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
 #include "viscera/lab/stress_controlled.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
@@ -274,6 +275,26 @@ struct Selection {
   std::vector<Candidate> candidates;
 };
 
+NoiseCheck check_noise(const Dataset& d) {
+  NoiseCheck c;
+  double first2 = 0, holds2 = 0;
+  for (const auto& t : d.tests) {
+    const HoldNoise h = noise_in_holds(t);
+    if (h.holds == 0) continue;
+    const double to_pa = t.control == Control::strain ? 1.0 : apparent_modulus_pa(t);
+    if (c.tests++ == 0) c.window_s = h.window_s;
+    c.holds += h.holds;
+    c.first_stated = c.first_stated || (t.control == Control::strain && !t.stress_sd_pa.empty());
+    first2 += noise_level_pa(t) * noise_level_pa(t);
+    holds2 += h.sd * to_pa * h.sd * to_pa;
+  }
+  if (c.tests == 0) return c;
+  c.first_pa = std::sqrt(first2 / c.tests);
+  c.holds_pa = std::sqrt(holds2 / c.tests);
+  c.agree = c.holds_pa <= kNoiseAgreementFactor * c.first_pa && c.first_pa <= kNoiseAgreementFactor * c.holds_pa;
+  return c;
+}
+
 double noise_of(const Dataset& d) {
   double n2 = 0;
   for (const auto& t : d.tests) n2 += noise_level_pa(t) * noise_level_pa(t);
@@ -309,7 +330,7 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
       ++evaluated;
       Candidate c{m, round, current.heldout_rms_pa, ev.heldout_rms_pa, false, evidence(m, current.model, d)};
       const double reduction = current.heldout_rms_pa * current.heldout_rms_pa - ev.heldout_rms_pa * ev.heldout_rms_pa;
-      bool above_noise = reduction > kNoiseFraction * noise_pa * noise_pa && ev.heldout_rms_pa < (1.0 - kMinGain) * current.heldout_rms_pa;
+      bool above_noise = gain_holds(current.heldout_rms_pa, ev.heldout_rms_pa, noise_pa);
       say(fmt("  held-out RMS %.4g -> %.4g Pa (noise %.4g Pa)", current.heldout_rms_pa, ev.heldout_rms_pa, noise_pa) +
           (above_noise ? ": gain above noise" : ": no gain above noise"));
       double gain_measure = reduction;
@@ -333,7 +354,7 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
           if (!current_blocks) current_blocks = evaluate(current.model, d, HeldOut::blocks);
           const ModelEvaluation eb = evaluate(s, d, HeldOut::blocks);
           const double rb = current_blocks->heldout_rms_pa * current_blocks->heldout_rms_pa - eb.heldout_rms_pa * eb.heldout_rms_pa;
-          above_noise = rb > kNoiseFraction * noise_pa * noise_pa && eb.heldout_rms_pa < (1.0 - kMinGain) * current_blocks->heldout_rms_pa;
+          above_noise = gain_holds(current_blocks->heldout_rms_pa, eb.heldout_rms_pa, noise_pa);
           gain_measure = rb;
           c.evidence += fmt("; on held-out blocks of the tests (reloading shows within a test): held-out RMS %.4g -> %.4g Pa",
                             current_blocks->heldout_rms_pa, eb.heldout_rms_pa);
@@ -362,6 +383,20 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
 
 }  // namespace
 
+const char* to_string(CausesStatus s) {
+  switch (s) {
+    case CausesStatus::none: return "none";
+    case CausesStatus::confirmed: return "confirmed";
+    case CausesStatus::not_confirmed: return "not_confirmed";
+    case CausesStatus::tentative: return "tentative";
+  }
+  return "?";
+}
+
+bool gain_holds(double before_pa, double after_pa, double noise_pa) {
+  return before_pa * before_pa - after_pa * after_pa > kNoiseFraction * noise_pa * noise_pa && after_pa < (1.0 - kMinGain) * before_pa;
+}
+
 Analysis analyze(const Dataset& measured, const std::function<void(const std::string&)>& progress, const AnalyzeOptions& options) {
   const auto say = [&](const std::string& s) {
     if (progress) progress(s);
@@ -376,6 +411,10 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
     }
   a.dataset = d.name;
   a.noise_pa = noise_of(d);
+  a.noise_check = check_noise(measured);  // every row: the holds' running means need the original sampling
+  if (a.noise_check.tests > 0)
+    say(fmt("noise: %.4g Pa from second differences; %.4g Pa from the spread in ", a.noise_check.first_pa, a.noise_check.holds_pa) +
+        std::to_string(a.noise_check.holds) + " holds" + (a.noise_check.agree ? " (they agree)" : " (they disagree)"));
   MaterialModel structure;
   structure.relaxation_time_s = relaxation_times_for(d);
   structure.odd_only = d.mode == Mode::simple_shear;
@@ -388,7 +427,12 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
   const ModelEvaluation current = sel.final;
   a.final = current;
   a.gain = a.baseline.heldout_rms_pa / a.final.heldout_rms_pa;
-  if (options.nested && d.tests.size() >= 3) {
+  if (!options.nested)
+    a.nested_not_run = "the nested leave-one-out was turned off";
+  else if (d.tests.size() < 3)
+    a.nested_not_run = std::to_string(d.tests.size()) + (d.tests.size() == 1 ? " test" : " tests") +
+                       ": the nested leave-one-out needs at least 3 (a selection on the other tests, held out within them)";
+  if (a.nested_not_run.empty()) {
     // The honest gain: for each test, the whole selection runs on the other tests only (its own
     // leave-one-out inside), the chosen model is fitted to them and predicts the test.
     double sq = 0.0;
@@ -410,6 +454,10 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
             a.nested_gain) +
         fmt("%.4g Pa (gain %.3gx) for the model chosen on all tests", a.final.heldout_rms_pa, a.gain));
   }
+  if (!a.causes.empty())
+    a.causes_status = !a.nested_not_run.empty()                                                    ? CausesStatus::tentative
+                      : gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa) ? CausesStatus::confirmed
+                                                                                                   : CausesStatus::not_confirmed;
   if (options.specimen) {
     say("simulating baseline and final model on the tetrahedral specimen (GPS, implicit, inertia)");
     a.specimen.push_back(check_on_specimen(a.baseline.model, d));
@@ -417,30 +465,62 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
     for (const auto& c : a.specimen) say("  " + c.model + (c.ran ? ": done" : ": " + c.note));
   }
   std::ostringstream v;
-  if (a.causes.empty()) {
-    v << "The baseline (linear elasticity with Kelvin-Voigt damping) explains the data: no candidate mechanism lowers "
-         "the held-out error by more than the noise allows.";
-  } else {
-    v << "The baseline misses: ";
-    for (std::size_t k = 0; k < a.causes.size(); ++k) v << (k ? ", " : "") << name(a.causes[k]);
-    v << ". Adding them lowers the held-out RMS error from " << a.baseline.heldout_rms_pa << " Pa to " << a.final.heldout_rms_pa << " Pa (gain "
-      << a.gain << "x; noise " << a.noise_pa << " Pa).";
-  }
-  if (!a.nested.empty()) {
-    int same = 0;
-    for (const auto& f : a.nested) same += f.causes == a.causes;
-    v << " Chosen without each test in turn (nested leave-one-out), the model predicts the tests that played no part in choosing it "
+  const auto list = [&](const std::vector<Mechanism>& ms) {
+    for (std::size_t k = 0; k < ms.size(); ++k) v << (k ? ", " : "") << name(ms[k]);
+  };
+  int same = 0;
+  for (const auto& f : a.nested) same += f.causes == a.causes;
+  const auto nested_figures = [&] {
+    v << "chosen without each test in turn (nested leave-one-out), the model predicts the tests that played no part in choosing it "
          "with an RMS error of "
-      << a.nested_heldout_rms_pa << " Pa (gain " << a.nested_gain << "x, the honest figure; the gain above had every test in the choice); " << same
-      << " of " << a.nested.size() << " folds chose the same mechanisms.";
+      << a.nested_heldout_rms_pa << " Pa (gain " << a.nested_gain << "x over the baseline); " << same << " of " << a.nested.size()
+      << " folds chose the same mechanisms.";
+  };
+  switch (a.causes_status) {
+    case CausesStatus::none:
+      v << "The baseline (linear elasticity with Kelvin-Voigt damping) explains the data: no candidate mechanism lowers "
+           "the held-out error by more than the noise allows.";
+      break;
+    case CausesStatus::confirmed:
+    case CausesStatus::tentative:
+      v << (a.causes_status == CausesStatus::confirmed ? "The baseline misses: " : "Tentatively, the baseline misses: ");
+      list(a.causes);
+      v << ". Adding them lowers the held-out RMS error from " << a.baseline.heldout_rms_pa << " Pa to " << a.final.heldout_rms_pa << " Pa (gain "
+        << a.gain << "x; noise " << a.noise_pa << " Pa).";
+      if (a.causes_status == CausesStatus::confirmed) {
+        v << " The choice holds on data it did not see: ";
+        nested_figures();
+      } else {
+        v << " Tentative because every test had a say in the choice and no honest gain was measured: " << a.nested_not_run << ".";
+      }
+      break;
+    case CausesStatus::not_confirmed:
+      v << "No cause is named as found. Chosen on all tests, ";
+      list(a.causes);
+      v << " lowered the held-out RMS error from " << a.baseline.heldout_rms_pa << " Pa to " << a.final.heldout_rms_pa << " Pa (gain " << a.gain
+        << "x), but the choice does not hold where it never saw the test: ";
+      nested_figures();
+      v << " The baseline is the model this analysis stands by (model.json).";
+      break;
   }
   if (structure.odd_only)
     v << " Simple shear: tension/compression asymmetry was not a candidate and stiffening was offered in its odd forms only (an "
          "isotropic solid's shear stress is odd in the shear strain).";
-  if (a.final.model.has(Mechanism::strain_stiffening)) v << " Stiffening form chosen by the fit: " << name(a.final.model.stiffening_form) << ".";
-  const double excess = a.final.heldout_rms_pa / std::max(a.noise_pa, 1e-300);
+  if (a.supported_model().has(Mechanism::strain_stiffening))
+    v << " Stiffening form chosen by the fit: " << name(a.supported_model().stiffening_form) << ".";
+  const double supported_rms = a.causes_status == CausesStatus::not_confirmed ? a.baseline.heldout_rms_pa : a.final.heldout_rms_pa;
+  const double excess = supported_rms / std::max(a.noise_pa, 1e-300);
   if (excess > 2.0)
-    v << " The final model is still " << excess << "x the noise on held-out tests: something the candidate mechanisms do not describe remains.";
+    v << " The model it stands by is still " << excess
+      << "x the noise on held-out tests: something the candidate mechanisms do not describe remains.";
+  if (const NoiseCheck& c = a.noise_check; !c.agree)
+    v << " The two noise estimates disagree: " << c.first_pa
+      << (c.first_stated ? " Pa from the data's stress_sd_pa, " : " Pa from the differences between neighbouring samples, ") << c.holds_pa
+      << " Pa from the spread in the holds (" << c.holds << " holds, about a running mean over " << c.window_s << " s); "
+      << (c.holds_pa > c.first_pa ? "the noise is correlated over many samples (a logger's filter, or drift), so every ratio to the noise above "
+                                    "is too large by up to that factor."
+                                  : "the first is too large (a stated SD that is the spread between specimens rather than the instrument's "
+                                    "noise, or steps between samples), so every ratio to the noise above is too small by up to that factor.");
   a.verdict = v.str();
   return a;
 }

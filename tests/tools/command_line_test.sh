@@ -90,7 +90,7 @@ expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/tit
 expect lab-no-dataset 2 "nowhere/dataset.json: cannot open file" -- "$lab" analyze "$tmp/nowhere" --out "$tmp/o"
 fi
 if [ "$part" != programs ]; then
-expect lab-analyze 0 "causes: broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet
+expect lab-analyze 0 "causes (confirmed): broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet
 expect lab-predict 0 "wrote" -- "$lab" predict "$tmp/titin/model.json" "$src/data/titin-passive-muscle" --out "$tmp/predicted"
 # A model file edited by hand: each mistake named by file and field.
 model_case() {  # model_case NAME PATTERN PYTHON-EDIT

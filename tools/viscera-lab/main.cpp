@@ -66,13 +66,19 @@ int main(int argc, char** argv) {
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       write_report(a, decimate(d, AnalyzeOptions{}.max_fit_points), out, seconds);  // plots of what was fitted
       std::printf("%s\n", a.verdict.c_str());
-      std::printf("causes:");
-      for (Mechanism m : a.causes) std::printf(" %s", name(m));
+      std::printf("causes (%s):", to_string(a.causes_status));
+      for (Mechanism m : a.named_causes()) std::printf(" %s", name(m));
+      if (a.causes_status == CausesStatus::not_confirmed) {
+        std::printf(" none named; chosen on all tests but not held by the honest gain:");
+        for (Mechanism m : a.causes) std::printf(" %s", name(m));
+      }
       std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
                   a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
       if (!a.nested.empty())
         std::printf("honest gain (nested leave-one-out: mechanisms chosen without the test predicted): %.3gx, held-out RMS %.4g Pa\n", a.nested_gain,
                     a.nested_heldout_rms_pa);
+      else
+        std::printf("honest gain not measured: %s\n", a.nested_not_run.c_str());
       return 0;
     }
     if (positional[0] == "predict") {

@@ -7,6 +7,7 @@
 
 #include "viscera/lab/fit.hpp"
 #include "viscera/lab/model_file.hpp"
+#include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/stress_controlled.hpp"
 #include "viscera/plot/svg_plot.hpp"
 
@@ -46,13 +47,38 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   j["dataset"] = a.dataset;
   j["mode"] = to_string(d.mode);
   j["noise_pa"] = a.noise_pa;
+  {
+    const NoiseCheck& c = a.noise_check;
+    json n{{"estimate_pa", a.noise_pa},
+           {"method",
+            "RMS over tests of stress_sd_pa where given, else the second differences of the measured quantity (median absolute "
+            "value, the SD for white noise)"},
+           {"tests_with_holds", c.tests}};
+    if (c.tests > 0) {
+      n["first_estimate_on_those_tests_pa"] = c.first_pa;
+      n["second_estimate_pa"] = c.holds_pa;
+      n["second_method"] = "spread of the measured quantity in " + std::to_string(c.holds) + " holds about a running mean over " +
+                           std::to_string(c.window_s) + " s (robust SD, first window of each hold left out)";
+      n["ratio"] = c.holds_pa / std::max(c.first_pa, 1e-300);
+      n["agree_within_factor"] = kNoiseAgreementFactor;
+    }
+    n["agree"] = c.agree;
+    j["noise"] = n;
+  }
   j["baseline"] = figures(a.baseline);
   j["final"] = figures(a.final);
-  j["causes"] = json::array();
-  for (Mechanism m : a.causes) j["causes"].push_back(name(m));
+  const auto names = [](const std::vector<Mechanism>& ms) {
+    json l = json::array();
+    for (Mechanism m : ms) l.push_back(name(m));
+    return l;
+  };
+  j["causes"] = names(a.named_causes());  // found (or tentative); none when the honest gain did not hold
+  j["causes_status"] = to_string(a.causes_status);
+  j["causes_chosen_on_all_tests"] = names(a.causes);
   j["gain"] = a.gain;
+  if (!a.nested_not_run.empty()) j["nested_leave_one_out"] = {{"ran", false}, {"why", a.nested_not_run}};
   if (!a.nested.empty()) {
-    json n{{"heldout_rms_pa", a.nested_heldout_rms_pa}, {"gain", a.nested_gain}, {"folds", json::array()}};
+    json n{{"ran", true}, {"heldout_rms_pa", a.nested_heldout_rms_pa}, {"gain", a.nested_gain}, {"folds", json::array()}};
     for (const auto& f : a.nested) {
       json causes = json::array();
       for (Mechanism m : f.causes) causes.push_back(name(m));
@@ -80,14 +106,20 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   j["seconds"] = seconds;
   j["decimated"] = a.decimated;
   std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
-  write_model((fs::path(out_dir) / "model.json").string(), a.final.model, a.dataset);
+  write_model((fs::path(out_dir) / "model.json").string(), a.supported_model(), a.dataset);
 
   std::ofstream md(fs::path(out_dir) / "report.md");
   md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
   md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences; for a stress-controlled test that of its strain, as "
         "an equivalent stress): "
-     << a.noise_pa << " Pa. "
-     << "Analysis time: " << seconds << " s.\n\n";
+     << a.noise_pa << " Pa. ";
+  if (const NoiseCheck& c = a.noise_check; c.tests > 0)
+    md << "Checked by a second path, the spread in " << c.holds << " holds of " << c.tests << " tests about a running mean over " << c.window_s
+       << " s: " << c.holds_pa << " Pa against " << c.first_pa << " Pa by the first on the same tests"
+       << (c.agree ? " (they agree within a factor of 2). " : " (**they disagree** by more than a factor of 2: see the verdict). ");
+  else
+    md << "No test holds its command long enough to check the noise by a second path. ";
+  md << "Analysis time: " << seconds << " s.\n\n";
   for (const auto& line : a.decimated) md << "Decimated for the fit and the plots: " << line << ".\n\n";
   md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out "
         "|\n|---|---|---|---|---|---|\n";
@@ -116,6 +148,10 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
       md << (f.causes.empty() ? "none" : "") << " | " << f.heldout_rms_pa << " |\n";
     }
     md << "\n";
+  } else if (!a.nested_not_run.empty()) {
+    md << "## The honest gain: not measured\n\n"
+       << a.nested_not_run << ". Every test had a say in which mechanisms were chosen, so "
+       << "the gain above is optimistic and the causes are tentative.\n\n";
   }
   md << "## Candidate mechanisms\n\n| round | mechanism | held-out RMS before | after | accepted | evidence in the residuals "
         "|\n|---|---|---|---|---|---|\n";

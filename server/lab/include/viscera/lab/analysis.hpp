@@ -62,9 +62,33 @@ struct NestedFold {
   double heldout_rms_pa = 0.0;
 };
 
+/// Whether the mechanisms chosen on all tests are named as found (report.json "causes_status").
+enum class CausesStatus {
+  none,  ///< nothing chosen: the baseline explains the data
+  confirmed,  ///< the nested leave-one-out's honest gain holds by the rule that accepts a mechanism
+  not_confirmed,  ///< it ran and its gain does not hold: nothing is named as found; the baseline stands
+  tentative,  ///< it did not run (fewer than three tests, or turned off): named, as tentative
+};
+const char* to_string(CausesStatus s);
+
+/// The rule that accepts a mechanism, for a held-out RMS `after` [Pa] against `before` [Pa]: the
+/// mean square error falls by more than half the noise variance and the RMS by at least 5%.
+bool gain_holds(double before_pa, double after_pa, double noise_pa);
+
+/// The noise by a second, independent path (noise_check.hpp), over the tests that have holds.
+struct NoiseCheck {
+  int tests = 0, holds = 0;  ///< tests with holds, and holds used
+  double window_s = 0.0;  ///< the running mean's width in the first test with holds [s]
+  double first_pa = 0.0;  ///< the first estimate over the same tests (RMS) [Pa]
+  bool first_stated = false;  ///< the first estimate is the data's own stress_sd_pa (in some of those tests)
+  double holds_pa = 0.0;  ///< the spread in their holds (RMS over tests) [Pa]
+  bool agree = true;  ///< within kNoiseAgreementFactor of each other (true without holds)
+};
+
 struct Analysis {
   std::string dataset;
-  double noise_pa = 0.0;
+  double noise_pa = 0.0;  ///< the first estimate (noise_level_pa, RMS over tests): every ratio to the noise uses it
+  NoiseCheck noise_check;
   ModelEvaluation baseline, final;
   std::vector<Candidate> candidates;
   std::vector<Mechanism> causes;  ///< accepted, strongest first
@@ -76,6 +100,15 @@ struct Analysis {
   /// baseline's held-out RMS over it. 0 when not run.
   std::vector<NestedFold> nested;
   double nested_heldout_rms_pa = 0.0, nested_gain = 0.0;
+  /// Why the nested leave-one-out did not run ("" when it ran).
+  std::string nested_not_run;
+  /// What `causes` are worth: confirmed by the honest gain, tentative without it, or not confirmed
+  /// (then the report names none as found, and the baseline is the model written).
+  CausesStatus causes_status = CausesStatus::none;
+  /// The model the analysis stands by: `final`'s, or the baseline's when the choice did not hold.
+  const MaterialModel& supported_model() const { return causes_status == CausesStatus::not_confirmed ? baseline.model : final.model; }
+  /// The causes named as found or tentative: `causes`, or none when they were not confirmed.
+  std::vector<Mechanism> named_causes() const { return causes_status == CausesStatus::not_confirmed ? std::vector<Mechanism>{} : causes; }
   std::string verdict;  ///< one paragraph: what is wrong, why, what still does not fit
   std::vector<std::string> decimated;  ///< "file: N rows, fitted on M" for the tests decimated for the fit
   std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen

@@ -1,0 +1,32 @@
+#pragma once
+// A second estimate of a test's noise, independent of the first (second differences of every
+// sample, noise_level_measured): the spread of the measured quantity in the holds, about a running
+// mean. Second differences see only the noise that changes from one sample to the next: noise
+// that a logger's filter has smoothed (correlated over many samples) looks several times smaller
+// to them than it is, and every ratio to the noise would be that much too large. The spread in
+// the holds sees it whole, as long as the hold's own relaxation is smooth over the window.
+#include <cstddef>
+#include <string>
+
+#include "viscera/lab/dataset.hpp"
+
+namespace viscera::lab {
+
+/// The two estimates agree when neither is more than this factor above the other.
+inline constexpr double kNoiseAgreementFactor = 2.0;
+
+struct HoldNoise {
+  double sd = 0.0;           ///< of the measured quantity (stress [Pa], or strain under stress control); 0 without holds
+  std::size_t samples = 0;   ///< residuals it rests on
+  int holds = 0;             ///< holds used
+  double window_s = 0.0;     ///< the running mean's width [s]
+};
+
+/// The measured quantity in the holds of `t` (its command, the strain or under stress control the
+/// stress, held within its own noise for at least three windows), less its running mean over
+/// `window_s` (at least 9 samples), after the first window of each hold (where the relaxation
+/// bends fastest): the robust SD (median absolute value / 0.6745), corrected for the mean's own
+/// share of the noise.
+HoldNoise noise_in_holds(const TestData& t, double window_s = 1.0);
+
+}  // namespace viscera::lab

@@ -1,0 +1,157 @@
+// The verdict stands on the honest gain, and the noise is checked by a second path. The data here
+// come from a generator of their own (not the lab's synthetic one): a standard linear solid (a
+// spring beside one Maxwell arm, relaxation time 20 s) stretched in four ramp-and-hold tests to
+// 10-40% strain, like the blood clots of issue 38. Only the noise is random. Truths and forms the lab's catalogue was not
+// built on: one relaxation time (not a broad band), specimens that differ from test to test, and
+// noise that a logger's filter has correlated over many samples.
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "viscera/lab/analysis.hpp"
+#include "viscera/lab/noise_check.hpp"
+
+using namespace viscera::lab;
+
+namespace {
+
+struct Truth {
+  std::vector<double> specimen_scale{1, 1, 1, 1};  ///< each test's moduli times this (different specimens)
+  double noise_sd_pa = 5.0;
+  double noise_correlation = 0.0;  ///< AR(1) coefficient from sample to sample (0: white)
+  double rate_hz = 10.0;
+  double hold_s = 300.0;
+  std::size_t tests = 4;
+  unsigned seed = 1;
+};
+
+/// Ramps at 0.02 1/s to 0.1, 0.2, ... strain, each held hold_s; E = 2 kPa beside a 1.5 kPa Maxwell arm.
+Dataset clot_like(const Truth& truth) {
+  std::mt19937 rng(truth.seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Dataset d;
+  d.name = "clot-like";
+  d.folder = "generated";
+  d.mode = Mode::uniaxial;
+  d.specimen = {0.01, 0.003, 0.003, 1050};
+  const double tau = 20.0, dt = 1.0 / truth.rate_hz, rate = 0.02;
+  const double rho = truth.noise_correlation, innovation = std::sqrt(1 - rho * rho);
+  for (std::size_t k = 0; k < truth.tests; ++k) {
+    const double amp = 0.1 * static_cast<double>(k + 1), scale = truth.specimen_scale[k];
+    const double e = 2000 * scale, e1 = 1500 * scale;
+    TestData t;
+    t.file = "s" + std::to_string(k + 1) + ".csv";
+    const auto n = static_cast<std::size_t>((amp / rate + truth.hold_s) / dt);
+    double q = 0, previous = 0, noise = 0;
+    for (std::size_t i = 0; i <= n; ++i) {
+      const double time = static_cast<double>(i) * dt, eps = std::min(amp, rate * time);
+      // The Maxwell arm's stress, exact for a strain linear over each sample interval.
+      if (i > 0) q = q * std::exp(-dt / tau) + e1 * (eps - previous) * (tau / dt) * (1 - std::exp(-dt / tau));
+      noise = rho * noise + innovation * truth.noise_sd_pa * gauss(rng);
+      t.time_s.push_back(time);
+      t.strain.push_back(eps);
+      t.stress_pa.push_back(e * eps + q + noise);
+      previous = eps;
+    }
+    d.tests.push_back(std::move(t));
+  }
+  return d;
+}
+
+const AnalyzeOptions kWithoutSpecimen{.specimen = false};
+
+}  // namespace
+
+// One specimen, relaxation present: the choice holds on the tests it never saw.
+TEST(HonestGain, OneSpecimenRelaxationIsConfirmed) {
+  const Analysis a = analyze(clot_like({}), {}, kWithoutSpecimen);
+  ASSERT_FALSE(a.causes.empty());
+  EXPECT_EQ(a.causes[0], Mechanism::broadband_relaxation);
+  EXPECT_EQ(a.causes_status, CausesStatus::confirmed) << a.verdict;
+  EXPECT_TRUE(gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa));
+  EXPECT_EQ(a.named_causes(), a.causes);
+  std::printf("[ figure ] one specimen: gain %.2fx, honest gain %.2fx: %s\n", a.gain, a.nested_gain, to_string(a.causes_status));
+}
+
+// Four specimens whose moduli differ by up to 30%. The relaxation is in the truth, but the
+// differences between specimens are larger than what it explains: chosen on all tests it lowers
+// the held-out error a little (each test had a say in the choice), yet a selection that never
+// saw a specimen predicts it no better than the baseline. The honest call on four specimens this
+// different is to name nothing as found, say why, and stand by the baseline, as on the clots of
+// issue 38 (1.83x on all tests, 0.92x honest). Two orders of the same four specimens.
+TEST(HonestGain, SpecimensThatDifferHideTheGainAndNothingIsNamed) {
+  for (const std::vector<double>& scales : {std::vector<double>{1.3, 1.0, 0.8, 1.15}, std::vector<double>{1.0, 1.3, 0.8, 1.15}}) {
+    Truth truth;
+    truth.specimen_scale = scales;
+    const Analysis a = analyze(clot_like(truth), {}, kWithoutSpecimen);
+    ASSERT_FALSE(a.causes.empty()) << "the selection on all tests chose nothing, so this case tests nothing";
+    EXPECT_EQ(a.causes_status, CausesStatus::not_confirmed) << a.verdict;
+    EXPECT_FALSE(gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa));
+    EXPECT_TRUE(a.named_causes().empty());
+    EXPECT_EQ(a.supported_model().describe(), a.baseline.model.describe());
+    EXPECT_NE(a.verdict.find("No cause is named as found"), std::string::npos) << a.verdict;
+    std::printf("[ figure ] specimens x%.2f %.2f %.2f %.2f: gain %.2fx on all tests, honest gain %.2fx: %s\n", scales[0], scales[1], scales[2],
+                scales[3], a.gain, a.nested_gain, to_string(a.causes_status));
+  }
+}
+
+// Two tests: the nesting cannot run; the causes are tentative and the analysis says why.
+TEST(HonestGain, TwoTestsNameCausesAsTentativeAndSayWhy) {
+  Truth truth;
+  truth.tests = 2;
+  const Analysis a = analyze(clot_like(truth), {}, kWithoutSpecimen);
+  EXPECT_TRUE(a.nested.empty());
+  EXPECT_NE(a.nested_not_run.find("2 tests"), std::string::npos) << a.nested_not_run;
+  ASSERT_FALSE(a.causes.empty());
+  EXPECT_EQ(a.causes_status, CausesStatus::tentative);
+  EXPECT_NE(a.verdict.find("Tentatively"), std::string::npos) << a.verdict;
+  EXPECT_NE(a.verdict.find(a.nested_not_run), std::string::npos) << a.verdict;
+}
+
+// The second noise estimate against the truth: white noise, both agree with the SD generated;
+// noise correlated from sample to sample (AR(1), 0.9: about ten samples), the second differences
+// see about a quarter of it, the holds nearly all, and the analysis says they disagree.
+TEST(NoiseInHolds, FindsTheGeneratedSDWhereSecondDifferencesCannot) {
+  for (const double rho : {0.0, 0.9}) {
+    Truth truth;
+    truth.noise_sd_pa = 10.0;
+    truth.noise_correlation = rho;
+    truth.rate_hz = 100.0;
+    truth.hold_s = 30.0;
+    const Dataset d = clot_like(truth);
+    for (const auto& t : d.tests) {
+      const HoldNoise h = noise_in_holds(t);
+      ASSERT_EQ(h.holds, 1) << t.file;
+      EXPECT_NEAR(h.window_s, 1.01, 1e-9);
+      // Correlated over about 10 of the window's 101 samples, the running mean takes about a
+      // tenth of the variance with it: 0.9 of the SD is expected.
+      EXPECT_NEAR(h.sd / truth.noise_sd_pa, rho == 0 ? 1.0 : 0.9, 0.1) << t.file << " rho " << rho;
+      const double first = noise_level_pa(t);
+      if (rho == 0)
+        EXPECT_NEAR(first / truth.noise_sd_pa, 1.0, 0.1) << t.file;
+      else
+        EXPECT_LT(first / truth.noise_sd_pa, 0.4) << t.file;  // sqrt((6 - 8 rho + 2 rho^2) / 6) = 0.26
+    }
+    std::printf("[ figure ] noise SD 10 Pa, AR(1) %.1f: second differences %.2f Pa, spread in the holds %.2f Pa\n", rho,
+                noise_level_pa(d.tests[0]), noise_in_holds(d.tests[0]).sd);
+  }
+}
+
+TEST(HonestGain, CorrelatedNoiseIsReportedAsTwoEstimatesThatDisagree) {
+  Truth truth;
+  truth.noise_sd_pa = 10.0;
+  truth.noise_correlation = 0.9;
+  truth.rate_hz = 100.0;
+  truth.hold_s = 30.0;
+  const Analysis a = analyze(clot_like(truth), {}, {.specimen = false, .nested = false});
+  EXPECT_EQ(a.noise_check.tests, 4);
+  EXPECT_FALSE(a.noise_check.agree);
+  EXPECT_GT(a.noise_check.holds_pa, kNoiseAgreementFactor * a.noise_check.first_pa);
+  EXPECT_NE(a.verdict.find("The two noise estimates disagree"), std::string::npos) << a.verdict;
+  truth.noise_correlation = 0.0;
+  EXPECT_TRUE(analyze(clot_like(truth), {}, {.specimen = false, .nested = false}).noise_check.agree);
+}
