@@ -123,5 +123,5 @@ sys.exit(0 if commands >= 7000 and forces >= commands and rt_slow["p50"] >= 4000
 PY
 kill -INT "${pids[0]}"; wait "${pids[0]}"; rc_server=$?
 check "the server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
-echo "namespaces_test: $passed passed, $failures failed"
+echo "namespaces_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

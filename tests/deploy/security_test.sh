@@ -127,5 +127,5 @@ print(f"[ figure ] round trip without security p50 {rt(p, 'p50'):.0f} us p99 {rt
       f"(ratio p50 {rt(s, 'p50') / rt(p, 'p50'):.2f}, p99 {rt(s, 'p99') / rt(p, 'p99'):.2f})")
 sys.exit(0 if rt(s, "p50") > 0 and rt(p, "p50") > 0 else 1)
 PY
-echo "security_test: $passed passed, $failures failed"
+echo "security_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

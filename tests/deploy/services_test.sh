@@ -31,5 +31,5 @@ openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 timeout 3 "$tmp/opt/bin/viscera-console" --domain "$domain" --stations svc --listen 127.0.0.1:0 --token-file "$tmp/token" \
   --web-root "$tmp/opt/share/viscera/web" > "$tmp/console.log" 2>&1
 check "the installed console started on the installed page" "grep -q 'station(s); open' '$tmp/console.log'"
-echo "services_test: $passed passed, $failures failed"
+echo "services_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

@@ -56,5 +56,5 @@ for b in (1, 2, 3):
     print(line)
 sys.exit(0)
 PY
-echo "stations_test: $passed passed, $failures failed"
+echo "stations_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

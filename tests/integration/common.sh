@@ -7,10 +7,11 @@ domain=$(( (RANDOM % 200) + 1 ))
 scene="$tmp/scene.json"
 sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" \
   "$src/data/scenes/liver.json" > "$scene"
-failures=0; passed=0
-check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); fi; }
+# failed_names: the failed checks again, for the script's last line (a CI log keeps only its tail).
+failures=0; passed=0; failed_names=
+check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); failed_names+=" [$1]"; fi; }
 # A check written in Python, read from standard input (a here-document): counts one pass or one failure.
-pycheck() { if python3 - "$@"; then passed=$((passed+1)); else echo "FAIL the Python check above"; failures=$((failures+1)); fi; }
+pycheck() { if python3 - "$@"; then passed=$((passed+1)); else echo "FAIL the Python check above"; failures=$((failures+1)); failed_names+=" [a Python check]"; fi; }
 # Waits until PATTERN appears in FILE (at most TENTHS tenths of a second, default 100); says so if it never does.
 wait_for() {  # PATTERN FILE [TENTHS]
   for _ in $(seq "${3:-100}"); do grep -q "$1" "$2" && return 0; sleep 0.1; done

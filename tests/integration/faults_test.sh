@@ -169,5 +169,5 @@ check "the server runs on (alive, still reporting)" "kill -0 $server && [ \$(gre
 kill -INT "$server"; wait "$server"; rc_server=$?
 check "the server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
 
-echo "faults_test: $passed passed, $failures failed"
+echo "faults_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

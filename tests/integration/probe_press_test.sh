@@ -149,5 +149,5 @@ print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% oppos
       f"({100 * deep / (k * travel):.0f}% of the penalty on a rigid surface over {1000 * travel:.0f} mm); "
       f"round trip p50 {rt['p50']:.0f} us, p99 {rt['p99']:.0f} us, max {rt['max']:.0f} us over {rt['samples']} commands")
 PY
-echo "probe_press_test: $passed passed, $failures failed"
+echo "probe_press_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

@@ -296,5 +296,5 @@ cat "$tmp/late.log"
 check "a server joining the replay's partition stops it (rc $rc_late, want 3)" "[ $rc_late -eq 3 ] && grep -q 'holds a live viscera-server' '$tmp/late.log'"
 kill -INT "$guard" "$late_server"; wait "$guard" "$late_server"
 
-echo "recording: $passed passed, $failures failed"
+echo "recording: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

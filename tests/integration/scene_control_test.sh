@@ -113,5 +113,5 @@ assert len(a["samples"]) / a["duration_s"] > 800, "forces in the new scene below
 print(f"[ figure ] after loading liver-12k: a new client received {len(frames)} frames of the new surface and "
       f"{len(a['samples']) / a['duration_s']:.0f} forces/s")
 PY
-echo "scene_control_test: $passed passed, $failures failed"
+echo "scene_control_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

@@ -135,5 +135,5 @@ for path in sys.argv[1:3]:
           f"round trip p50 {r['round_trip_us']['p50']:.0f} us p99 {r['round_trip_us']['p99']:.0f} us")
 print(f"[ figure ] SIGKILLed client's instrument claimed by another {float(sys.argv[3]):.2f} s after the kill")
 PY
-echo "sessions_test: $passed passed, $failures failed"
+echo "sessions_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

@@ -142,5 +142,5 @@ cat "$tmp/bad1.err" "$tmp/bad2.err" "$tmp/bad3.err"
 check "unknown field: exit 2 naming file and field" "[ $rc1 -eq 2 ] && grep -q 'unknown.json: colour: unknown field' '$tmp/bad1.err' && [ \$(wc -l < '$tmp/bad1.err') -eq 1 ]"
 check "value out of range: exit 2 naming file and field" "[ $rc2 -eq 2 ] && grep -q 'range.json: time_limit_s' '$tmp/bad2.err'"
 check "bad command line: exit 2" "[ $rc3 -eq 2 ]"
-echo "training: $passed passed, $failures failed"
+echo "training: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ $failures -eq 0 ]
