@@ -28,12 +28,8 @@ constexpr double kMinGain = 0.05;
 constexpr double kSofteningZ = 3.0;
 // Held-out blocks per test (evaluate()).
 constexpr std::size_t kBlocks = 4;
-
-double rms(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x * x;
-  return std::sqrt(s / static_cast<double>(std::max<std::size_t>(v.size(), 1)));
-}
+// Wall time one test may take on the specimen before its run stops and says where it was.
+constexpr double kSpecimenSecondsPerTest = 60.0;
 
 std::string fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[256];
@@ -156,14 +152,6 @@ double rms_over_tests(const std::vector<TestFigures>& t, double TestFigures::*f)
 
 }  // namespace
 
-double noise_level_measured(const TestData& t) {
-  if (t.control == Control::stress) return noise_from_second_differences(t.strain);
-  if (!t.stress_sd_pa.empty()) return rms(t.stress_sd_pa);
-  return noise_from_second_differences(t.stress_pa);
-}
-
-double noise_level_pa(const TestData& t) { return noise_level_measured(t) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t)); }
-
 ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d, HeldOut unit) {
   if (d.tests.size() < 2) throw common::InputError(d.folder, 0, "tests", "at least two tests are needed to measure errors on held-out tests");
   ModelEvaluation ev;
@@ -229,7 +217,7 @@ ModelEvaluation evaluate(const MaterialModel& structure, const Dataset& d, HeldO
   return ev;
 }
 
-SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
+SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d, const std::function<void(const std::string&)>& say) {
   SpecimenCheck c;
   c.model = m.describe();
   std::string why;
@@ -249,8 +237,11 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
                     100 * calibration.uncalibrated_mismatch, 100 * calibration.mismatch);
       c.note += text;
     }
-    for (const auto& t : d.tests) {
-      const SpecimenResult r = simulate_specimen(m, d, t, &calibration);
+    for (std::size_t k = 0; k < d.tests.size(); ++k) {
+      const TestData& t = d.tests[k];
+      say("  " + c.model + " on the specimen: " + t.file + " (" + std::to_string(k + 1) + " of " + std::to_string(d.tests.size()) +
+          fmt(", %.4g s of history; at most %.0f s)", t.time_s.back() - t.time_s.front(), kSpecimenSecondsPerTest));
+      const SpecimenResult r = simulate_specimen(m, d, t, &calibration, kSpecimenSecondsPerTest);
       c.files.push_back(t.file);
       c.specimen_rms_pa.push_back(r.rms_pa);
       c.law_rms_pa.push_back(rms_error_pa(m, t));
@@ -259,10 +250,11 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d) {
     }
     c.ran = true;
   } catch (const tissue::SimulationError& e) {
+    c.note = "the specimen simulation failed on " + (c.files.size() < d.tests.size() ? d.tests[c.files.size()].file : std::string("a test")) + ": " +
+             e.what() + "; only the material-point law is reported";
     c.files.clear();
     c.specimen_rms_pa.clear();
     c.law_rms_pa.clear();
-    c.note = std::string("the specimen simulation failed: ") + e.what() + "; only the material-point law is reported";
   }
   return c;
 }
@@ -460,8 +452,8 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
                                                                                                    : CausesStatus::not_confirmed;
   if (options.specimen) {
     say("simulating baseline and final model on the tetrahedral specimen (GPS, implicit, inertia)");
-    a.specimen.push_back(check_on_specimen(a.baseline.model, d));
-    if (!a.causes.empty()) a.specimen.push_back(check_on_specimen(a.final.model, d));
+    a.specimen.push_back(check_on_specimen(a.baseline.model, d, say));
+    if (!a.causes.empty()) a.specimen.push_back(check_on_specimen(a.final.model, d, say));
     for (const auto& c : a.specimen) say("  " + c.model + (c.ran ? ": done" : ": " + c.note));
   }
   std::ostringstream v;

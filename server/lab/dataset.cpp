@@ -228,6 +228,27 @@ double noise_from_second_differences(const std::vector<double>& v) {
   return d2[d2.size() / 2] / 0.6745 / std::sqrt(6.0);
 }
 
+double quantum_of(const std::vector<double>& v) {
+  double quantum = 0;
+  for (std::size_t k = 1; k < v.size(); ++k)
+    if (const double step = std::abs(v[k] - v[k - 1]); step > 0 && (quantum == 0 || step < quantum)) quantum = step;
+  return quantum;
+}
+
+double noise_of_reading(const std::vector<double>& v) {
+  if (const double n = noise_from_second_differences(v); n > 0 || v.size() < 3) return n;
+  // More than half the second differences are exactly zero: a reading quantised more coarsely
+  // than its noise, and their median says nothing. Their RMS over the central 98% then (the
+  // largest 2%, the command's corners, left out), never below the quantum's own noise.
+  std::vector<double> d2;
+  for (std::size_t k = 2; k < v.size(); ++k) d2.push_back(std::abs(v[k] - 2 * v[k - 1] + v[k - 2]));
+  std::sort(d2.begin(), d2.end());
+  const std::size_t kept = std::max<std::size_t>(1, d2.size() * 98 / 100);
+  double sq = 0;
+  for (std::size_t k = 0; k < kept; ++k) sq += d2[k] * d2[k];
+  return std::max(std::sqrt(sq / static_cast<double>(kept) / 6.0), quantum_of(v) / std::sqrt(12.0));
+}
+
 Dataset read_dataset(const std::string& folder) {
   const std::string meta = (std::filesystem::path(folder) / "dataset.json").string();
   if (!std::filesystem::exists(meta)) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");

@@ -4,7 +4,21 @@
 #include <cmath>
 #include <vector>
 
+#include "viscera/lab/stress_controlled.hpp"
+
 namespace viscera::lab {
+
+double noise_level_measured(const TestData& t) {
+  if (t.control == Control::stress) return noise_of_reading(t.strain);
+  if (!t.stress_sd_pa.empty()) {
+    double sq = 0;
+    for (double x : t.stress_sd_pa) sq += x * x;
+    return std::sqrt(sq / static_cast<double>(t.stress_sd_pa.size()));
+  }
+  return noise_of_reading(t.stress_pa);
+}
+
+double noise_level_pa(const TestData& t) { return noise_level_measured(t) * (t.control == Control::strain ? 1.0 : apparent_modulus_pa(t)); }
 
 HoldNoise noise_in_holds(const TestData& t, double window_s) {
   const bool stress_control = t.control == Control::stress;
@@ -39,9 +53,19 @@ HoldNoise noise_in_holds(const TestData& t, double window_s) {
   if (residual.empty()) return r;
   r.samples = residual.size();
   for (double& x : residual) x = std::abs(x);
-  std::nth_element(residual.begin(), residual.begin() + static_cast<long>(residual.size() / 2), residual.end());
+  std::sort(residual.begin(), residual.end());
   // A residual about a w-sample mean has variance sd^2 (1 - 1/w) for white noise.
-  r.sd = residual[residual.size() / 2] / 0.6745 / std::sqrt(1.0 - 1.0 / static_cast<double>(w));
+  const double mean_share = std::sqrt(1.0 - 1.0 / static_cast<double>(w));
+  if (const double median = residual[residual.size() / 2]; median > 0) {
+    r.sd = median / 0.6745 / mean_share;
+    return r;
+  }
+  // Quantised: most samples of a hold sit on one level, and the median residual says nothing.
+  // The RMS of the central 98% then, never below the quantum's own noise (as the first estimate).
+  const std::size_t kept = std::max<std::size_t>(1, residual.size() * 98 / 100);
+  double sq = 0;
+  for (std::size_t k = 0; k < kept; ++k) sq += residual[k] * residual[k];
+  r.sd = std::max(std::sqrt(sq / static_cast<double>(kept)) / mean_share, quantum_of(measured) / std::sqrt(12.0));
   return r;
 }
 

@@ -1,12 +1,15 @@
 #include "viscera/lab/specimen_simulation.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/lab/command_path.hpp"
 #include "viscera/lab/golden_section.hpp"
+#include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/stress_controlled.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/implicit_integrator.hpp"
@@ -270,9 +273,18 @@ BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const Test
 /// Advances to time `end` [s] in steps from 1/8 of the sampling interval `interval` (or 1 ms)
 /// growing by 1.6x: small where the history turns, long through holds (backward Euler is stable
 /// for any step). A step whose Newton iteration does not converge is retried at a quarter.
-void advance_to(ImplicitIntegrator& integrator, State& s, double end, double interval, double total_s, SpecimenResult& r) {
+/// Past `deadline` it stops with a SimulationError saying where it was.
+void advance_to(ImplicitIntegrator& integrator, State& s, double end, double interval, double total_s, SpecimenResult& r,
+                std::chrono::steady_clock::time_point deadline) {
   double dt = std::min(1e-3, interval / 8);
   while (s.time_s < end - 1e-12) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      char text[300];
+      std::snprintf(text, sizeof text,
+                    "stopped at its time limit at t = %.4g s of %.4g s of the test (%ld steps, %ld step cuts, %ld Newton iterations)", s.time_s,
+                    total_s, r.steps, r.step_cuts, r.newton_iterations);
+      throw SimulationError(text);
+    }
     dt = std::min(dt, end - s.time_s);
     integrator.set_dt(dt);
     try {
@@ -291,7 +303,12 @@ void advance_to(ImplicitIntegrator& integrator, State& s, double end, double int
 
 }  // namespace
 
-SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration) {
+SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration,
+                                 double max_seconds) {
+  const auto deadline = max_seconds > 0
+                            ? std::chrono::steady_clock::now() +
+                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(max_seconds))
+                            : std::chrono::steady_clock::time_point::max();
   SpecimenResult r;
   r.supported = specimen_supports(m, d.mode, &r.note);
   if (!r.supported) return r;
@@ -302,7 +319,7 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
   const GpsModel model(mesh, {specimen_elasticity(E_u, rig.shear)}, {}, options);
   const CommandPath path = command_path(t.time_s, t.control == Control::strain ? t.strain : t.stress_pa);
   ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), d.specimen.density_kg_m3), specimen_loading(rig, d, t, path),
-                                {1e-3, 0.0, 1e-8, 25});
+                                {1e-3, 0.0, 1e-8, 25, kSpecimenResidualToNoise * noise_level_pa(t) * rig.area});
   State s = State::at_rest(*mesh);
   // The command path's start is taken as an equilibrium state, as the material-point law does: grip (or
   // load) at its first value, solved statically, memory variables fully relaxed there.
@@ -335,7 +352,7 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
   // Point to point along the path, so that no step straddles one of its corners.
   std::size_t k = 0;
   for (std::size_t j = 0; j < path.time_s.size(); ++j) {
-    if (j > 0) advance_to(integrator, s, path.time_s[j] - t0, path.time_s[j] - path.time_s[j - 1], path.time_s.back() - t0, r);
+    if (j > 0) advance_to(integrator, s, path.time_s[j] - t0, path.time_s[j] - path.time_s[j - 1], path.time_s.back() - t0, r, deadline);
     if (path.sample[k] != j) continue;
     const auto [stress, strain] = measure(r.steps == 0);
     if (t.control == Control::strain) {

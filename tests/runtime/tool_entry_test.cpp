@@ -31,7 +31,7 @@ constexpr double kDepthM = 0.02;  // below the top of the organ's bounds, at its
 
 struct Run {
   std::vector<double> force_z;  // stepped force on the tool per tick [N]
-  int resets = 0;               // physics_reset events (the organ went unstable)
+  int resets = 0;  // physics_reset events (the organ went unstable)
   std::string first_reset;
 };
 
@@ -104,9 +104,10 @@ void expect_entered_gently(const std::string& scene_file) {
   const double peak = *std::max_element(deep.force_z.begin(), deep.force_z.end());
   const double peak_pressed = *std::max_element(pressed.force_z.begin(), pressed.force_z.begin() + kResetAt);  // before its reset
   EXPECT_LT(peak, 1.2 * peak_pressed);
-  std::printf("[ figure ] %s, probe claimed %.0f mm deep and the organ reset under it: peak %.3f N, held %.3f N; "
-              "pressed in from above: peak %.3f N, held %.3f N\n",
-              scene_file.c_str(), 1e3 * kDepthM, peak, held_deep, peak_pressed, held);
+  std::printf(
+      "[ figure ] %s, probe claimed %.0f mm deep and the organ reset under it: peak %.3f N, held %.3f N; "
+      "pressed in from above: peak %.3f N, held %.3f N\n",
+      scene_file.c_str(), 1e3 * kDepthM, peak, held_deep, peak_pressed, held);
 }
 
 TEST(ToolEntry, AProbeClaimedInsideTheLiverEntersFromItsSurface) { expect_entered_gently("liver.json"); }

@@ -163,7 +163,8 @@ NewtonReport ImplicitIntegrator::newton(State& state, bool dynamic, const std::v
   const double dt = options_.dt_s;
   const double mass_scale = dynamic ? (1.0 + options_.mass_damping_per_s * dt) / (dt * dt) : 0.0;
   std::vector<Vec3> trial;
-  const auto converged = [&] { return rn <= options_.relative_tolerance * rep.force_scale_n; };
+  const double tolerance = std::max(options_.relative_tolerance * rep.force_scale_n, options_.absolute_tolerance_n);
+  const auto converged = [&] { return rn <= tolerance; };
   while (!converged() && rep.iterations < options_.max_iterations) {
     ++rep.iterations;
     const double rn_before = rn;
@@ -228,7 +229,7 @@ NewtonReport ImplicitIntegrator::step(State& state) {
   if (!rep.converged) {
     std::ostringstream msg;
     msg << "implicit step at t = " << state.time_s << " s did not converge in " << rep.iterations << " Newton iterations: residual " << rep.residual_n
-        << " N (tolerance " << options_.relative_tolerance * rep.force_scale_n << " N)";
+        << " N (tolerance " << std::max(options_.relative_tolerance * rep.force_scale_n, options_.absolute_tolerance_n) << " N)";
     state.x = x_n;
     state.v = v_n;
     memory_before_ = nullptr;

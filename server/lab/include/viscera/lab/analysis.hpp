@@ -8,6 +8,7 @@
 
 #include "viscera/lab/dataset.hpp"
 #include "viscera/lab/material_model.hpp"
+#include "viscera/lab/noise_check.hpp"
 
 namespace viscera::lab {
 
@@ -113,13 +114,6 @@ struct Analysis {
   std::vector<std::string> decimated;  ///< "file: N rows, fitted on M" for the tests decimated for the fit
   std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen
 };
-
-/// Noise of what a test measured: under strain control the stress [Pa], the RMS of stress_sd_pa
-/// if given, else from the second differences of the stress (median absolute value); under stress
-/// control the strain, from its second differences.
-double noise_level_measured(const TestData& t);
-/// The same in pascals (strain noise times the apparent modulus under stress control).
-double noise_level_pa(const TestData& t);
 
 /// Fits `structure` to all tests and, for every held-out unit, to the rest (held-out prediction).
 /// What a held-out error holds out: a whole test (the model fitted to the other tests predicts

@@ -33,8 +33,14 @@ Dataset read_dataset(const std::string& folder);
 void write_dataset(const Dataset& d, const std::string& folder);
 
 /// Noise of a sampled quantity from its second differences (the median absolute value, robust
-/// to the changes of a command): the SD for white noise.
+/// to the changes of a command): the SD for white noise; 0 for a command sampled exactly.
 double noise_from_second_differences(const std::vector<double>& v);
+/// The smallest nonzero change between neighbouring samples (a reading's resolution, if quantised).
+double quantum_of(const std::vector<double>& v);
+/// The noise of a reading (a measured quantity): noise_from_second_differences, or where more than
+/// half of them are exactly zero (a reading quantised more coarsely than its noise) their RMS over
+/// the central 98%, never below quantum_of(v) / sqrt(12).
+double noise_of_reading(const std::vector<double>& v);
 
 const char* to_string(Mode m);
 const char* to_string(Control c);

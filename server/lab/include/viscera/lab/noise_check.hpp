@@ -1,6 +1,6 @@
 #pragma once
-// A second estimate of a test's noise, independent of the first (second differences of every
-// sample, noise_level_measured): the spread of the measured quantity in the holds, about a running
+// A test's noise, by two independent paths. The first (noise_level_measured) from the second
+// differences of every sample; the second the spread of the measured quantity in the holds, about a running
 // mean. Second differences see only the noise that changes from one sample to the next: noise
 // that a logger's filter has smoothed (correlated over many samples) looks several times smaller
 // to them than it is, and every ratio to the noise would be that much too large. The spread in
@@ -12,14 +12,21 @@
 
 namespace viscera::lab {
 
+/// The first estimate: the noise of what a test measured. Under strain control the stress [Pa]:
+/// the RMS of stress_sd_pa if given, else from the second differences of the stress
+/// (noise_of_reading); under stress control the strain, the same way.
+double noise_level_measured(const TestData& t);
+/// The same in pascals (strain noise times the apparent modulus under stress control).
+double noise_level_pa(const TestData& t);
+
 /// The two estimates agree when neither is more than this factor above the other.
 inline constexpr double kNoiseAgreementFactor = 2.0;
 
 struct HoldNoise {
-  double sd = 0.0;           ///< of the measured quantity (stress [Pa], or strain under stress control); 0 without holds
-  std::size_t samples = 0;   ///< residuals it rests on
-  int holds = 0;             ///< holds used
-  double window_s = 0.0;     ///< the running mean's width [s]
+  double sd = 0.0;  ///< of the measured quantity (stress [Pa], or strain under stress control); 0 without holds
+  std::size_t samples = 0;  ///< residuals it rests on
+  int holds = 0;  ///< holds used
+  double window_s = 0.0;  ///< the running mean's width [s]
 };
 
 /// The measured quantity in the holds of `t` (its command, the strain or under stress control the

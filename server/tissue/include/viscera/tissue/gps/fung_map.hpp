@@ -38,8 +38,11 @@ inline FungEnergyMap fung_energy_map(double B, double e) {
 ///  - exponential: Fung's (exp(B e) - 1) / B (stiffer in tension than in compression);
 ///  - odd_exponential: sign(e) (exp(B |e|) - 1) / B, odd in e (a shear response must be: an
 ///    isotropic solid's shear stress is odd in the shear strain). Energy map: h(e) = sign(e)
-///    h_exp(|e|), h' even, h'' odd (it jumps from -B/3 to B/3 at 0, where it multiplies a zero
-///    tension, so the tangent stays continuous);
+///    h_exp(|e|), h' even, h'' odd: it jumps from -B/3 to B/3 at 0. In a bar it multiplies a
+///    zero tension there; in a tetrahedron it multiplies (H h)_k, which the other edges' strains
+///    make nonzero, so the tangent jumps where an edge crosses zero strain and Newton converges
+///    only linearly near such a state (viscera-lab's specimen in compression: its residual
+///    tolerance is tied to the data's noise, specimen_simulation.hpp);
 ///  - odd_polynomial: e (1 + B^2 e^2 / 6). Energy map h = e sqrt(q), q = 1 + c e^2, c = B^2 / 12:
 ///    h h' = e (1 + 2 c e^2) = g.
 enum class StiffeningShape { exponential, odd_exponential, odd_polynomial };

@@ -21,6 +21,9 @@ struct ImplicitOptions {
   double mass_damping_per_s = 0.0;
   double relative_tolerance = 1e-8;  ///< |r| <= tol x force scale (see NewtonReport)
   int max_iterations = 50;
+  /// |r| at or below this also converges [N] (0: none): the residual that matters to the caller,
+  /// where the relative tolerance asks for more than the problem's conditioning gives.
+  double absolute_tolerance_n = 0.0;
 };
 
 struct NewtonReport {
