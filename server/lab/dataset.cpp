@@ -218,6 +218,15 @@ void check_control(const TestData& t, const JsonObject& entry) {
   }
 }
 
+/// A specimen object; with `defaults` (a test's own), each field absent takes the data set's.
+Specimen read_specimen(const JsonObject& s, const Specimen* defaults) {
+  s.require_known({"length_m", "width_m", "thickness_m", "density_kg_m3"});
+  if (!defaults)
+    return {s.number("length_m", 1e-6, 10), s.number("width_m", 1e-6, 10), s.number("thickness_m", 1e-6, 10), s.number("density_kg_m3", 1, 1e5)};
+  return {s.number("length_m", 1e-6, 10, defaults->length_m), s.number("width_m", 1e-6, 10, defaults->width_m),
+          s.number("thickness_m", 1e-6, 10, defaults->thickness_m), s.number("density_kg_m3", 1, 1e5, defaults->density_kg_m3)};
+}
+
 }  // namespace
 
 double noise_from_second_differences(const std::vector<double>& v) {
@@ -259,19 +268,18 @@ Dataset read_dataset(const std::string& folder) {
   d.folder = folder;
   d.name = top.text("name", std::filesystem::path(folder).filename().string());
   d.mode = top.choice("mode", {"uniaxial", "simple_shear"}, "") == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
-  const JsonObject s = top.object("specimen");
-  s.require_known({"length_m", "width_m", "thickness_m", "density_kg_m3"});
-  d.specimen = {s.number("length_m", 1e-6, 10), s.number("width_m", 1e-6, 10), s.number("thickness_m", 1e-6, 10), s.number("density_kg_m3", 1, 1e5)};
+  d.specimen = read_specimen(top.object("specimen"), nullptr);
   // Longer tests exist (creep over days) but are rare; a span beyond a day is more often a time
   // column in another unit, so it must be declared.
   const double max_duration_s = top.number("max_test_duration_s", 1e-3, 1e9, 86400.0);
   const json& tests = top.array("tests", 1);
   for (std::size_t k = 0; k < tests.size(); ++k) {
     const JsonObject t(tests[k], meta, "tests[" + std::to_string(k) + "]");
-    t.require_known({"file", "control"});
+    t.require_known({"file", "control", "specimen"});
     const std::string file = t.text("file");
     const Control control = t.choice("control", {"strain", "stress"}, "") == "strain" ? Control::strain : Control::stress;
     d.tests.push_back(read_csv(test_path(folder, file, t), file, control));
+    if (t.has("specimen")) d.tests.back().specimen = read_specimen(t.object("specimen"), &d.specimen);
     const TestData& added = d.tests.back();
     check_control(added, t);
     const double span = added.time_s.back() - added.time_s.front();
@@ -289,13 +297,14 @@ void write_dataset(const Dataset& d, const std::string& folder) {
   json j;
   j["name"] = d.name;
   j["mode"] = to_string(d.mode);
-  j["specimen"] = {{"length_m", d.specimen.length_m},
-                   {"width_m", d.specimen.width_m},
-                   {"thickness_m", d.specimen.thickness_m},
-                   {"density_kg_m3", d.specimen.density_kg_m3}};
+  const auto specimen = [](const Specimen& sp) {
+    return json{{"length_m", sp.length_m}, {"width_m", sp.width_m}, {"thickness_m", sp.thickness_m}, {"density_kg_m3", sp.density_kg_m3}};
+  };
+  j["specimen"] = specimen(d.specimen);
   j["tests"] = json::array();
   for (const auto& t : d.tests) {
     j["tests"].push_back({{"file", t.file}, {"control", to_string(t.control)}});
+    if (t.specimen) j["tests"].back()["specimen"] = specimen(*t.specimen);
     std::ofstream csv(std::filesystem::path(folder) / t.file);
     csv.precision(10);
     csv << "time_s,strain,stress_pa" << (t.stress_sd_pa.empty() ? "" : ",stress_sd_pa") << "\n";

@@ -65,10 +65,9 @@ struct Rig {
   double gauge = 0, area = 0;
 };
 
-Rig make_rig(const Dataset& d) {
+Rig make_rig(Mode mode, const Specimen& sp) {
   Rig rig;
-  rig.shear = d.mode == Mode::simple_shear;
-  const Specimen& sp = d.specimen;
+  rig.shear = mode == Mode::simple_shear;
   rig.mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(sp.length_m, sp.width_m, sp.thickness_m), 2, 1, 1));
   const double eps = 1e-9 * sp.length_m;
   for (std::size_t i = 0; i < rig.mesh->node_count(); ++i) {
@@ -171,7 +170,7 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
     if (c.strain_hi > 1e-6) tension.push_back(c.strain_hi * k / 6.0);
     if (c.strain_lo < -1e-6) compression.push_back(c.strain_lo * k / 6.0);
   }
-  const Rig rig = make_rig(d);
+  const Rig rig = make_rig(d.mode, d.specimen);  // the shape is calibrated on the data set's specimen
   const double E = 1e4;  // the shape is what is calibrated (the stress scales with the modulus)
   const auto law = [&](double e) { return E * ElasticShape{m}.value(e); };  // the virgin curve
   const StiffeningShape shape = gps_shape(m.stiffening_form);
@@ -243,7 +242,7 @@ GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCal
 /// The test's loading on the rig's moving face: its strain history prescribed on the moving
 /// nodes' x, or its stress history as a traction on the moving face (per pascal, scaled by the
 /// history), along its command path (command_path.hpp), which must outlive them.
-BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const TestData& t, const CommandPath& path) {
+BoundaryConditions specimen_loading(const Rig& rig, const Specimen& sp, const TestData& t, const CommandPath& path) {
   BoundaryConditions bc = rig.bc;
   const bool shear = rig.shear;
   const double t0 = path.time_s.front();
@@ -255,10 +254,10 @@ BoundaryConditions specimen_loading(const Rig& rig, const Dataset& d, const Test
     return bc;
   }
   const auto& mesh = *rig.mesh;
-  const double eps = 1e-9 * d.specimen.length_m;
+  const double eps = 1e-9 * sp.length_m;
   bc.nodal_forces.assign(mesh.node_count(), Vec3::Zero());
   const int normal = shear ? 2 : 0;
-  const double face = shear ? d.specimen.thickness_m : d.specimen.length_m;
+  const double face = shear ? sp.thickness_m : sp.length_m;
   for (const auto& tri : extract_boundary(mesh).triangles) {
     bool on = true;
     for (auto v : tri) on = on && mesh.nodes[v][normal] > face - eps;
@@ -312,13 +311,14 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
   SpecimenResult r;
   r.supported = specimen_supports(m, d.mode, &r.note);
   if (!r.supported) return r;
-  const Rig rig = make_rig(d);
+  const Specimen& sp = specimen_of(d, t);
+  const Rig rig = make_rig(d.mode, sp);
   const auto& mesh = rig.mesh;
   double E_u = 0.0;
   const GpsOptions options = specimen_gps(m, d, calibration, &E_u, &r.shape);
   const GpsModel model(mesh, {specimen_elasticity(E_u, rig.shear)}, {}, options);
   const CommandPath path = command_path(t.time_s, t.control == Control::strain ? t.strain : t.stress_pa);
-  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), d.specimen.density_kg_m3), specimen_loading(rig, d, t, path),
+  ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), sp.density_kg_m3), specimen_loading(rig, sp, t, path),
                                 {1e-3, 0.0, 1e-8, 25, kSpecimenResidualToNoise * noise_level_pa(t) * rig.area});
   State s = State::at_rest(*mesh);
   // The command path's start is taken as an equilibrium state, as the material-point law does: grip (or

@@ -2,6 +2,7 @@
 // A measured data set (README "The data a user brings"): a folder with dataset.json and one CSV
 // per test (time_s, strain, stress_pa[, stress_sd_pa]). SI units: seconds, engineering strain,
 // pascals. Reading checks everything a file can get wrong and names file, line and field.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct Specimen {
 struct TestData {
   std::string file;  ///< as named in dataset.json
   Control control = Control::strain;
+  /// The test's own specimen (tests[k].specimen in dataset.json: each field given there replaces
+  /// the data set's); absent: the data set's. Real data sets hold several specimens of different sizes.
+  std::optional<Specimen> specimen;
   std::vector<double> time_s, strain, stress_pa, stress_sd_pa;  ///< sd empty if not given
 };
 
@@ -26,6 +30,9 @@ struct Dataset {
   Specimen specimen;
   std::vector<TestData> tests;
 };
+
+/// The specimen a test was measured on: its own, else the data set's.
+inline const Specimen& specimen_of(const Dataset& d, const TestData& t) { return t.specimen ? *t.specimen : d.specimen; }
 
 /// Reads DATASET_DIR/dataset.json and its CSVs; throws common::InputError on bad input.
 Dataset read_dataset(const std::string& folder);
