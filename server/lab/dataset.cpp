@@ -263,10 +263,11 @@ Dataset read_dataset(const std::string& folder) {
   if (!std::filesystem::exists(meta)) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");
   const json j = common::read_json_file(meta);
   const JsonObject top(j, meta);
-  top.require_known({"name", "mode", "specimen", "tests", "max_test_duration_s"});
+  top.require_known({"name", "mode", "specimen", "tests", "max_test_duration_s", "import"});
   Dataset d;
   d.folder = folder;
   d.name = top.text("name", std::filesystem::path(folder).filename().string());
+  d.import_note = top.text("import", "");
   d.mode = top.choice("mode", {"uniaxial", "simple_shear"}, "") == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
   d.specimen = read_specimen(top.object("specimen"), nullptr);
   // Longer tests exist (creep over days) but are rare; a span beyond a day is more often a time
@@ -297,6 +298,7 @@ void write_dataset(const Dataset& d, const std::string& folder) {
   json j;
   j["name"] = d.name;
   j["mode"] = to_string(d.mode);
+  if (!d.import_note.empty()) j["import"] = d.import_note;
   const auto specimen = [](const Specimen& sp) {
     return json{{"length_m", sp.length_m}, {"width_m", sp.width_m}, {"thickness_m", sp.thickness_m}, {"density_kg_m3", sp.density_kg_m3}};
   };

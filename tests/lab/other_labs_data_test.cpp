@@ -7,7 +7,9 @@
 // noise that a logger's filter has correlated over many samples.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 #include <string>
@@ -18,6 +20,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/fit.hpp"
+#include "viscera/lab/lab_import.hpp"
 #include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
@@ -259,4 +262,56 @@ TEST(SpecimenLimits, EachTestRunsOnItsOwnSpecimen) {
     const SpecimenResult r = simulate_specimen(m, d, t);
     EXPECT_NEAR(r.rms_pa, rms_error_pa(m, t), 0.02 * rms_error_pa(m, t)) << t.file;
   }
+}
+
+// viscera-lab import: a test machine's export (force in mN, displacement in mm, tab separated,
+// a byte-order mark) becomes a data set whose strain and stress are the hand conversion, with the
+// conversion written into dataset.json; what cannot be right is named.
+TEST(Import, ExportsBecomeADataSetByTheStatedConversion) {
+  const std::string dir = std::string(VISCERA_TEST_TMP) + "/import";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir + "/sample A.txt");
+    f << "\xEF\xBB\xBF"
+      << "\"Time\"\t\"Force\"\t\"Disp\"\r\n";
+    for (int k = 0; k <= 100; ++k) f << 0.1 * k << '\t' << 2.0 * std::min(k, 50) << '\t' << 0.02 * std::min(k, 50) << "\r\n";
+  }
+  ImportOptions o;
+  o.specimen = {0.01, 0.003, 0.002, 1050};
+  o.time = parse_import_column("time", "Time", ImportQuantity::time);
+  o.force = parse_import_column("force", "Force:mN", ImportQuantity::force);
+  o.displacement = parse_import_column("displacement", "Disp:mm", ImportQuantity::displacement);
+  const Dataset d = import_dataset({dir + "/sample A.txt"}, o, dir + "/ds");
+  ASSERT_EQ(d.tests.size(), 1u);
+  const TestData& t = d.tests[0];
+  EXPECT_EQ(t.file, "sample A.csv");
+  ASSERT_EQ(t.time_s.size(), 101u);
+  // At row 30: 60 mN over 3 mm x 2 mm = 10 kPa; 0.6 mm over 10 mm = 0.06.
+  EXPECT_NEAR(t.time_s[30], 3.0, 1e-12);
+  EXPECT_NEAR(t.stress_pa[30], 60e-3 / 6e-6, 1e-6);
+  EXPECT_NEAR(t.strain[30], 0.06, 1e-12);
+  EXPECT_NE(d.import_note.find("'Force' [mN]"), std::string::npos) << d.import_note;
+  const auto error = [&](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // Not over an existing data set; a column that is not there, named with the ones that are.
+  EXPECT_NE(error([&] { import_dataset({dir + "/sample A.txt"}, o, dir + "/ds"); }).find("already exists"), std::string::npos);
+  ImportOptions wrong = o;
+  wrong.force.name = "Load";
+  const std::string missing = error([&] { import_dataset({dir + "/sample A.txt"}, wrong, dir + "/ds2"); });
+  EXPECT_NE(missing.find("sample A.txt:1: Load: no such column (--force); the columns are: Time, Force, Disp"), std::string::npos) << missing;
+  // Millimetres declared as metres: strains of 1000% are refused by the data set's own checks.
+  wrong = o;
+  wrong.displacement = parse_import_column("displacement", "Disp:m", ImportQuantity::displacement);
+  const std::string percent = error([&] { import_dataset({dir + "/sample A.txt"}, wrong, dir + "/ds3"); });
+  EXPECT_NE(percent.find("strain"), std::string::npos) << percent;
+  EXPECT_NE(percent.find("cannot be right"), std::string::npos) << percent;
+  EXPECT_NE(error([] { parse_import_column("force", "Force:lb", ImportQuantity::force); }).find("--force: unit 'lb' is not a force unit"),
+            std::string::npos);
 }

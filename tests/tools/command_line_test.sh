@@ -88,6 +88,16 @@ expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
 expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"
 expect lab-no-dataset 2 "nowhere/dataset.json: cannot open file" -- "$lab" analyze "$tmp/nowhere" --out "$tmp/o"
+# import: a machine's export (mN, mm, semicolons) into a data set that analyze then reads.
+printf 'Time;Force;Disp\n0;0;0\n1;30;0.5\n2;60;1\n3;58;1\n4;57;1\n' > "$tmp/export.txt"
+import=(--length-m 0.01 --width-m 0.003 --thickness-m 0.002 --force Force:mN --displacement Disp:mm --time Time)
+expect lab-import 0 "export.csv: 5 rows, 4 s, strain 0 to 0.1, stress 0 to 1e+04 Pa" -- "$lab" import "$tmp/export.txt" --out "$tmp/imported" "${import[@]}"
+expect lab-import-again 2 "imported/dataset.json: already exists" -- "$lab" import "$tmp/export.txt" --out "$tmp/imported" "${import[@]}"
+expect lab-import-unit 2 "--force: unit 'lbf' is not a force unit" -- "$lab" import "$tmp/export.txt" --out "$tmp/i2" "${import[@]}" --force Force:lbf
+mkdir -p "$tmp/in" && cp "$tmp/export.txt" "$tmp/in/export.csv"
+expect lab-import-over-input 2 "is the same file as" -- "$lab" import "$tmp/in/export.csv" --out "$tmp/in" "${import[@]}"
+expect lab-import-mm-as-m 2 "strain: 50 cannot be right" -- "$lab" import "$tmp/export.txt" --out "$tmp/i4" "${import[@]}" --displacement Disp:m
+expect lab-import-no-geometry 2 "import needs --length-m" -- "$lab" import "$tmp/export.txt" --out "$tmp/i3" --force Force --displacement Disp
 fi
 if [ "$part" != programs ]; then
 expect lab-analyze 0 "causes (confirmed): broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet

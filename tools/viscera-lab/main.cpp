@@ -1,9 +1,12 @@
 // viscera-lab: confronts viscera's tissue model with measured data.
 //   viscera-lab analyze DATASET_DIR --out OUT_DIR
 //   viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR
+//   viscera-lab import EXPORT... --out DATASET_DIR --length-m L --width-m W --thickness-m T --time COL --force COL --displacement COL
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "viscera/common/command_line.hpp"
@@ -11,6 +14,7 @@
 #include "viscera/common/same_file.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/decimation.hpp"
+#include "viscera/lab/lab_import.hpp"
 #include "viscera/lab/model_file.hpp"
 
 #include "report.hpp"
@@ -25,12 +29,29 @@ int main(int argc, char** argv) {
       "  tension_compression_asymmetry and first_load_softening (accepted only if the held-out gain is clearly above the\n"
       "  noise of the data), extends the model, refits, and writes OUT_DIR/report.json, report.md (with SVG plots) and\n"
       "  model.json.\n"
-      "predict: runs a fitted model.json on another data set and writes OUT_DIR/report.json with per-test RMS errors.\n\n"
+      "predict: runs a fitted model.json on another data set and writes OUT_DIR/report.json with per-test RMS errors.\n"
+      "import: turns a test machine's exports (one file per test: force and displacement over time, comma, semicolon or tab\n"
+      "  separated, a header row naming the columns) into a data set in --out: strain = displacement / length (simple shear:\n"
+      "  / thickness), stress = force / (width x thickness) (simple shear: / (length x width)); the conversion is written into\n"
+      "  dataset.json. Columns as COLUMN:UNIT (time s|ms|min|h, force N|mN|kN, displacement m|mm|um).\n\n"
       "Data set format: README.md, section \"The data a user brings\". Units are SI. Progress lines go to stderr.");
-  cl.usage("viscera-lab analyze DATASET_DIR --out OUT_DIR\n       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR");
+  cl.usage(
+      "viscera-lab analyze DATASET_DIR --out OUT_DIR\n       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR\n"
+      "       viscera-lab import EXPORT... --out DATASET_DIR --length-m L --width-m W --thickness-m T --time COLUMN[:UNIT]\n"
+      "                          --force COLUMN[:UNIT] --displacement COLUMN[:UNIT] [--mode uniaxial|simple_shear] [--control strain|stress]");
   cl.flag("out", "DIR", "output folder (required)");
   cl.option_switch("quiet", "no progress lines");
-  cl.allow_positional(3);
+  cl.flag("mode", "MODE", "import: uniaxial | simple_shear", "uniaxial");
+  cl.flag("control", "C", "import: strain (displacement imposed) | stress (force imposed)", "strain");
+  cl.flag("length-m", "L", "import: specimen length [m] (the gauge under uniaxial load)");
+  cl.flag("width-m", "W", "import: specimen width [m]");
+  cl.flag("thickness-m", "T", "import: specimen thickness [m] (the gauge in simple shear)");
+  cl.flag("density-kg-m3", "RHO", "import: specimen density [kg/m^3]", "1060");
+  cl.flag("time", "COLUMN[:UNIT]", "import: the time column, s | ms | min | h", "time:s");
+  cl.flag("force", "COLUMN[:UNIT]", "import: the force column, N | mN | kN");
+  cl.flag("displacement", "COLUMN[:UNIT]", "import: the displacement column (from the unloaded specimen), m | mm | um");
+  cl.flag("name", "NAME", "import: the data set's name (default: the --out folder's)");
+  cl.allow_positional(1000);
   const auto usage_error = [](const std::string& what) {
     std::fprintf(stderr, "viscera-lab: %s (see --help)\n", what.c_str());
     return 2;
@@ -81,6 +102,33 @@ int main(int argc, char** argv) {
         std::printf("honest gain not measured: %s\n", a.nested_not_run.c_str());
       return 0;
     }
+    if (positional[0] == "import") {
+      if (positional.size() < 2) return usage_error("import takes one or more EXPORT files");
+      const std::vector<std::string> files(positional.begin() + 1, positional.end());
+      for (const auto& f : files) viscera::common::refuse_overwrite(out + "/" + std::filesystem::path(f).stem().string() + ".csv", {f}, "--out");
+      ImportOptions o;
+      o.name = cl.has("name") ? cl.text("name") : "";
+      const std::string mode = cl.text("mode"), control = cl.text("control");
+      if (mode != "uniaxial" && mode != "simple_shear") return usage_error("--mode: '" + mode + "' is not uniaxial or simple_shear");
+      if (control != "strain" && control != "stress") return usage_error("--control: '" + control + "' is not strain or stress");
+      o.mode = mode == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
+      o.control = control == "strain" ? Control::strain : Control::stress;
+      for (const char* required : {"length-m", "width-m", "thickness-m", "force", "displacement"})
+        if (!cl.has(required)) return usage_error(std::string("import needs --") + required);
+      o.specimen = {cl.number_in("length-m", 1e-6, 10), cl.number_in("width-m", 1e-6, 10), cl.number_in("thickness-m", 1e-6, 10),
+                    cl.number_in("density-kg-m3", 1, 1e5)};
+      o.time = parse_import_column("time", cl.text("time"), ImportQuantity::time);
+      o.force = parse_import_column("force", cl.text("force"), ImportQuantity::force);
+      o.displacement = parse_import_column("displacement", cl.text("displacement"), ImportQuantity::displacement);
+      const Dataset d = import_dataset(files, o, out);
+      for (const auto& t : d.tests)
+        std::printf("%s: %zu rows, %.4g s, strain %.4g to %.4g, stress %.4g to %.4g Pa\n", t.file.c_str(), t.time_s.size(),
+                    t.time_s.back() - t.time_s.front(), *std::min_element(t.strain.begin(), t.strain.end()),
+                    *std::max_element(t.strain.begin(), t.strain.end()), *std::min_element(t.stress_pa.begin(), t.stress_pa.end()),
+                    *std::max_element(t.stress_pa.begin(), t.stress_pa.end()));
+      std::printf("wrote %s/dataset.json (%s)\n", out.c_str(), d.import_note.c_str());
+      return 0;
+    }
     if (positional[0] == "predict") {
       if (positional.size() != 3) return usage_error("predict takes MODEL_JSON and DATASET_DIR");
       MaterialModel m = read_model(positional[1]);
@@ -94,5 +142,7 @@ int main(int argc, char** argv) {
   } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "viscera-lab: %s\n", e.what());
     return 2;
+  } catch (const viscera::common::UsageError& e) {
+    return usage_error(e.what());
   }
 }

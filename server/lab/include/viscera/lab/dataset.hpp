@@ -26,6 +26,7 @@ struct TestData {
 
 struct Dataset {
   std::string name, folder;
+  std::string import_note;  ///< how `viscera-lab import` made it, with its units ("import" in dataset.json; "" otherwise)
   Mode mode = Mode::uniaxial;
   Specimen specimen;
   std::vector<TestData> tests;

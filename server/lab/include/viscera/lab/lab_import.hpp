@@ -1,0 +1,47 @@
+#pragma once
+// viscera-lab import: a test machine's export (force against displacement over time, in the
+// machine's own units and column names) turned into a data set (dataset.hpp). The conversion to
+// strain and stress, and the units it assumed, are written into dataset.json ("import"), so that
+// what the lab fits can be traced back to the files a researcher measured.
+//  - uniaxial: strain = displacement / length, stress = force / (width x thickness) (nominal);
+//  - simple shear: strain = displacement / thickness, stress = force / (length x width).
+#include <string>
+#include <vector>
+
+#include "viscera/lab/dataset.hpp"
+
+namespace viscera::lab {
+
+/// A column of the export and the factor that takes its unit to SI.
+struct ImportColumn {
+  std::string name;
+  std::string unit;
+  double to_si = 1.0;
+};
+
+enum class ImportQuantity { time, force, displacement };
+
+/// "COLUMN" or "COLUMN:UNIT" (time: s, ms, min, h; force: N, mN, kN; displacement: m, mm, um);
+/// without a unit, SI. Throws common::UsageError naming `flag` on an unknown unit or an empty name.
+ImportColumn parse_import_column(const std::string& flag, const std::string& text, ImportQuantity q);
+
+struct ImportOptions {
+  std::string name;  ///< the data set's name ("" : the output folder's)
+  Mode mode = Mode::uniaxial;
+  Control control = Control::strain;
+  Specimen specimen;
+  ImportColumn time{"time", "s", 1.0}, force{"force", "N", 1.0}, displacement{"displacement", "m", 1.0};
+};
+
+/// One export as a test: the file separated by commas, semicolons or tabs (the first line's most
+/// frequent one), a header row naming the columns, empty lines skipped. Throws common::InputError
+/// naming the file, the line and the column.
+TestData import_test(const std::string& path, const ImportOptions& o);
+
+/// The exports `files` as a data set in `folder`: one CSV per file (named after it), dataset.json
+/// with the conversion under "import"; then read back with read_dataset, so that every check a
+/// data set gets (units that cannot be right, times that do not increase) applies. Refuses a
+/// folder that already holds a dataset.json, and two files with the same name.
+Dataset import_dataset(const std::vector<std::string>& files, const ImportOptions& o, const std::string& folder);
+
+}  // namespace viscera::lab

@@ -1,0 +1,142 @@
+#include "viscera/lab/lab_import.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <string_view>
+
+#include "viscera/common/command_line.hpp"
+#include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
+#include "viscera/common/number_text.hpp"
+
+namespace viscera::lab {
+
+using common::InputError;
+
+namespace {
+
+// An export larger than this is not one test (a 1 kHz logger over a day is about 100 MB).
+constexpr std::size_t kMaxExportBytes = std::size_t{1} << 30;
+
+std::vector<std::string> split(std::string_view line, char separator) {
+  std::vector<std::string> out;
+  for (;;) {
+    const std::size_t at = line.find(separator);
+    std::string_view cell = line.substr(0, at);
+    while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '"')) cell.remove_suffix(1);
+    while (!cell.empty() && (cell.front() == ' ' || cell.front() == '"')) cell.remove_prefix(1);
+    out.emplace_back(cell);
+    if (at == std::string_view::npos) return out;
+    line.remove_prefix(at + 1);
+  }
+}
+
+const char* quantity_name(ImportQuantity q) {
+  switch (q) {
+    case ImportQuantity::time: return "time";
+    case ImportQuantity::force: return "force";
+    case ImportQuantity::displacement: return "displacement";
+  }
+  return "?";
+}
+
+}  // namespace
+
+ImportColumn parse_import_column(const std::string& flag, const std::string& text, ImportQuantity q) {
+  static const std::vector<std::pair<std::string, double>> time{{"s", 1.0}, {"ms", 1e-3}, {"min", 60.0}, {"h", 3600.0}},
+      force{{"N", 1.0}, {"mN", 1e-3}, {"kN", 1e3}}, displacement{{"m", 1.0}, {"mm", 1e-3}, {"um", 1e-6}};
+  const auto& units = q == ImportQuantity::time ? time : q == ImportQuantity::force ? force : displacement;
+  ImportColumn c;
+  const std::size_t colon = text.rfind(':');
+  c.name = text.substr(0, colon);
+  c.unit = colon == std::string::npos ? units.front().first : text.substr(colon + 1);
+  if (c.name.empty()) throw common::UsageError("--" + flag + ": '" + text + "' names no column (COLUMN or COLUMN:UNIT)");
+  for (const auto& [unit, factor] : units)
+    if (unit == c.unit) {
+      c.to_si = factor;
+      return c;
+    }
+  std::string known;
+  for (const auto& [unit, factor] : units) known += (known.empty() ? "" : ", ") + unit;
+  throw common::UsageError("--" + flag + ": unit '" + c.unit + "' is not a " + quantity_name(q) + " unit (" + known + ")");
+}
+
+TestData import_test(const std::string& path, const ImportOptions& o) {
+  const std::string content = common::read_text_file(path, kMaxExportBytes);
+  std::string_view text(content);
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  const auto next_line = [&]() -> std::optional<std::string_view> {
+    if (text.empty()) return std::nullopt;
+    const std::size_t end = text.find('\n');
+    const std::string_view line = text.substr(0, end);
+    text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
+    return line;
+  };
+  const auto first = next_line();
+  if (!first) throw InputError(path, 1, "header", "file is empty");
+  char separator = ',';
+  for (const char c : {';', '\t'})
+    if (std::count(first->begin(), first->end(), c) > std::count(first->begin(), first->end(), separator)) separator = c;
+  const auto header = split(*first, separator);
+  const auto column = [&](const ImportColumn& c, const char* flag) {
+    const auto at = std::find(header.begin(), header.end(), c.name);
+    if (at == header.end()) {
+      std::string names;
+      for (const auto& h : header) names += (names.empty() ? "" : ", ") + common::printable(h, 30);
+      throw InputError(path, 1, c.name, std::string("no such column (--") + flag + "); the columns are: " + names);
+    }
+    return static_cast<std::size_t>(at - header.begin());
+  };
+  const std::size_t ct = column(o.time, "time"), cf = column(o.force, "force"), cd = column(o.displacement, "displacement");
+  const bool shear = o.mode == Mode::simple_shear;
+  const Specimen& sp = o.specimen;
+  const double gauge = shear ? sp.thickness_m : sp.length_m, area = shear ? sp.length_m * sp.width_m : sp.width_m * sp.thickness_m;
+  TestData t;
+  t.file = std::filesystem::path(path).stem().string() + ".csv";
+  t.control = o.control;
+  long row = 1;
+  while (const auto line = next_line()) {
+    ++row;
+    if (line->empty() || *line == "\r") continue;
+    const auto cells = split(*line, separator);
+    const auto value = [&](std::size_t col, const ImportColumn& c) {
+      if (col >= cells.size()) throw InputError(path, row, c.name, "missing value");
+      std::string why;
+      const auto v = common::read_number(cells[col], &why);
+      if (!v) throw InputError(path, row, c.name, why);
+      return *v * c.to_si;
+    };
+    t.time_s.push_back(value(ct, o.time));
+    t.strain.push_back(value(cd, o.displacement) / gauge);
+    t.stress_pa.push_back(value(cf, o.force) / area);
+  }
+  if (t.time_s.size() < 3) throw InputError(path, row, "rows", std::to_string(t.time_s.size()) + " rows of data: a test needs at least 3");
+  return t;
+}
+
+Dataset import_dataset(const std::vector<std::string>& files, const ImportOptions& o, const std::string& folder) {
+  const std::string meta = (std::filesystem::path(folder) / "dataset.json").string();
+  if (std::filesystem::exists(meta)) throw InputError(meta, 0, "", "already exists: import writes a new data set, never over one");
+  Dataset d;
+  d.name = o.name.empty() ? std::filesystem::path(folder).filename().string() : o.name;
+  d.mode = o.mode;
+  d.specimen = o.specimen;
+  std::set<std::string> names;
+  for (const auto& f : files) {
+    d.tests.push_back(import_test(f, o));
+    if (!names.insert(d.tests.back().file).second)
+      throw InputError(f, 0, "", "a second export named " + d.tests.back().file + ": each test is written under its file's name");
+  }
+  const bool shear = o.mode == Mode::simple_shear;
+  const std::string gauge = shear ? "thickness_m" : "length_m", area = shear ? "length_m x width_m" : "width_m x thickness_m";
+  d.import_note = "viscera-lab import: time_s = '" + o.time.name + "' [" + o.time.unit + "] x " + common::short_number(o.time.to_si) +
+                  "; strain = '" + o.displacement.name + "' [" + o.displacement.unit + "] x " + common::short_number(o.displacement.to_si) +
+                  " / specimen." + gauge + "; stress_pa = '" + o.force.name + "' [" + o.force.unit + "] x " + common::short_number(o.force.to_si) +
+                  " / (specimen." + area + ")";
+  write_dataset(d, folder);
+  return read_dataset(folder);
+}
+
+}  // namespace viscera::lab
