@@ -13,6 +13,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/number_text.hpp"
+#include "viscera/lab/csv_lines.hpp"
 
 namespace viscera::lab {
 
@@ -36,33 +37,12 @@ constexpr double kSoftestPa = 10.0, kStiffestPa = 5e10;
 // A test file larger than this is not a measurement of one specimen (1.3 million rows are 43 MB).
 constexpr std::size_t kMaxCsvBytes = std::size_t{1} << 30;
 
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> out;
-  for (;;) {
-    const std::size_t comma = line.find(',');
-    std::string_view cell = line.substr(0, comma);
-    while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.remove_suffix(1);
-    while (!cell.empty() && cell.front() == ' ') cell.remove_prefix(1);
-    out.push_back(cell);
-    if (comma == std::string_view::npos) return out;
-    line.remove_prefix(comma + 1);
-  }
-}
-
 TestData read_csv(const std::string& path, const std::string& file, Control control) {
   const std::string content = common::read_text_file(path, kMaxCsvBytes);
-  std::string_view text(content);
-  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // a UTF-8 byte-order mark (spreadsheet exports)
-  const auto next_line = [&]() -> std::optional<std::string_view> {
-    if (text.empty()) return std::nullopt;
-    const std::size_t end = text.find('\n');
-    const std::string_view line = text.substr(0, end);
-    text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
-    return line;
-  };
-  const auto first = next_line();
+  CsvLines lines(content);
+  const auto first = lines.next();
   if (!first) throw InputError(path, 1, "header", "file is empty");
-  const auto header = split(*first);
+  const auto header = csv_cells(*first);
   int col_t = -1, col_e = -1, col_s = -1, col_sd = -1;
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (header[c] == "time_s")
@@ -83,10 +63,10 @@ TestData read_csv(const std::string& path, const std::string& file, Control cont
   t.file = file;
   t.control = control;
   long row = 1;
-  while (const auto line = next_line()) {
+  while (const auto line = lines.next()) {
     ++row;
     if (line->empty() || *line == "\r") continue;
-    const auto cells = split(*line);
+    const auto cells = csv_cells(*line);
     const auto value = [&](int col, const char* name) {
       if (col >= static_cast<int>(cells.size())) throw InputError(path, row, name, "missing value");
       std::string why;

@@ -10,6 +10,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/number_text.hpp"
+#include "viscera/lab/csv_lines.hpp"
 
 namespace viscera::lab {
 
@@ -19,19 +20,6 @@ namespace {
 
 // An export larger than this is not one test (a 1 kHz logger over a day is about 100 MB).
 constexpr std::size_t kMaxExportBytes = std::size_t{1} << 30;
-
-std::vector<std::string> split(std::string_view line, char separator) {
-  std::vector<std::string> out;
-  for (;;) {
-    const std::size_t at = line.find(separator);
-    std::string_view cell = line.substr(0, at);
-    while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '"')) cell.remove_suffix(1);
-    while (!cell.empty() && (cell.front() == ' ' || cell.front() == '"')) cell.remove_prefix(1);
-    out.emplace_back(cell);
-    if (at == std::string_view::npos) return out;
-    line.remove_prefix(at + 1);
-  }
-}
 
 const char* quantity_name(ImportQuantity q) {
   switch (q) {
@@ -65,21 +53,13 @@ ImportColumn parse_import_column(const std::string& flag, const std::string& tex
 
 TestData import_test(const std::string& path, const ImportOptions& o) {
   const std::string content = common::read_text_file(path, kMaxExportBytes);
-  std::string_view text(content);
-  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
-  const auto next_line = [&]() -> std::optional<std::string_view> {
-    if (text.empty()) return std::nullopt;
-    const std::size_t end = text.find('\n');
-    const std::string_view line = text.substr(0, end);
-    text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
-    return line;
-  };
-  const auto first = next_line();
+  CsvLines lines(content);
+  const auto first = lines.next();
   if (!first) throw InputError(path, 1, "header", "file is empty");
   char separator = ',';
   for (const char c : {';', '\t'})
     if (std::count(first->begin(), first->end(), c) > std::count(first->begin(), first->end(), separator)) separator = c;
-  const auto header = split(*first, separator);
+  const auto header = csv_cells(*first, separator);
   const auto column = [&](const ImportColumn& c, const char* flag) {
     const auto at = std::find(header.begin(), header.end(), c.name);
     if (at == header.end()) {
@@ -97,10 +77,10 @@ TestData import_test(const std::string& path, const ImportOptions& o) {
   t.file = std::filesystem::path(path).stem().string() + ".csv";
   t.control = o.control;
   long row = 1;
-  while (const auto line = next_line()) {
+  while (const auto line = lines.next()) {
     ++row;
     if (line->empty() || *line == "\r") continue;
-    const auto cells = split(*line, separator);
+    const auto cells = csv_cells(*line, separator);
     const auto value = [&](std::size_t col, const ImportColumn& c) {
       if (col >= cells.size()) throw InputError(path, row, c.name, "missing value");
       std::string why;
