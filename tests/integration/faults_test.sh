@@ -66,9 +66,12 @@ assert f_kill > 0.3, f"the probe was not pressing when the server went ({f_kill:
 assert after and mag(after[-1]) == 0.0, f"the rendered force did not reach zero ({mag(after[-1]) if after else None} N)"
 # Smoothly: the fade takes the force down by at most F / (fade_s x rate) per 1 ms sample; the local
 # model's own change as the probe moves adds a little. An abrupt drop would be the whole force.
-steps = [mag(a) - mag(b) for a, b in zip([before[-1]] + after, after)]
-worst = max(steps)
-assert worst < 0.05 * f_kill + 0.01, f"the force dropped by {worst:.3f} N in one sample (of {f_kill:.3f} N)"
+# Where the worst step fell is printed if it fails (one CI run saw a 0.085 N step of 0.976 N after
+# a SIGKILL, with nothing recorded to say where).
+steps = [(mag(a) - mag(b), b["t_s"]) for a, b in zip([before[-1]] + after, after)]
+worst, at = max(steps)
+assert worst < 0.05 * f_kill + 0.01, (f"the force dropped by {worst:.3f} N in one sample (of {f_kill:.3f} N), "
+                                      f"{at - killed:.3f} s after the signal, {at - lost:.3f} s after the client noticed")
 print(f"[ figure ] SIG{sys.argv[3]}: the client noticed {notice:.3f} s after the signal; the rendered force went from "
       f"{f_kill:.3f} N to 0 in {after[-1]['t_s'] - killed:.3f} s, at most {worst:.4f} N per 1 ms sample")
 PY
