@@ -69,4 +69,24 @@ HoldNoise noise_in_holds(const TestData& t, double window_s) {
   return r;
 }
 
+NoiseCheck check_noise(const Dataset& d) {
+  NoiseCheck c;
+  double first2 = 0, holds2 = 0;
+  for (const auto& t : d.tests) {
+    const HoldNoise h = noise_in_holds(t);
+    if (h.holds == 0) continue;
+    const double to_pa = t.control == Control::strain ? 1.0 : apparent_modulus_pa(t);
+    if (c.tests++ == 0) c.window_s = h.window_s;
+    c.holds += h.holds;
+    c.first_stated = c.first_stated || (t.control == Control::strain && !t.stress_sd_pa.empty());
+    first2 += noise_level_pa(t) * noise_level_pa(t);
+    holds2 += h.sd * to_pa * h.sd * to_pa;
+  }
+  if (c.tests == 0) return c;
+  c.first_pa = std::sqrt(first2 / c.tests);
+  c.holds_pa = std::sqrt(holds2 / c.tests);
+  c.agree = c.holds_pa <= kNoiseAgreementFactor * c.first_pa && c.first_pa <= kNoiseAgreementFactor * c.holds_pa;
+  return c;
+}
+
 }  // namespace viscera::lab

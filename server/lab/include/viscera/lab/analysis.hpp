@@ -76,16 +76,6 @@ const char* to_string(CausesStatus s);
 /// mean square error falls by more than half the noise variance and the RMS by at least 5%.
 bool gain_holds(double before_pa, double after_pa, double noise_pa);
 
-/// The noise by a second, independent path (noise_check.hpp), over the tests that have holds.
-struct NoiseCheck {
-  int tests = 0, holds = 0;  ///< tests with holds, and holds used
-  double window_s = 0.0;  ///< the running mean's width in the first test with holds [s]
-  double first_pa = 0.0;  ///< the first estimate over the same tests (RMS) [Pa]
-  bool first_stated = false;  ///< the first estimate is the data's own stress_sd_pa (in some of those tests)
-  double holds_pa = 0.0;  ///< the spread in their holds (RMS over tests) [Pa]
-  bool agree = true;  ///< within kNoiseAgreementFactor of each other (true without holds)
-};
-
 struct Analysis {
   std::string dataset;
   double noise_pa = 0.0;  ///< the first estimate (noise_level_pa, RMS over tests): every ratio to the noise uses it

@@ -36,4 +36,15 @@ struct HoldNoise {
 /// share of the noise.
 HoldNoise noise_in_holds(const TestData& t, double window_s = 1.0);
 
+/// The two estimates over a data set's tests that have holds.
+struct NoiseCheck {
+  int tests = 0, holds = 0;  ///< tests with holds, and holds used
+  double window_s = 0.0;  ///< the running mean's width in the first test with holds [s]
+  double first_pa = 0.0;  ///< the first estimate over the same tests (RMS) [Pa]
+  bool first_stated = false;  ///< the first estimate is the data's own stress_sd_pa (in some of those tests)
+  double holds_pa = 0.0;  ///< the spread in their holds (RMS over tests) [Pa]
+  bool agree = true;  ///< within kNoiseAgreementFactor of each other (true without holds)
+};
+NoiseCheck check_noise(const Dataset& d);
+
 }  // namespace viscera::lab
