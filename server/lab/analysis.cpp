@@ -369,73 +369,34 @@ bool gain_holds(double before_pa, double after_pa, double noise_pa) {
   return before_pa * before_pa - after_pa * after_pa > kNoiseFraction * noise_pa * noise_pa && after_pa < (1.0 - kMinGain) * before_pa;
 }
 
-Analysis analyze(const Dataset& measured, const std::function<void(const std::string&)>& progress, const AnalyzeOptions& options) {
-  const auto say = [&](const std::string& s) {
-    if (progress) progress(s);
-  };
-  const Dataset d = decimate(measured, options.max_fit_points);
-  Analysis a;
-  for (std::size_t k = 0; k < d.tests.size(); ++k)
-    if (d.tests[k].time_s.size() < measured.tests[k].time_s.size()) {
-      a.decimated.push_back(d.tests[k].file + ": " + std::to_string(measured.tests[k].time_s.size()) + " rows, fitted on " +
-                            std::to_string(d.tests[k].time_s.size()) + " of them (kept evenly along time and strain; noise measured on every row)");
-      say(a.decimated.back());
-    }
-  a.dataset = d.name;
-  a.noise_pa = noise_of(d);
-  a.noise_check = check_noise(measured);  // every row: the holds' running means need the original sampling
-  if (a.noise_check.tests > 0)
-    say(fmt("noise: %.4g Pa from second differences; %.4g Pa from the spread in ", a.noise_check.first_pa, a.noise_check.holds_pa) +
-        std::to_string(a.noise_check.holds) + " holds" + (a.noise_check.agree ? " (they agree)" : " (they disagree)"));
-  MaterialModel structure;
-  structure.relaxation_time_s = relaxation_times_for(d);
-  structure.odd_only = d.mode == Mode::simple_shear;
-  say("fitting the baseline (linear elastic + Kelvin-Voigt) to " + std::to_string(d.tests.size()) + " tests, leaving each out in turn");
-  a.baseline = evaluate(structure, d);
-  say(fmt("baseline: fit RMS %.4g Pa, held-out RMS %.4g Pa, noise %.4g Pa", a.baseline.fit_rms_pa, a.baseline.heldout_rms_pa, a.noise_pa));
-  Selection sel = select_mechanisms(a.baseline, d, a.noise_pa, say);
-  a.causes = sel.causes;
-  a.candidates = sel.candidates;
-  const ModelEvaluation current = sel.final;
-  a.final = current;
-  a.gain = a.baseline.heldout_rms_pa / a.final.heldout_rms_pa;
-  if (!options.nested)
-    a.nested_not_run = "the nested leave-one-out was turned off";
-  else if (d.tests.size() < 3)
-    a.nested_not_run = std::to_string(d.tests.size()) + (d.tests.size() == 1 ? " test" : " tests") +
-                       ": the nested leave-one-out needs at least 3 (a selection on the other tests, held out within them)";
-  if (a.nested_not_run.empty()) {
-    // The honest gain: for each test, the whole selection runs on the other tests only (its own
-    // leave-one-out inside), the chosen model is fitted to them and predicts the test.
-    double sq = 0.0;
-    for (std::size_t k = 0; k < d.tests.size(); ++k) {
-      say("nested leave-one-out: choosing the mechanisms without " + d.tests[k].file + " (" + std::to_string(k + 1) + " of " +
-          std::to_string(d.tests.size()) + ")");
-      Dataset others = d;
-      others.tests.erase(others.tests.begin() + static_cast<long>(k));
-      const Selection fold = select_mechanisms(evaluate(structure, others), others, noise_of(others), [](const std::string&) {});
-      std::vector<const TestData*> fit_on;
-      for (const auto& t : others.tests) fit_on.push_back(&t);
-      const double e = rms_error_pa(fit_model(fold.final.model, fit_on), d.tests[k]);
-      a.nested.push_back({d.tests[k].file, fold.causes, e});
-      sq += e * e;
-    }
-    a.nested_heldout_rms_pa = std::sqrt(sq / static_cast<double>(d.tests.size()));
-    a.nested_gain = a.baseline.heldout_rms_pa / a.nested_heldout_rms_pa;
-    say(fmt("nested leave-one-out: held-out RMS %.4g Pa (gain %.3gx) where the selection never saw the test; ", a.nested_heldout_rms_pa,
-            a.nested_gain) +
-        fmt("%.4g Pa (gain %.3gx) for the model chosen on all tests", a.final.heldout_rms_pa, a.gain));
+namespace {
+
+/// The honest gain: for each test, the whole selection runs on the other tests only (its own
+/// leave-one-out inside), the chosen model is fitted to them and predicts the test.
+void measure_nested(Analysis& a, const Dataset& d, const MaterialModel& structure, const std::function<void(const std::string&)>& say) {
+  double sq = 0.0;
+  for (std::size_t k = 0; k < d.tests.size(); ++k) {
+    say("nested leave-one-out: choosing the mechanisms without " + d.tests[k].file + " (" + std::to_string(k + 1) + " of " +
+        std::to_string(d.tests.size()) + ")");
+    Dataset others = d;
+    others.tests.erase(others.tests.begin() + static_cast<long>(k));
+    const Selection fold = select_mechanisms(evaluate(structure, others), others, noise_of(others), [](const std::string&) {});
+    std::vector<const TestData*> fit_on;
+    for (const auto& t : others.tests) fit_on.push_back(&t);
+    const double e = rms_error_pa(fit_model(fold.final.model, fit_on), d.tests[k]);
+    a.nested.push_back({d.tests[k].file, fold.causes, e});
+    sq += e * e;
   }
-  if (!a.causes.empty())
-    a.causes_status = !a.nested_not_run.empty()                                                    ? CausesStatus::tentative
-                      : gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa) ? CausesStatus::confirmed
-                                                                                                   : CausesStatus::not_confirmed;
-  if (options.specimen) {
-    say("simulating baseline and final model on the tetrahedral specimen (GPS, implicit, inertia)");
-    a.specimen.push_back(check_on_specimen(a.baseline.model, d, say));
-    if (!a.causes.empty()) a.specimen.push_back(check_on_specimen(a.final.model, d, say));
-    for (const auto& c : a.specimen) say("  " + c.model + (c.ran ? ": done" : ": " + c.note));
-  }
+  a.nested_heldout_rms_pa = std::sqrt(sq / static_cast<double>(d.tests.size()));
+  a.nested_gain = a.baseline.heldout_rms_pa / a.nested_heldout_rms_pa;
+  say(fmt("nested leave-one-out: held-out RMS %.4g Pa (gain %.3gx) where the selection never saw the test; ", a.nested_heldout_rms_pa,
+          a.nested_gain) +
+      fmt("%.4g Pa (gain %.3gx) for the model chosen on all tests", a.final.heldout_rms_pa, a.gain));
+}
+
+/// The verdict in words: what the baseline misses, whether the choice holds on data it did not see,
+/// what remains above the noise, and whether the two noise estimates agree.
+std::string verdict_of(const Analysis& a, bool odd_only) {
   std::ostringstream v;
   const auto list = [&](const std::vector<Mechanism>& ms) {
     for (std::size_t k = 0; k < ms.size(); ++k) v << (k ? ", " : "") << name(ms[k]);
@@ -475,7 +436,7 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
       v << " The baseline is the model this analysis stands by (model.json).";
       break;
   }
-  if (structure.odd_only)
+  if (odd_only)
     v << " Simple shear: tension/compression asymmetry was not a candidate and stiffening was offered in its odd forms only (an "
          "isotropic solid's shear stress is odd in the shear strain).";
   if (a.supported_model().has(Mechanism::strain_stiffening))
@@ -493,7 +454,58 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
                                     "is too large by up to that factor."
                                   : "the first is too large (a stated SD that is the spread between specimens rather than the instrument's "
                                     "noise, or steps between samples), so every ratio to the noise above is too small by up to that factor.");
-  a.verdict = v.str();
+  return v.str();
+}
+
+}  // namespace
+
+Analysis analyze(const Dataset& measured, const std::function<void(const std::string&)>& progress, const AnalyzeOptions& options) {
+  const auto say = [&](const std::string& s) {
+    if (progress) progress(s);
+  };
+  const Dataset d = decimate(measured, options.max_fit_points);
+  Analysis a;
+  for (std::size_t k = 0; k < d.tests.size(); ++k)
+    if (d.tests[k].time_s.size() < measured.tests[k].time_s.size()) {
+      a.decimated.push_back(d.tests[k].file + ": " + std::to_string(measured.tests[k].time_s.size()) + " rows, fitted on " +
+                            std::to_string(d.tests[k].time_s.size()) + " of them (kept evenly along time and strain; noise measured on every row)");
+      say(a.decimated.back());
+    }
+  a.dataset = d.name;
+  a.noise_pa = noise_of(d);
+  a.noise_check = check_noise(measured);  // every row: the holds' running means need the original sampling
+  if (a.noise_check.tests > 0)
+    say(fmt("noise: %.4g Pa from second differences; %.4g Pa from the spread in ", a.noise_check.first_pa, a.noise_check.holds_pa) +
+        std::to_string(a.noise_check.holds) + " holds" + (a.noise_check.agree ? " (they agree)" : " (they disagree)"));
+  MaterialModel structure;
+  structure.relaxation_time_s = relaxation_times_for(d);
+  structure.odd_only = d.mode == Mode::simple_shear;
+  say("fitting the baseline (linear elastic + Kelvin-Voigt) to " + std::to_string(d.tests.size()) + " tests, leaving each out in turn");
+  a.baseline = evaluate(structure, d);
+  say(fmt("baseline: fit RMS %.4g Pa, held-out RMS %.4g Pa, noise %.4g Pa", a.baseline.fit_rms_pa, a.baseline.heldout_rms_pa, a.noise_pa));
+  Selection sel = select_mechanisms(a.baseline, d, a.noise_pa, say);
+  a.causes = sel.causes;
+  a.candidates = sel.candidates;
+  const ModelEvaluation current = sel.final;
+  a.final = current;
+  a.gain = a.baseline.heldout_rms_pa / a.final.heldout_rms_pa;
+  if (!options.nested)
+    a.nested_not_run = "the nested leave-one-out was turned off";
+  else if (d.tests.size() < 3)
+    a.nested_not_run = std::to_string(d.tests.size()) + (d.tests.size() == 1 ? " test" : " tests") +
+                       ": the nested leave-one-out needs at least 3 (a selection on the other tests, held out within them)";
+  if (a.nested_not_run.empty()) measure_nested(a, d, structure, say);
+  if (!a.causes.empty())
+    a.causes_status = !a.nested_not_run.empty()                                                    ? CausesStatus::tentative
+                      : gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa) ? CausesStatus::confirmed
+                                                                                                   : CausesStatus::not_confirmed;
+  if (options.specimen) {
+    say("simulating baseline and final model on the tetrahedral specimen (GPS, implicit, inertia)");
+    a.specimen.push_back(check_on_specimen(a.baseline.model, d, say));
+    if (!a.causes.empty()) a.specimen.push_back(check_on_specimen(a.final.model, d, say));
+    for (const auto& c : a.specimen) say("  " + c.model + (c.ran ? ": done" : ": " + c.note));
+  }
+  a.verdict = verdict_of(a, structure.odd_only);
   return a;
 }
 

@@ -10,7 +10,7 @@ using namespace viscera::tissue;
 std::optional<proto::Command> SimulationServer::Impl::decode_counted(std::span<const std::uint8_t> payload) {
   std::string why;
   auto c = proto::decode_command(payload, &why);
-  if (!c) ++rejected_malformed;
+  if (!c) ++counted.malformed;
   return c;
 }
 
@@ -19,8 +19,8 @@ bool SimulationServer::Impl::offer_counted(const proto::Command& c, std::int64_t
   switch (instruments.command(c, now_ns)) {
     case CommandResult::accepted: return true;
     case CommandResult::stale: return false;
-    case CommandResult::not_owner: ++rejected_not_owner; return false;
-    case CommandResult::unknown_instrument: ++rejected_unknown_instrument; return false;
+    case CommandResult::not_owner: ++counted.not_owner; return false;
+    case CommandResult::unknown_instrument: ++counted.unknown_instrument; return false;
   }
   return false;
 }
@@ -40,7 +40,7 @@ void SimulationServer::Impl::answer_new_commands() {
     if (!c) return;
     const std::int64_t now = proto::now_ns();
     if (!clients.admit(c->client_id, {r.participant, r.identity}, now)) {
-      ++rejected_other_participant;
+      ++counted.other_participant;
       return;
     }
     if (offer_counted(*c, now)) updated.push_back({c->instrument_id, c->client_id, *c});
@@ -63,7 +63,7 @@ void SimulationServer::Impl::answer_in_lockstep(const std::vector<std::vector<st
     const auto c = decode_counted(payload);
     if (!c) continue;
     if (!instruments.owner(c->instrument_id)) {
-      ++rejected_unknown_instrument;
+      ++counted.unknown_instrument;
       continue;
     }
     std::uint64_t tick = 0;

@@ -39,12 +39,12 @@ void SimulationServer::Impl::publish_scene_files() {
   f.generation = generation;
   f.server_version = server_build();
   f.files = organ->sources;
-  f.first_tick = scene_first_tick;
-  f.sim_time_s = scene_sim_time_s;
+  f.first_tick = loaded.first_tick;
+  f.sim_time_s = loaded.sim_time_s;
   const nlohmann::json settings = {{"max_tick_ms", 1e3 * budget.max_tick_s},
                                    {"scene_dir", session.scene_dir()},
                                    {"physics_rate_hz", scene.physics_rate_hz},
-                                   {"changes", scene_changes}};
+                                   {"changes", loaded.changes}};
   f.settings_json = settings.dump();
   endpoints.write_scene_files(proto::encode(f));
 }
@@ -84,7 +84,7 @@ void SimulationServer::Impl::publish_force(std::uint32_t id, std::uint32_t owner
     capture->forces.push_back(std::move(payload));
   else
     endpoints.write_force(id, payload);
-  ++forces_sent;
+  ++counted.forces_sent;
 }
 
 /// After a tick: every active tool's force, and its contact and grasp events.

@@ -24,7 +24,7 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
     std::string why;
     const auto req = proto::decode_session_request(payload, &why);
     if (!req) {
-      ++rejected_malformed;
+      ++counted.malformed;
       return;
     }
     // What acts on an instrument is bound to the participant that holds the client id (pause,
@@ -32,7 +32,7 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
     const bool on_instrument = req->action == proto::Action::claim_instrument || req->action == proto::Action::release_instrument ||
                                req->action == proto::Action::take_over || req->action == proto::Action::hand_back;
     if (participant && on_instrument && !clients.admit(req->client_id, *participant, proto::now_ns())) {
-      ++rejected_other_participant;
+      ++counted.other_participant;
       return;
     }
     const std::string who = "client " + std::to_string(req->client_id);
@@ -66,7 +66,7 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
             event(proto::EventKind::instrument_claimed, req->instrument_id, req->client_id);
             changed = true;
             break;
-          case ClaimResult::unknown_instrument: ++rejected_unknown_instrument; break;
+          case ClaimResult::unknown_instrument: ++counted.unknown_instrument; break;
           case ClaimResult::already_owner:
           case ClaimResult::taken: break;  // no fault: its owner may let it go
         }
@@ -83,8 +83,8 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
                   proto::EventReason::by_owner);
             changed = true;
             break;
-          case ReleaseResult::not_owner: ++rejected_not_owner; break;
-          case ReleaseResult::unknown_instrument: ++rejected_unknown_instrument; break;
+          case ReleaseResult::not_owner: ++counted.not_owner; break;
+          case ReleaseResult::unknown_instrument: ++counted.unknown_instrument; break;
         }
         return;
     }
@@ -178,7 +178,7 @@ void SimulationServer::Impl::conclude(const proto::SessionRequest& req, bool acc
   if (accepted && req.action != proto::Action::load_scene) {
     nlohmann::json change = proto::to_json(req);
     change["tick"] = current_tick();
-    scene_changes.push_back(std::move(change));
+    loaded.changes.push_back(std::move(change));
   }
   const proto::EventKind kind = !accepted                                   ? proto::EventKind::request_refused
                                 : req.action == proto::Action::load_scene   ? proto::EventKind::scene_loaded

@@ -62,9 +62,9 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
       responder.set_instruments(scene.instruments, organ->boundary.triangles, organ->mesh->nodes, scene.contact_stiffness_n_per_m);
       state = State::at_rest(*organ->mesh);
       if (old) ++generation;
-      scene_first_tick = current_tick();
-      scene_sim_time_s = sim_time_s;
-      scene_changes = nlohmann::json::array();
+      loaded.first_tick = current_tick();
+      loaded.sim_time_s = sim_time_s;
+      loaded.changes = nlohmann::json::array();
     } else {
       scene.physics_rate_hz = rate;  // a set_physics_rate outlives a material change
       if (state.memory.size() != organ->model->memory_size()) state.memory.clear();  // relaxed
@@ -199,8 +199,8 @@ proto::LockstepResult SimulationServer::Impl::lockstep_tick(const proto::Lockste
   if (first) {  // the recording's clock: its tick numbers and simulated time
     ticks_run = step.tick - 1;
     sim_time_s = step.sim_time_s;
-    scene_first_tick = step.tick;
-    scene_sim_time_s = sim_time_s;
+    loaded.first_tick = step.tick;
+    loaded.sim_time_s = sim_time_s;
     publish_snapshot(ticks_run);
   } else if (step.tick != current_tick()) {
     result.error = "step for tick " + std::to_string(step.tick) + ", expected tick " + std::to_string(current_tick());
@@ -217,12 +217,12 @@ proto::LockstepResult SimulationServer::Impl::lockstep_tick(const proto::Lockste
 
 /// The counters the other threads keep, into stats.
 void SimulationServer::Impl::collect_counts() {
-  stats.rejected_malformed = rejected_malformed;
-  stats.rejected_not_owner = rejected_not_owner;
-  stats.rejected_unknown_instrument = rejected_unknown_instrument;
-  stats.rejected_other_participant = rejected_other_participant;
+  stats.rejected_malformed = counted.malformed;
+  stats.rejected_not_owner = counted.not_owner;
+  stats.rejected_unknown_instrument = counted.unknown_instrument;
+  stats.rejected_other_participant = counted.other_participant;
   stats.rejected = stats.rejected_malformed + stats.rejected_not_owner + stats.rejected_unknown_instrument + stats.rejected_other_participant;
-  stats.forces_sent = forces_sent;
+  stats.forces_sent = counted.forces_sent;
   stats.mesh_frames = mesh_frames_before + (mesh_publisher ? mesh_publisher->frames_published() : 0);
   stats.mesh_frames_skipped = mesh_skipped_before + (mesh_publisher ? mesh_publisher->frames_skipped() : 0);
 }
@@ -267,7 +267,7 @@ ServerStats SimulationServer::run_lockstep(const std::atomic<bool>& stop, Lockst
       const auto step = proto::decode_lockstep_step(payload, &why);
       proto::LockstepResult result;
       if (!step) {
-        ++s.rejected_malformed;
+        ++s.counted.malformed;
         result.error = "not a lockstep step: " + why;
       } else {
         result = s.lockstep_tick(*step, first, status);

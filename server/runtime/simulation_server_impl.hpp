@@ -54,9 +54,11 @@ struct SimulationServer::Impl {
   std::uint32_t generation = 1;  // +1 per scene loaded: the surface's mesh_id
   bool paused = false;
   // What the scene was loaded with and changed by since (SceneFiles, for recordings).
-  std::uint64_t scene_first_tick = 1;
-  double scene_sim_time_s = 0;
-  nlohmann::json scene_changes = nlohmann::json::array();
+  struct SceneRecord {
+    std::uint64_t first_tick = 1;
+    double sim_time_s = 0;
+    nlohmann::json changes = nlohmann::json::array();  // the material and rate requests since
+  } loaded;
   // Lockstep (run_lockstep): no wall clock, no lease, builds waited for; forces and events of the
   // tick go into its result.
   bool lockstep = false;
@@ -73,8 +75,9 @@ struct SimulationServer::Impl {
   SessionControl session;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread
   std::uint64_t mesh_frames_before = 0, mesh_skipped_before = 0;  // of the publishers of earlier scenes
-  std::atomic<std::uint64_t> rejected_malformed{0}, rejected_not_owner{0}, rejected_unknown_instrument{0}, rejected_other_participant{0},
-      forces_sent{0};
+  struct Counted {  // both threads: refused commands and requests by reason, forces sent
+    std::atomic<std::uint64_t> malformed{0}, not_owner{0}, unknown_instrument{0}, other_participant{0}, forces_sent{0};
+  } counted;
   ClientBinding clients;  // both threads (thread-safe)
   ServerStats stats;  // physics thread
 

@@ -1,19 +1,25 @@
 #!/usr/bin/env bash
-# clang-tidy with the project's .clang-tidy (its findings are errors) on the C++ sources changed in
-# the last COMMITS commits (default 3, the work just landed; "all" for every source, about 15 minutes on two cores).
-# Usage: clang_tidy.sh BUILD_DIR SOURCE_DIR [COMMITS|all]
+# clang-tidy with the project's .clang-tidy (its findings are errors) on the C++ sources a change
+# touches: those changed since BASE and those that include a header changed since BASE (from the
+# build's dependency log). BASE: on a branch, its merge base with origin/main; on main itself, the
+# last 3 commits (the work just landed); "all" for every source (about 15 minutes on two cores).
+# Usage: clang_tidy.sh BUILD_DIR SOURCE_DIR [BASE|all]
 set -u
-build="$1"; src="$2"; range="${3:-3}"
+build="$1"; src="$2"; base="${3:-}"
 cd "$src" || exit 2
 [ -f "$build/compile_commands.json" ] || { echo "clang_tidy: $build/compile_commands.json missing (configure first)"; exit 2; }
-if [ "$range" = all ] || ! git rev-parse -q --verify "HEAD~$range" > /dev/null; then
-  files=$(git ls-files '*.cpp' | grep -v '^tests/fuzz/')
-else
-  files=$(git diff --name-only --diff-filter=d "HEAD~$range" -- '*.cpp' | grep -v '^tests/fuzz/')
+if [ -z "$base" ]; then
+  head=$(git rev-parse HEAD)
+  base=$(git merge-base HEAD origin/main 2> /dev/null || true)
+  if [ -z "$base" ] || [ "$base" = "$head" ]; then
+    base=HEAD~3
+    git rev-parse -q --verify "$base" > /dev/null || base=all
+  fi
 fi
-[ -z "$files" ] && { echo "clang_tidy: no C++ source changed"; exit 0; }
+files=$(python3 "$src/tests/lint/changed_sources.py" "$build" "$src" "$base") || exit 2
+[ -z "$files" ] && { echo "clang_tidy: no C++ source changed since $base"; exit 0; }
 count=$(echo "$files" | wc -l)
-echo "clang_tidy: $count sources"
+echo "clang_tidy: $count sources (changed since $base, or including a header that did)"
 if echo "$files" | xargs -P "$(nproc)" -n 4 clang-tidy -p "$build" --quiet 2>/dev/null | grep -E "(warning|error):"; then
   echo "clang_tidy: findings above (fix them, or justify each with a NOLINT comment that says why)"
   exit 1

@@ -99,116 +99,122 @@ client::DeviceSample PalpatingDevice::read(double t) {
   }
   Probe& p = probes_[current_];
   switch (phase_) {
-    case Phase::travel: {
-      if (z_ < safe_z_) {  // straight up first, the way it came down
-        z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
-        break;
-      }
-      const double dx = p.x - x_, dy = p.y - y_, d = std::hypot(dx, dy), step = kTravelSpeed * dt;
-      if (d <= step) {
-        x_ = p.x;
-        y_ = p.y;
-        if (z_ >= safe_z_) phase_ = Phase::descend;
-      } else {
-        x_ += dx / d * step;
-        y_ += dy / d * step;
-      }
-      break;
-    }
-    case Phase::descend:
-      if (contact_) {
-        contact_z_ = z_;
-        phase_ = Phase::press;
-      } else if (z_ <= bottom_) {
-        next_point();  // no tissue under this point
-      } else {
-        z_ -= kDescendSpeed * dt;
-      }
-      break;
-    case Phase::press: {
-      if (magnitude(force_) > kSafeForceN && marking_) {
-        // The marking press stops where the tissue pushes back this hard and marks there: touching,
-        // and never pressing past the safe force (a CI run marked 4.4 N deep without this stop).
-        phase_ = Phase::dwell;
-        phase_t_ = t;
-        settle_sum_ = {};
-        settle_samples_ = 0;
-        break;
-      }
-      if (magnitude(force_) > kSafeForceN) {
-        // The tissue pushes back hard enough to stop the press. Past the hold at half the depth,
-        // the point is judged by the force held there (the tissue is firm); before it, by
-        // nothing: a force that high so soon is the surface still moving from the last press,
-        // and the point is left out.
-        p.force_n = p.settled && p.half_vertical ? p.half_force_n : -1.0;
-        if (verbose_) {
-          std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.1f mm, stopped at %.3f N before %.0f mm%s\n", p.x, p.y, contact_z_,
-                      p.half_force_n, 1e3 * std::min(contact_z_ - z_, 0.5 * depth_), magnitude(force_), 1000 * depth_,
-                      !p.settled      ? " (before half way: left out)"
-                      : p.force_n < 0 ? " (steep: left out)"
-                                      : "");
-          std::fflush(stdout);
-        }
-        phase_ = Phase::lift;
-        break;
-      }
-      // The marking press goes half as deep: where the tip still holds on to the surface, so
-      // that the mark is made touching the tissue.
-      const bool mark = marking_ && current_ + 1 == probes_.size();
-      const double depth = mark || !p.settled ? 0.5 * depth_ : depth_;
-      z_ = std::max(contact_z_ - depth, z_ - kPressSpeed * dt);
-      if (z_ <= contact_z_ - depth) {
-        phase_ = mark || p.settled ? Phase::dwell : Phase::settle;
-        phase_t_ = t;
-        settle_sum_ = {};
-        settle_samples_ = 0;
-      }
-      break;
-    }
+    case Phase::travel: travel(p, dt); break;
+    case Phase::descend: descend(dt); break;
+    case Phase::press: press(p, t, dt); break;
     case Phase::settle:
-    case Phase::dwell: {
-      // Held still, at DEPTH / 2 and then at DEPTH; the force is the mean over the end of each
-      // hold. The marking press holds briefly, pressing button 1 for its second half.
-      const bool mark = marking_ && current_ + 1 == probes_.size();
-      const double hold = mark ? kDwellS : kSettleS;
-      if (mark) buttons_ = t - phase_t_ < 0.5 * kDwellS ? 0u : 1u;
-      if (t - phase_t_ >= hold - kSettleMeanS) {
-        for (int k = 0; k < 3; ++k) settle_sum_[k] += force_[k];
-        ++settle_samples_;
-      }
-      if (t - phase_t_ < hold) break;
-      protocol::Vector3 mean{};
-      for (int k = 0; k < 3; ++k) mean[k] = settle_sum_[k] / std::max(1, settle_samples_);
-      const double F = magnitude(mean);
-      if (phase_ == Phase::settle) {
-        p.half_force_n = F;
-        p.half_vertical = F > 0 && mean[2] >= kMinVerticalShare * F;
-        p.settled = true;
-        phase_ = Phase::press;
-        break;
-      }
-      // Judged by the forces held at half the depth and at the full depth together: half way
-      // alone the lump is barely reached, and the full depth alone misleads where the tip slips
-      // sideways off a stiff spot and the force stops growing.
-      p.force_n = p.half_vertical ? p.half_force_n + F : -1.0;
-      if (verbose_ && !mark) {
-        std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s\n", p.x, p.y, contact_z_, p.half_force_n,
-                    500 * depth_, F, 1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
-        std::fflush(stdout);
-      }
-      buttons_ = 0;
-      phase_ = Phase::lift;
-      break;
-    }
-    case Phase::lift:
-      // Slowly while touching, so that the tissue follows the tip back and is not left ringing
-      // for the next press; then fast.
-      z_ = std::min(safe_z_, z_ + (z_ < contact_z_ ? kPressSpeed : kLiftSpeed) * dt);
-      if (z_ >= safe_z_) next_point();
-      break;
+    case Phase::dwell: hold(p, t); break;
+    case Phase::lift: lift(dt); break;
     case Phase::done: break;
   }
   return {{x_, y_, z_}, 0.5, buttons_, false};
+}
+
+void PalpatingDevice::travel(Probe& p, double dt) {
+  if (z_ < safe_z_) {  // straight up first, the way it came down
+    z_ = std::min(safe_z_, z_ + kLiftSpeed * dt);
+    return;
+  }
+  const double dx = p.x - x_, dy = p.y - y_, d = std::hypot(dx, dy), step = kTravelSpeed * dt;
+  if (d <= step) {
+    x_ = p.x;
+    y_ = p.y;
+    if (z_ >= safe_z_) phase_ = Phase::descend;
+  } else {
+    x_ += dx / d * step;
+    y_ += dy / d * step;
+  }
+}
+
+void PalpatingDevice::descend(double dt) {
+  if (contact_) {
+    contact_z_ = z_;
+    phase_ = Phase::press;
+  } else if (z_ <= bottom_) {
+    next_point();  // no tissue under this point
+  } else {
+    z_ -= kDescendSpeed * dt;
+  }
+}
+
+void PalpatingDevice::press(Probe& p, double t, double dt) {
+  if (magnitude(force_) > kSafeForceN && marking_) {
+    // The marking press stops where the tissue pushes back this hard and marks there: touching,
+    // and never pressing past the safe force (a CI run marked 4.4 N deep without this stop).
+    start_hold(Phase::dwell, t);
+    return;
+  }
+  if (magnitude(force_) > kSafeForceN) {
+    // The tissue pushes back hard enough to stop the press. Past the hold at half the depth,
+    // the point is judged by the force held there (the tissue is firm); before it, by
+    // nothing: a force that high so soon is the surface still moving from the last press,
+    // and the point is left out.
+    p.force_n = p.settled && p.half_vertical ? p.half_force_n : -1.0;
+    if (verbose_) {
+      std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.1f mm, stopped at %.3f N before %.0f mm%s\n", p.x, p.y, contact_z_,
+                  p.half_force_n, 1e3 * std::min(contact_z_ - z_, 0.5 * depth_), magnitude(force_), 1000 * depth_,
+                  !p.settled      ? " (before half way: left out)"
+                  : p.force_n < 0 ? " (steep: left out)"
+                                  : "");
+      std::fflush(stdout);
+    }
+    phase_ = Phase::lift;
+    return;
+  }
+  // The marking press goes half as deep: where the tip still holds on to the surface, so
+  // that the mark is made touching the tissue.
+  const bool mark = marking_ && current_ + 1 == probes_.size();
+  const double depth = mark || !p.settled ? 0.5 * depth_ : depth_;
+  z_ = std::max(contact_z_ - depth, z_ - kPressSpeed * dt);
+  if (z_ <= contact_z_ - depth) start_hold(mark || p.settled ? Phase::dwell : Phase::settle, t);
+}
+
+void PalpatingDevice::start_hold(Phase phase, double t) {
+  phase_ = phase;
+  phase_t_ = t;
+  settle_sum_ = {};
+  settle_samples_ = 0;
+}
+
+void PalpatingDevice::hold(Probe& p, double t) {
+  // Held still, at DEPTH / 2 and then at DEPTH; the force is the mean over the end of each
+  // hold. The marking press holds briefly, pressing button 1 for its second half.
+  const bool mark = marking_ && current_ + 1 == probes_.size();
+  const double hold_s = mark ? kDwellS : kSettleS;
+  if (mark) buttons_ = t - phase_t_ < 0.5 * kDwellS ? 0u : 1u;
+  if (t - phase_t_ >= hold_s - kSettleMeanS) {
+    for (int k = 0; k < 3; ++k) settle_sum_[k] += force_[k];
+    ++settle_samples_;
+  }
+  if (t - phase_t_ < hold_s) return;
+  protocol::Vector3 mean{};
+  for (int k = 0; k < 3; ++k) mean[k] = settle_sum_[k] / std::max(1, settle_samples_);
+  const double F = magnitude(mean);
+  if (phase_ == Phase::settle) {
+    p.half_force_n = F;
+    p.half_vertical = F > 0 && mean[2] >= kMinVerticalShare * F;
+    p.settled = true;
+    phase_ = Phase::press;
+    return;
+  }
+  // Judged by the forces held at half the depth and at the full depth together: half way
+  // alone the lump is barely reached, and the full depth alone misleads where the tip slips
+  // sideways off a stiff spot and the force stops growing.
+  p.force_n = p.half_vertical ? p.half_force_n + F : -1.0;
+  if (verbose_ && !mark) {
+    std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s\n", p.x, p.y, contact_z_, p.half_force_n,
+                500 * depth_, F, 1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
+    std::fflush(stdout);
+  }
+  buttons_ = 0;
+  phase_ = Phase::lift;
+}
+
+void PalpatingDevice::lift(double dt) {
+  // Slowly while touching, so that the tissue follows the tip back and is not left ringing
+  // for the next press; then fast.
+  z_ = std::min(safe_z_, z_ + (z_ < contact_z_ ? kPressSpeed : kLiftSpeed) * dt);
+  if (z_ >= safe_z_) next_point();
 }
 
 void PalpatingDevice::render(const protocol::Vector3& f, bool in_contact) {

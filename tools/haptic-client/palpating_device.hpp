@@ -39,6 +39,14 @@ class PalpatingDevice : public client::Device {
     bool half_vertical = false;  ///< ... and mostly vertical there
     bool settled = false;  ///< the hold at DEPTH / 2 is done
   };
+  // One period of each phase; `p` the point being probed, `t` the device's time [s], `dt` since
+  // the last period [s].
+  void travel(Probe& p, double dt);  ///< above the tissue to the next point (straight up first)
+  void descend(double dt);  ///< down until contact (or past the bottom: no tissue here)
+  void press(Probe& p, double t, double dt);  ///< into the tissue to half the depth, then the full depth
+  void start_hold(Phase phase, double t);
+  void hold(Probe& p, double t);  ///< held still at a depth (settle, dwell), the force averaged at its end
+  void lift(double dt);  ///< up, slowly while touching
   void next_point();
   /// The centre of the stiff area around `best`: the points within 1.5 cm of it, each weighted by
   /// how much more force it felt than the median point (a hand marks the middle of the lump it

@@ -21,6 +21,82 @@
 
 using namespace viscera::lab;
 
+namespace {
+
+using viscera::common::UsageError;
+
+/// The analysis's summary on standard output: the verdict, the causes, the figures.
+void print_summary(const Analysis& a, double seconds, const std::string& out) {
+  std::printf("%s\n", a.verdict.c_str());
+  std::printf("causes (%s):", to_string(a.causes_status));
+  for (Mechanism m : a.named_causes()) std::printf(" %s", name(m));
+  if (a.causes_status == CausesStatus::not_confirmed) {
+    std::printf(" none named; chosen on all tests but not held by the honest gain:");
+    for (Mechanism m : a.causes) std::printf(" %s", name(m));
+  }
+  std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
+              a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
+  if (!a.nested.empty())
+    std::printf("honest gain (nested leave-one-out: mechanisms chosen without the test predicted): %.3gx, held-out RMS %.4g Pa\n", a.nested_gain,
+                a.nested_heldout_rms_pa);
+  else
+    std::printf("honest gain not measured: %s\n", a.nested_not_run.c_str());
+}
+
+void run_analyze(const std::vector<std::string>& positional, const std::string& out, bool quiet) {
+  if (positional.size() != 2) throw UsageError("analyze takes one DATASET_DIR");
+  const auto t0 = std::chrono::steady_clock::now();
+  const Dataset d = read_dataset(positional[1]);
+  if (!quiet) std::fprintf(stderr, "viscera-lab: %s: %zu tests, %s\n", d.name.c_str(), d.tests.size(), to_string(d.mode));
+  const Analysis a = analyze(d, [&](const std::string& s) {
+    if (!quiet) {
+      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::fprintf(stderr, "[%6.1f s] %s\n", el, s.c_str());
+    }
+  });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_report(a, decimate(d, AnalyzeOptions{}.max_fit_points), out, seconds);  // plots of what was fitted
+  print_summary(a, seconds, out);
+}
+
+void run_import(const std::vector<std::string>& positional, const std::string& out, const viscera::common::CommandLine& cl) {
+  if (positional.size() < 2) throw UsageError("import takes one or more EXPORT files");
+  const std::vector<std::string> files(positional.begin() + 1, positional.end());
+  for (const auto& f : files) viscera::common::refuse_overwrite(out + "/" + std::filesystem::path(f).stem().string() + ".csv", {f}, "--out");
+  ImportOptions o;
+  o.name = cl.has("name") ? cl.text("name") : "";
+  const std::string mode = cl.text("mode"), control = cl.text("control");
+  if (mode != "uniaxial" && mode != "simple_shear") throw UsageError("--mode: '" + mode + "' is not uniaxial or simple_shear");
+  if (control != "strain" && control != "stress") throw UsageError("--control: '" + control + "' is not strain or stress");
+  o.mode = mode == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
+  o.control = control == "strain" ? Control::strain : Control::stress;
+  for (const char* required : {"length-m", "width-m", "thickness-m", "force", "displacement"})
+    if (!cl.has(required)) throw UsageError(std::string("import needs --") + required);
+  o.specimen = {cl.number_in("length-m", 1e-6, 10), cl.number_in("width-m", 1e-6, 10), cl.number_in("thickness-m", 1e-6, 10),
+                cl.number_in("density-kg-m3", 1, 1e5)};
+  o.time = parse_import_column("time", cl.text("time"), ImportQuantity::time);
+  o.force = parse_import_column("force", cl.text("force"), ImportQuantity::force);
+  o.displacement = parse_import_column("displacement", cl.text("displacement"), ImportQuantity::displacement);
+  const Dataset d = import_dataset(files, o, out);
+  for (const auto& t : d.tests)
+    std::printf("%s: %zu rows, %.4g s, strain %.4g to %.4g, stress %.4g to %.4g Pa\n", t.file.c_str(), t.time_s.size(),
+                t.time_s.back() - t.time_s.front(), *std::min_element(t.strain.begin(), t.strain.end()),
+                *std::max_element(t.strain.begin(), t.strain.end()), *std::min_element(t.stress_pa.begin(), t.stress_pa.end()),
+                *std::max_element(t.stress_pa.begin(), t.stress_pa.end()));
+  std::printf("wrote %s/dataset.json (%s)\n", out.c_str(), d.import_note.c_str());
+}
+
+void run_predict(const std::vector<std::string>& positional, const std::string& out) {
+  if (positional.size() != 3) throw UsageError("predict takes MODEL_JSON and DATASET_DIR");
+  MaterialModel m = read_model(positional[1]);
+  const Dataset d = read_dataset(positional[2]);
+  m.odd_only = d.mode == Mode::simple_shear;  // Ogden's form responds as the data's mode loads it
+  write_prediction(m, positional[1], d, out);
+  std::printf("wrote %s/report.json\n", out.c_str());
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   viscera::common::CommandLine cl(
       "viscera-lab",
@@ -58,7 +134,7 @@ int main(int argc, char** argv) {
   };
   try {
     if (!cl.parse(argc, argv)) return 0;
-  } catch (const viscera::common::UsageError& e) {
+  } catch (const UsageError& e) {
     std::fprintf(stderr, "viscera-lab: %s\n", e.what());
     return 2;
   }
@@ -68,81 +144,24 @@ int main(int argc, char** argv) {
   const std::string out = cl.text("out");
   const bool quiet = cl.has("quiet");
   try {
-    const auto t0 = std::chrono::steady_clock::now();
     // The report never goes over what the run reads: not into the data set's folder (its plots are
     // named after the tests), and not over the model predict reads.
     if (positional.size() >= 2) viscera::common::refuse_overwrite(out, {positional.back()}, "--out");
     if (positional[0] == "predict" && positional.size() == 3)
       for (const char* written : {"report.json", "model.json"}) viscera::common::refuse_overwrite(out + "/" + written, {positional[1]}, "--out");
-    if (positional[0] == "analyze") {
-      if (positional.size() != 2) return usage_error("analyze takes one DATASET_DIR");
-      const Dataset d = read_dataset(positional[1]);
-      if (!quiet) std::fprintf(stderr, "viscera-lab: %s: %zu tests, %s\n", d.name.c_str(), d.tests.size(), to_string(d.mode));
-      const Analysis a = analyze(d, [&](const std::string& s) {
-        if (!quiet) {
-          const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          std::fprintf(stderr, "[%6.1f s] %s\n", el, s.c_str());
-        }
-      });
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      write_report(a, decimate(d, AnalyzeOptions{}.max_fit_points), out, seconds);  // plots of what was fitted
-      std::printf("%s\n", a.verdict.c_str());
-      std::printf("causes (%s):", to_string(a.causes_status));
-      for (Mechanism m : a.named_causes()) std::printf(" %s", name(m));
-      if (a.causes_status == CausesStatus::not_confirmed) {
-        std::printf(" none named; chosen on all tests but not held by the honest gain:");
-        for (Mechanism m : a.causes) std::printf(" %s", name(m));
-      }
-      std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
-                  a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
-      if (!a.nested.empty())
-        std::printf("honest gain (nested leave-one-out: mechanisms chosen without the test predicted): %.3gx, held-out RMS %.4g Pa\n", a.nested_gain,
-                    a.nested_heldout_rms_pa);
-      else
-        std::printf("honest gain not measured: %s\n", a.nested_not_run.c_str());
-      return 0;
-    }
-    if (positional[0] == "import") {
-      if (positional.size() < 2) return usage_error("import takes one or more EXPORT files");
-      const std::vector<std::string> files(positional.begin() + 1, positional.end());
-      for (const auto& f : files) viscera::common::refuse_overwrite(out + "/" + std::filesystem::path(f).stem().string() + ".csv", {f}, "--out");
-      ImportOptions o;
-      o.name = cl.has("name") ? cl.text("name") : "";
-      const std::string mode = cl.text("mode"), control = cl.text("control");
-      if (mode != "uniaxial" && mode != "simple_shear") return usage_error("--mode: '" + mode + "' is not uniaxial or simple_shear");
-      if (control != "strain" && control != "stress") return usage_error("--control: '" + control + "' is not strain or stress");
-      o.mode = mode == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
-      o.control = control == "strain" ? Control::strain : Control::stress;
-      for (const char* required : {"length-m", "width-m", "thickness-m", "force", "displacement"})
-        if (!cl.has(required)) return usage_error(std::string("import needs --") + required);
-      o.specimen = {cl.number_in("length-m", 1e-6, 10), cl.number_in("width-m", 1e-6, 10), cl.number_in("thickness-m", 1e-6, 10),
-                    cl.number_in("density-kg-m3", 1, 1e5)};
-      o.time = parse_import_column("time", cl.text("time"), ImportQuantity::time);
-      o.force = parse_import_column("force", cl.text("force"), ImportQuantity::force);
-      o.displacement = parse_import_column("displacement", cl.text("displacement"), ImportQuantity::displacement);
-      const Dataset d = import_dataset(files, o, out);
-      for (const auto& t : d.tests)
-        std::printf("%s: %zu rows, %.4g s, strain %.4g to %.4g, stress %.4g to %.4g Pa\n", t.file.c_str(), t.time_s.size(),
-                    t.time_s.back() - t.time_s.front(), *std::min_element(t.strain.begin(), t.strain.end()),
-                    *std::max_element(t.strain.begin(), t.strain.end()), *std::min_element(t.stress_pa.begin(), t.stress_pa.end()),
-                    *std::max_element(t.stress_pa.begin(), t.stress_pa.end()));
-      std::printf("wrote %s/dataset.json (%s)\n", out.c_str(), d.import_note.c_str());
-      return 0;
-    }
-    if (positional[0] == "predict") {
-      if (positional.size() != 3) return usage_error("predict takes MODEL_JSON and DATASET_DIR");
-      MaterialModel m = read_model(positional[1]);
-      const Dataset d = read_dataset(positional[2]);
-      m.odd_only = d.mode == Mode::simple_shear;  // Ogden's form responds as the data's mode loads it
-      write_prediction(m, positional[1], d, out);
-      std::printf("wrote %s/report.json\n", out.c_str());
-      return 0;
-    }
-    return usage_error("unknown command '" + positional[0] + "'");
+    if (positional[0] == "analyze")
+      run_analyze(positional, out, quiet);
+    else if (positional[0] == "import")
+      run_import(positional, out, cl);
+    else if (positional[0] == "predict")
+      run_predict(positional, out);
+    else
+      return usage_error("unknown command '" + positional[0] + "'");
+    return 0;
   } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "viscera-lab: %s\n", e.what());
     return 2;
-  } catch (const viscera::common::UsageError& e) {
+  } catch (const UsageError& e) {
     return usage_error(e.what());
   }
 }

@@ -39,53 +39,64 @@ json figures(const ModelEvaluation& e) {
 
 std::string stem(const std::string& file) { return fs::path(file).stem().string(); }
 
-}  // namespace
+json noise_json(const Analysis& a) {
+  const NoiseCheck& c = a.noise_check;
+  json n{{"estimate_pa", a.noise_pa},
+         {"method",
+          "RMS over tests of stress_sd_pa where given, else the second differences of the measured quantity (median absolute "
+          "value, the SD for white noise)"},
+         {"tests_with_holds", c.tests}};
+  if (c.tests > 0) {
+    n["first_estimate_on_those_tests_pa"] = c.first_pa;
+    n["second_estimate_pa"] = c.holds_pa;
+    n["second_method"] = "spread of the measured quantity in " + std::to_string(c.holds) + " holds about a running mean over " +
+                         std::to_string(c.window_s) + " s (robust SD, first window of each hold left out)";
+    n["ratio"] = c.holds_pa / std::max(c.first_pa, 1e-300);
+    n["agree_within_factor"] = kNoiseAgreementFactor;
+  }
+  n["agree"] = c.agree;
+  return n;
+}
 
-void write_report(const Analysis& a, const Dataset& d, const std::string& out_dir, double seconds) {
-  fs::create_directories(out_dir);
+json names_json(const std::vector<Mechanism>& ms) {
+  json l = json::array();
+  for (Mechanism m : ms) l.push_back(name(m));
+  return l;
+}
+
+json nested_json(const Analysis& a) {
+  if (a.nested.empty()) return {{"ran", false}, {"why", a.nested_not_run}};
+  json n{{"ran", true}, {"heldout_rms_pa", a.nested_heldout_rms_pa}, {"gain", a.nested_gain}, {"folds", json::array()}};
+  for (const auto& f : a.nested) n["folds"].push_back({{"left_out", f.file}, {"causes", names_json(f.causes)}, {"heldout_rms_pa", f.heldout_rms_pa}});
+  return n;
+}
+
+json specimen_json(const Analysis& a) {
+  json out = json::array();
+  for (const auto& c : a.specimen) {
+    json jc{{"model", c.model}, {"ran", c.ran}, {"note", c.note}, {"steps", c.steps}, {"newton_iterations", c.newton_iterations}};
+    jc["tests"] = json::array();
+    for (std::size_t k = 0; k < c.files.size(); ++k)
+      jc["tests"].push_back({{"file", c.files[k]}, {"specimen_rms_pa", c.specimen_rms_pa[k]}, {"law_rms_pa", c.law_rms_pa[k]}});
+    out.push_back(jc);
+  }
+  return out;
+}
+
+/// report.json: every figure of the analysis.
+json report_json(const Analysis& a, const Dataset& d, double seconds) {
   json j;
   j["dataset"] = a.dataset;
   j["mode"] = to_string(d.mode);
   j["noise_pa"] = a.noise_pa;
-  {
-    const NoiseCheck& c = a.noise_check;
-    json n{{"estimate_pa", a.noise_pa},
-           {"method",
-            "RMS over tests of stress_sd_pa where given, else the second differences of the measured quantity (median absolute "
-            "value, the SD for white noise)"},
-           {"tests_with_holds", c.tests}};
-    if (c.tests > 0) {
-      n["first_estimate_on_those_tests_pa"] = c.first_pa;
-      n["second_estimate_pa"] = c.holds_pa;
-      n["second_method"] = "spread of the measured quantity in " + std::to_string(c.holds) + " holds about a running mean over " +
-                           std::to_string(c.window_s) + " s (robust SD, first window of each hold left out)";
-      n["ratio"] = c.holds_pa / std::max(c.first_pa, 1e-300);
-      n["agree_within_factor"] = kNoiseAgreementFactor;
-    }
-    n["agree"] = c.agree;
-    j["noise"] = n;
-  }
+  j["noise"] = noise_json(a);
   j["baseline"] = figures(a.baseline);
   j["final"] = figures(a.final);
-  const auto names = [](const std::vector<Mechanism>& ms) {
-    json l = json::array();
-    for (Mechanism m : ms) l.push_back(name(m));
-    return l;
-  };
-  j["causes"] = names(a.named_causes());  // found (or tentative); none when the honest gain did not hold
+  j["causes"] = names_json(a.named_causes());  // found (or tentative); none when the honest gain did not hold
   j["causes_status"] = to_string(a.causes_status);
-  j["causes_chosen_on_all_tests"] = names(a.causes);
+  j["causes_chosen_on_all_tests"] = names_json(a.causes);
   j["gain"] = a.gain;
-  if (!a.nested_not_run.empty()) j["nested_leave_one_out"] = {{"ran", false}, {"why", a.nested_not_run}};
-  if (!a.nested.empty()) {
-    json n{{"ran", true}, {"heldout_rms_pa", a.nested_heldout_rms_pa}, {"gain", a.nested_gain}, {"folds", json::array()}};
-    for (const auto& f : a.nested) {
-      json causes = json::array();
-      for (Mechanism m : f.causes) causes.push_back(name(m));
-      n["folds"].push_back({{"left_out", f.file}, {"causes", causes}, {"heldout_rms_pa", f.heldout_rms_pa}});
-    }
-    j["nested_leave_one_out"] = n;
-  }
+  if (!a.nested.empty() || !a.nested_not_run.empty()) j["nested_leave_one_out"] = nested_json(a);
   j["candidates"] = json::array();
   for (const auto& c : a.candidates)
     j["candidates"].push_back({{"mechanism", name(c.mechanism)},
@@ -95,21 +106,13 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
                                {"accepted", c.accepted},
                                {"evidence", c.evidence}});
   j["verdict"] = a.verdict;
-  j["specimen"] = json::array();
-  for (const auto& c : a.specimen) {
-    json jc{{"model", c.model}, {"ran", c.ran}, {"note", c.note}, {"steps", c.steps}, {"newton_iterations", c.newton_iterations}};
-    jc["tests"] = json::array();
-    for (std::size_t k = 0; k < c.files.size(); ++k)
-      jc["tests"].push_back({{"file", c.files[k]}, {"specimen_rms_pa", c.specimen_rms_pa[k]}, {"law_rms_pa", c.law_rms_pa[k]}});
-    j["specimen"].push_back(jc);
-  }
+  j["specimen"] = specimen_json(a);
   j["seconds"] = seconds;
   j["decimated"] = a.decimated;
-  std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
-  write_model((fs::path(out_dir) / "model.json").string(), a.supported_model(), a.dataset);
+  return j;
+}
 
-  std::ofstream md(fs::path(out_dir) / "report.md");
-  md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
+void md_noise(std::ostream& md, const Analysis& a, double seconds) {
   md << "Noise level of the data (RMS of `stress_sd_pa`, or estimated from second differences; for a stress-controlled test that of its strain, as "
         "an equivalent stress): "
      << a.noise_pa << " Pa. ";
@@ -121,6 +124,9 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
     md << "No test holds its command long enough to check the noise by a second path. ";
   md << "Analysis time: " << seconds << " s.\n\n";
   for (const auto& line : a.decimated) md << "Decimated for the fit and the plots: " << line << ".\n\n";
+}
+
+void md_errors(std::ostream& md, const Analysis& a, const Dataset& d) {
   md << "## Errors per test (RMS, Pa)\n\n| test | noise | baseline fit | baseline held-out | final fit | final held-out "
         "|\n|---|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < a.baseline.tests.size(); ++k)
@@ -136,6 +142,9 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
       md << "- " << a.baseline.tests[k].file << " in strain: noise " << a.baseline.tests[k].noise_strain << ", baseline held-out "
          << a.baseline.tests[k].heldout_rms_strain << ", final held-out " << a.final.tests[k].heldout_rms_strain << "\n";
   md << "\n";
+}
+
+void md_nested(std::ostream& md, const Analysis& a) {
   if (!a.nested.empty()) {
     md << "## The honest gain: nested leave-one-out\n\nThe gain above is measured on held-out tests, but every test had a say in which "
           "mechanisms were chosen. Here the whole selection runs once per test without it; the model it chooses, fitted without the "
@@ -153,6 +162,9 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
        << a.nested_not_run << ". Every test had a say in which mechanisms were chosen, so "
        << "the gain above is optimistic and the causes are tentative.\n\n";
   }
+}
+
+void md_candidates(std::ostream& md, const Analysis& a) {
   md << "## Candidate mechanisms\n\n| round | mechanism | held-out RMS before | after | accepted | evidence in the residuals "
         "|\n|---|---|---|---|---|---|\n";
   for (const auto& c : a.candidates)
@@ -160,6 +172,9 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
        << (c.accepted ? "yes" : "no") << " | " << c.evidence << " |\n";
   md << "\nA mechanism is accepted when it lowers the held-out mean square error by more than half the noise variance and the "
         "held-out RMS by at least 5%; rounds add the best accepted mechanism and try the rest on top.\n\n";
+}
+
+void md_specimen(std::ostream& md, const Analysis& a) {
   md << "## On the tetrahedral specimen\n\nEach model also runs on the specimen meshed with tetrahedra (viscera's GPS with memory "
         "variables, backward Euler with adaptive steps, inertia from the specimen's density), driven by the measured history. "
         "For stress-controlled tests both columns are the strain error times the test's apparent modulus.\n\n";
@@ -175,44 +190,62 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
       md << "  | " << c.files[k] << " | " << c.specimen_rms_pa[k] << " | " << c.law_rms_pa[k] << " |\n";
     md << "\n";
   }
+}
+
+/// A test's two plots (data and models; residuals) and their section of report.md.
+void md_test_plots(std::ostream& md, const Analysis& a, const TestData& t, const std::string& out_dir) {
+  // What the test measured: stress under strain control, strain under stress control.
+  const bool strain_measured = t.control == Control::stress;
+  const std::vector<double>& data = strain_measured ? t.strain : t.stress_pa;
+  const std::string quantity = strain_measured ? "strain" : "stress", unit = strain_measured ? "strain [-]" : "stress [Pa]";
+  const auto yb = predict_measured(a.baseline.model, t), yf = predict_measured(a.final.model, t);
+  std::vector<double> rb, rf;
+  for (std::size_t i = 0; i < yb.size(); ++i) {
+    rb.push_back(data[i] - yb[i]);
+    rf.push_back(data[i] - yf[i]);
+  }
+  const std::string name_fit = stem(t.file) + "_fit.svg", name_res = stem(t.file) + "_residual.svg";
+  // Time since the first sample (plus one sampling interval), on a log axis: ramps and holds
+  // that last from 0.1 s to minutes are all visible.
+  std::vector<double> since;
+  const double offset = t.time_s[1] - t.time_s[0];
+  for (double x : t.time_s) since.push_back(x - t.time_s[0] + offset);
+  plot::Figure fit{t.file + ": " + quantity + ", data and models (fitted to all tests)",
+                   "time since the first sample [s] (log)",
+                   unit,
+                   {{"data", since, data, "#000000", "", 2.0},
+                    {"baseline (" + std::to_string(a.baseline.model.parameter_count()) + " parameters)", since, yb, "#1f77b4", "8 4", 1.6},
+                    {"final (" + std::to_string(a.final.model.parameter_count()) + " parameters)", since, yf, "#d62728", "", 1.6}}};
+  fit.log_x = true;
+  plot::write_svg((fs::path(out_dir) / name_fit).string(), fit);
+  plot::Figure res{t.file + ": residual (data - model)",
+                   "time since the first sample [s] (log)",
+                   "residual, " + unit,
+                   {{"baseline", since, rb, "#1f77b4", "8 4", 1.6}, {"final", since, rf, "#d62728", "", 1.6}}};
+  res.log_x = true;
+  plot::write_svg((fs::path(out_dir) / name_res).string(), res);
+  md << "### " << t.file << " (" << to_string(t.control) << " control)\n\n![" << t.file << "](" << name_fit << ")\n\n![residual](" << name_res
+     << ")\n\n";
+}
+
+}  // namespace
+
+void write_report(const Analysis& a, const Dataset& d, const std::string& out_dir, double seconds) {
+  fs::create_directories(out_dir);
+  std::ofstream(fs::path(out_dir) / "report.json") << report_json(a, d, seconds).dump(2) << "\n";
+  write_model((fs::path(out_dir) / "model.json").string(), a.supported_model(), a.dataset);
+
+  std::ofstream md(fs::path(out_dir) / "report.md");
+  md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
+  md_noise(md, a, seconds);
+  md_errors(md, a, d);
+  md_nested(md, a);
+  md_candidates(md, a);
+  md_specimen(md, a);
   md << "\n## Models\n\n- baseline: `" << a.baseline.model.describe() << "`, E = " << a.baseline.model.modulus_pa
      << " Pa, eta = " << a.baseline.model.viscosity_pa_s << " Pa s\n- final: `" << a.final.model.describe() << "` (parameters in `model.json`)\n\n";
   md << "## Data, baseline and final model\n\n";
-  for (std::size_t k = 0; k < d.tests.size(); ++k) {
-    const TestData& t = d.tests[k];
-    // What the test measured: stress under strain control, strain under stress control.
-    const bool strain_measured = t.control == Control::stress;
-    const std::vector<double>& data = strain_measured ? t.strain : t.stress_pa;
-    const std::string quantity = strain_measured ? "strain" : "stress", unit = strain_measured ? "strain [-]" : "stress [Pa]";
-    const auto yb = predict_measured(a.baseline.model, t), yf = predict_measured(a.final.model, t);
-    std::vector<double> rb, rf;
-    for (std::size_t i = 0; i < yb.size(); ++i) {
-      rb.push_back(data[i] - yb[i]);
-      rf.push_back(data[i] - yf[i]);
-    }
-    const std::string name_fit = stem(t.file) + "_fit.svg", name_res = stem(t.file) + "_residual.svg";
-    // Time since the first sample (plus one sampling interval), on a log axis: ramps and holds
-    // that last from 0.1 s to minutes are all visible.
-    std::vector<double> since;
-    const double offset = t.time_s[1] - t.time_s[0];
-    for (double x : t.time_s) since.push_back(x - t.time_s[0] + offset);
-    plot::Figure fit{t.file + ": " + quantity + ", data and models (fitted to all tests)",
-                     "time since the first sample [s] (log)",
-                     unit,
-                     {{"data", since, data, "#000000", "", 2.0},
-                      {"baseline (" + std::to_string(a.baseline.model.parameter_count()) + " parameters)", since, yb, "#1f77b4", "8 4", 1.6},
-                      {"final (" + std::to_string(a.final.model.parameter_count()) + " parameters)", since, yf, "#d62728", "", 1.6}}};
-    fit.log_x = true;
-    plot::write_svg((fs::path(out_dir) / name_fit).string(), fit);
-    plot::Figure res{t.file + ": residual (data - model)",
-                     "time since the first sample [s] (log)",
-                     "residual, " + unit,
-                     {{"baseline", since, rb, "#1f77b4", "8 4", 1.6}, {"final", since, rf, "#d62728", "", 1.6}}};
-    res.log_x = true;
-    plot::write_svg((fs::path(out_dir) / name_res).string(), res);
-    md << "### " << t.file << " (" << to_string(t.control) << " control)\n\n![" << t.file << "](" << name_fit << ")\n\n![residual](" << name_res
-       << ")\n\n";
-  }
+  for (const TestData& t : d.tests) md_test_plots(md, a, t, out_dir);
 }
 
 void write_prediction(const MaterialModel& m, const std::string& model_path, const Dataset& d, const std::string& out_dir) {

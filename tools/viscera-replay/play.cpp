@@ -66,182 +66,234 @@ std::string seconds(std::uint64_t ns) {
   return b;
 }
 
-}  // namespace
+/// One playback: the recording, the partition's writers, the scene state the replay shows (the
+/// recording's newest, with the playback's pause and the outcomes of the requests sent to the
+/// replayer), the clock, and the keys.
+class Player {
+ public:
+  Player(const PlayOptions& o, const std::atomic<bool>& stop)
+      : o_(o),
+        stop_(stop),
+        recording_(o.recording),
+        t0_(recording_.start_ns()),
+        t_end_(recording_.end_ns()),
+        from_(at(o.from_s)),
+        to_(o.to_s ? std::min(at(*o.to_s), t_end_) : t_end_),
+        domain_(o.domain ? *o.domain : recording_.domain_id()),
+        live_server_("station '" + common::printable(o.partition, 80) +
+                     "' holds a live viscera-server: a replay never drives one (choose a station name of its own)") {
+    if (from_ > t_end_)
+      throw common::InputError(o.recording, 0, "--from",
+                               seconds(from_ - t0_) + " is past the recording's end (it spans " + seconds(t_end_ - t0_) + ")");
+    if (from_ > to_)
+      throw common::InputError(o.recording, 0, "--from/--to", "the interval is empty (the recording spans " + seconds(t_end_ - t0_) + ")");
+  }
 
-int play(const PlayOptions& o, const std::atomic<bool>& stop) {
-  rec::Recording recording(o.recording);
-  const std::uint64_t t0 = recording.start_ns(), t_end = recording.end_ns();
-  const auto at = [&](double s) { return t0 + static_cast<std::uint64_t>(std::max(0.0, s) * 1e9); };
-  if (at(o.from_s) > t_end)
-    throw common::InputError(o.recording, 0, "--from",
-                             seconds(at(o.from_s) - t0) + " is past the recording's end (it spans " + seconds(t_end - t0) + ")");
-  const std::uint64_t from = at(o.from_s), to = o.to_s ? std::min(at(*o.to_s), t_end) : t_end;
-  if (from > to) throw common::InputError(o.recording, 0, "--from/--to", "the interval is empty (the recording spans " + seconds(t_end - t0) + ")");
-  const std::uint32_t domain = o.domain ? *o.domain : recording.domain_id();
+  int run() {
+    client::StreamPublisher publisher(domain_, o_.partition);
+    client::StreamTap requests(domain_, o_.partition, {proto::Stream::session_request}, 64);
+    publisher_ = &publisher;
+    requests_ = &requests;
+    // Writers for every stream the recording has, then a moment for the partition's clients to be
+    // discovered: a volatile sample written before a reader is known never reaches it.
+    std::map<proto::Stream, bool> streams;
+    for (const auto& [id, ch] : recording_.channels()) streams[ch.stream] = true;
+    for (const auto& [s, _] : streams) publisher.open(s);
+    publisher.wait_for_readers(std::chrono::milliseconds(static_cast<long long>(o_.discovery_s * 1000)));
+    if (publisher.live_server()) throw common::InputError("--station", 0, "", live_server_);
 
-  client::StreamPublisher publisher(domain, o.partition);
-  client::StreamTap requests(domain, o.partition, {proto::Stream::session_request}, 64);
-  // Writers for every stream the recording has, then a moment for the partition's clients to be
-  // discovered: a volatile sample written before a reader is known never reaches it.
-  std::map<proto::Stream, bool> streams;
-  for (const auto& [id, ch] : recording.channels()) streams[ch.stream] = true;
-  for (const auto& [s, _] : streams) publisher.open(s);
-  publisher.wait_for_readers(std::chrono::milliseconds(static_cast<long long>(o.discovery_s * 1000)));
-  const std::string live_server = "station '" + common::printable(o.partition, 80) +
-                                  "' holds a live viscera-server: a replay never drives one (choose a station name of its own)";
-  if (publisher.live_server()) throw common::InputError("--station", 0, "", live_server);
+    RawTerminal terminal(o_.keys);
+    terminal_ = &terminal;
+    if (!o_.quiet) {
+      std::printf("viscera-replay: playing %s (%s) from %s to %s at %gx onto DDS domain %u, station '%s'%s\n", o_.recording.c_str(),
+                  seconds(t_end_ - t0_).c_str(), seconds(from_ - t0_).c_str(), seconds(to_ - t0_).c_str(), o_.rate, domain_, o_.partition.c_str(),
+                  terminal.active() ? "; keys: space pause/resume, left/right seek 5 s, q quit" : "");
+      std::fflush(stdout);
+    }
+    const auto wall_start = Clock::now();
+    std::uint64_t cursor = from_;
+    clock_.seek(cursor, wall_start);  // the playback starts now, after discovery
+    prime(cursor);
+    while (!quit_ && !stop_.load()) {
+      cursor = play_until_interrupted(cursor);
+      if (quit_ || stop_.load()) break;
+      if (seek_to_) {
+        cursor = *seek_to_;
+        seek_to_.reset();
+      } else if (o_.loop) {
+        cursor = from_;
+      } else {
+        break;
+      }
+      clock_.seek(cursor, Clock::now());
+      prime(cursor);
+    }
+    if (!o_.quiet)
+      std::printf("viscera-replay: published %llu messages in %.1f s\n", static_cast<unsigned long long>(published_),
+                  std::chrono::duration<double>(Clock::now() - wall_start).count());
+    if (server_joined_) {
+      std::fprintf(stderr, "viscera-replay: stopped: %s\n", live_server_.c_str());
+      return 3;
+    }
+    return 0;
+  }
 
-  // The scene state the replay shows: the recording's newest, with the playback's pause and the
-  // outcomes of the requests sent to the replayer.
-  std::optional<proto::Scene> scene;
-  std::deque<proto::RequestOutcome> outcomes;
-  rec::PlaybackClock clock(from, o.rate, Clock::now());
-  const auto publish_scene = [&] {
-    if (!scene) return;
-    proto::Scene s = *scene;
-    s.paused = s.paused || clock.paused();
-    s.recent_requests.insert(s.recent_requests.end(), outcomes.begin(), outcomes.end());
-    publisher.publish(proto::Stream::scene_state, 0, proto::encode(s));
-  };
-  // What a client joining at recording time `t` must have: the newest sample of each state stream
-  // (scene state, surface topology, scene files) before it.
-  const auto prime = [&](std::uint64_t t) {
+ private:
+  std::uint64_t at(double s) const { return t0_ + static_cast<std::uint64_t>(std::max(0.0, s) * 1e9); }
+  std::uint64_t clamp(std::int64_t t) const {
+    return static_cast<std::uint64_t>(std::clamp<std::int64_t>(t, static_cast<std::int64_t>(from_), static_cast<std::int64_t>(to_)));
+  }
+
+  void publish_scene() {
+    if (!scene_) return;
+    proto::Scene s = *scene_;
+    s.paused = s.paused || clock_.paused();
+    s.recent_requests.insert(s.recent_requests.end(), outcomes_.begin(), outcomes_.end());
+    publisher_->publish(proto::Stream::scene_state, 0, proto::encode(s));
+  }
+
+  /// What a client joining at recording time `t` must have: the newest sample of each state
+  /// stream (scene state, surface topology, scene files) before it.
+  void prime(std::uint64_t t) {
     std::map<std::pair<proto::Stream, std::uint32_t>, std::vector<std::uint8_t>> last;
-    recording.for_each(
+    recording_.for_each(
         [&](const rec::RecordedChannel& ch, const mcap::Message& m) {
           if (proto::stream_info(ch.stream).state) last[{ch.stream, ch.source_id}] = m.data;
           return true;
         },
-        t0, t);
+        t0_, t);
     std::string why;
     for (const auto& [key, payload] : last) {
       if (key.first == proto::Stream::scene_state) {
-        scene = proto::decode_scene(payload, &why);
+        scene_ = proto::decode_scene(payload, &why);
         publish_scene();
       } else {
-        publisher.publish(key.first, key.second, payload);
+        publisher_->publish(key.first, key.second, payload);
       }
     }
-  };
+  }
 
-  RawTerminal terminal(o.keys);
-  if (!o.quiet) {
-    std::printf("viscera-replay: playing %s (%s) from %s to %s at %gx onto DDS domain %u, station '%s'%s\n", o.recording.c_str(),
-                seconds(t_end - t0).c_str(), seconds(from - t0).c_str(), seconds(to - t0).c_str(), o.rate, domain, o.partition.c_str(),
-                terminal.active() ? "; keys: space pause/resume, left/right seek 5 s, q quit" : "");
+  /// Publishes from `cursor` at the clock's pace until the end, a seek, a quit or the stop;
+  /// returns the recording time of the last message published.
+  std::uint64_t play_until_interrupted(std::uint64_t cursor) {
+    recording_.for_each(
+        [&](const rec::RecordedChannel& ch, const mcap::Message& m) {
+          if (!wait_until_due(m.log_time)) return false;
+          if (ch.stream == proto::Stream::scene_state) {
+            std::string why;
+            if (auto s = proto::decode_scene(m.data, &why)) scene_ = std::move(s);
+            publish_scene();
+          } else {
+            publisher_->publish(ch.stream, ch.source_id, m.data);
+          }
+          ++published_;
+          cursor = m.log_time;
+          print_status(cursor);
+          return true;
+        },
+        cursor, to_);
+    return cursor;
+  }
+
+  /// Handles input until recording time `t` is due; false when playing must stop (seek, quit).
+  bool wait_until_due(std::uint64_t t) {
+    for (;;) {
+      handle_input();
+      if (quit_ || seek_to_ || stop_.load()) return false;
+      const auto now = Clock::now();
+      const auto due = clock_.due(t);
+      if (now >= due) return true;
+      std::this_thread::sleep_for(std::min<Clock::duration>(due - now, std::chrono::milliseconds(10)));
+    }
+  }
+
+  void print_status(std::uint64_t cursor) {
+    if (o_.quiet || Clock::now() - last_status_ < std::chrono::seconds(1)) return;
+    last_status_ = Clock::now();
+    std::printf("viscera-replay: %s of %s%s, %llu messages\n", seconds(cursor - t0_).c_str(), seconds(to_ - t0_).c_str(),
+                clock_.paused() ? " (paused)" : "", static_cast<unsigned long long>(published_));
     std::fflush(stdout);
   }
-  prime(from);
-  bool quit = false;
-  std::optional<std::uint64_t> seek_to;
-  const auto clamp = [&](std::int64_t t) {
-    return static_cast<std::uint64_t>(std::clamp<std::int64_t>(t, static_cast<std::int64_t>(from), static_cast<std::int64_t>(to)));
-  };
-  // Keys and session requests: pause, resume, seek, quit; and a server that joins the partition.
-  bool server_joined = false;
-  auto server_checked = Clock::now();
-  const auto handle_input = [&] {
+
+  /// Keys and session requests: pause, resume, seek, quit; and a server that joins the partition.
+  void handle_input() {
     const auto now = Clock::now();
-    if (now - server_checked >= std::chrono::milliseconds(100)) {
-      server_checked = now;
-      server_joined = publisher.live_server();
-      quit = quit || server_joined;
+    if (now - server_checked_ >= std::chrono::milliseconds(100)) {
+      server_checked_ = now;
+      server_joined_ = publisher_->live_server();
+      quit_ = quit_ || server_joined_;
     }
-    const std::string keys = terminal.keys();
+    handle_keys(terminal_->keys(), now);
+    bool answered = false;
+    requests_->take([&](const client::TapSample& s) {
+      std::string why;
+      if (const auto r = proto::decode_session_request(s.payload, &why)) {
+        outcomes_.push_back(answer(*r, now));
+        while (outcomes_.size() > 8) outcomes_.pop_front();
+        answered = true;
+      }
+    });
+    if (answered) publish_scene();
+  }
+
+  void handle_keys(const std::string& keys, Clock::time_point now) {
     for (std::size_t i = 0; i < keys.size(); ++i) {
       const char k = keys[i];
-      if (k == 'q') quit = true;
-      if (k == ' ') clock.paused() ? clock.resume(now) : clock.pause(now);
+      if (k == 'q') quit_ = true;
+      if (k == ' ') clock_.paused() ? clock_.resume(now) : clock_.pause(now);
       if (k == '\x1b' && i + 2 < keys.size() && keys[i + 1] == '[') {
-        const std::int64_t pos = static_cast<std::int64_t>(clock.position(now));
-        if (keys[i + 2] == 'C') seek_to = clamp(pos + 5'000'000'000);
-        if (keys[i + 2] == 'D') seek_to = clamp(pos - 5'000'000'000);
+        const auto pos = static_cast<std::int64_t>(clock_.position(now));
+        if (keys[i + 2] == 'C') seek_to_ = clamp(pos + 5'000'000'000);
+        if (keys[i + 2] == 'D') seek_to_ = clamp(pos - 5'000'000'000);
         i += 2;
       }
     }
-    bool changed = false;
-    requests.take([&](const client::TapSample& s) {
-      std::string why;
-      const auto r = proto::decode_session_request(s.payload, &why);
-      if (!r) return;
-      proto::RequestOutcome out{r->client_id, r->request_seq, r->action, true, ""};
-      switch (r->action) {
-        case proto::Action::pause:
-          clock.pause(now);
-          out.message = "replay paused at " + seconds(clock.position(now) - t0);
-          break;
-        case proto::Action::resume:
-          clock.resume(now);
-          out.message = "replay resumed at " + seconds(clock.position(now) - t0);
-          break;
-        case proto::Action::seek:
-          seek_to = clamp(static_cast<std::int64_t>(at(r->seek_s)));
-          out.message = "replay sought to " + seconds(*seek_to - t0);
-          break;
-        default:
-          out.accepted = false;
-          out.message = std::string("a replay cannot ") + proto::action_name(r->action) + " (it plays a recording; control a live server instead)";
-      }
-      outcomes.push_back(out);
-      while (outcomes.size() > 8) outcomes.pop_front();
-      changed = true;
-    });
-    if (changed) publish_scene();
-  };
+  }
 
-  std::uint64_t published = 0, cursor = from;
-  auto last_status = Clock::now();
-  const auto wall_start = Clock::now();
-  while (!quit && !stop.load()) {
-    recording.for_each(
-        [&](const rec::RecordedChannel& ch, const mcap::Message& m) {
-          for (;;) {
-            handle_input();
-            if (quit || seek_to || stop.load()) return false;
-            const auto now = Clock::now();
-            const auto due = clock.due(m.log_time);
-            if (now >= due) break;
-            std::this_thread::sleep_for(std::min<Clock::duration>(due - now, std::chrono::milliseconds(10)));
-          }
-          if (ch.stream == proto::Stream::scene_state) {
-            std::string why;
-            if (auto s = proto::decode_scene(m.data, &why)) scene = std::move(s);
-            publish_scene();
-          } else {
-            publisher.publish(ch.stream, ch.source_id, m.data);
-          }
-          ++published;
-          cursor = m.log_time;
-          if (!o.quiet && Clock::now() - last_status >= std::chrono::seconds(1)) {
-            last_status = Clock::now();
-            std::printf("viscera-replay: %s of %s%s, %llu messages\n", seconds(cursor - t0).c_str(), seconds(to - t0).c_str(),
-                        clock.paused() ? " (paused)" : "", static_cast<unsigned long long>(published));
-            std::fflush(stdout);
-          }
-          return true;
-        },
-        cursor, to);
-    if (quit || stop.load()) break;
-    if (seek_to) {
-      cursor = *seek_to;
-      seek_to.reset();
-      clock.seek(cursor, Clock::now());
-      prime(cursor);
-      continue;
+  /// A session request sent to the replayer: pause, resume and seek act on the playback; the
+  /// rest are refused with the reason.
+  proto::RequestOutcome answer(const proto::SessionRequest& r, Clock::time_point now) {
+    proto::RequestOutcome out{r.client_id, r.request_seq, r.action, true, ""};
+    switch (r.action) {
+      case proto::Action::pause:
+        clock_.pause(now);
+        out.message = "replay paused at " + seconds(clock_.position(now) - t0_);
+        break;
+      case proto::Action::resume:
+        clock_.resume(now);
+        out.message = "replay resumed at " + seconds(clock_.position(now) - t0_);
+        break;
+      case proto::Action::seek:
+        seek_to_ = clamp(static_cast<std::int64_t>(at(r.seek_s)));
+        out.message = "replay sought to " + seconds(*seek_to_ - t0_);
+        break;
+      default:
+        out.accepted = false;
+        out.message = std::string("a replay cannot ") + proto::action_name(r.action) + " (it plays a recording; control a live server instead)";
     }
-    if (!o.loop) break;
-    cursor = from;
-    clock.seek(from, Clock::now());
-    prime(from);
+    return out;
   }
-  if (!o.quiet)
-    std::printf("viscera-replay: published %llu messages in %.1f s\n", static_cast<unsigned long long>(published),
-                std::chrono::duration<double>(Clock::now() - wall_start).count());
-  if (server_joined) {
-    std::fprintf(stderr, "viscera-replay: stopped: %s\n", live_server.c_str());
-    return 3;
-  }
-  return 0;
-}
+
+  const PlayOptions& o_;
+  const std::atomic<bool>& stop_;
+  rec::Recording recording_;
+  std::uint64_t t0_, t_end_, from_, to_;
+  std::uint32_t domain_;
+  std::string live_server_;  ///< why a replay stops when a server joins its partition
+  client::StreamPublisher* publisher_ = nullptr;  // alive during run()
+  client::StreamTap* requests_ = nullptr;
+  RawTerminal* terminal_ = nullptr;
+  std::optional<proto::Scene> scene_;
+  std::deque<proto::RequestOutcome> outcomes_;
+  rec::PlaybackClock clock_{from_, o_.rate, Clock::now()};
+  bool quit_ = false, server_joined_ = false;
+  std::optional<std::uint64_t> seek_to_;
+  std::uint64_t published_ = 0;
+  Clock::time_point server_checked_ = Clock::now(), last_status_ = Clock::now();
+};
+
+}  // namespace
+
+int play(const PlayOptions& o, const std::atomic<bool>& stop) { return Player(o, stop).run(); }
 
 }  // namespace viscera::replay

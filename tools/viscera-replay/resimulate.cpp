@@ -38,6 +38,103 @@ struct TempDir {
   }
 };
 
+using ull = unsigned long long;
+
+void print_plan(const ResimulateOptions& o, const rec::LockstepPlan& plan, const rec::ExtractedScenes& scenes) {
+  const std::uint64_t ticks = plan.last_tick - plan.first_tick + 1;
+  std::printf("viscera-replay: re-simulating %s: ticks %llu to %llu (%llu), %llu forces, %llu events, %llu frames recorded\n", o.recording.c_str(),
+              ull(plan.first_tick), ull(plan.last_tick), ull(ticks), ull(plan.recorded_forces), ull(plan.recorded_events), ull(plan.recorded_frames));
+  std::printf("viscera-replay: recorded by %s\n", plan.scene.server_version.c_str());
+  for (const auto& d : scenes.differences) std::printf("viscera-replay: what-if: %s\n", d.c_str());
+  for (const auto& n : plan.notes) std::printf("viscera-replay: note: %s\n", n.c_str());
+  std::fflush(stdout);
+}
+
+/// The lockstep server in a process of its own, driven step by step; its log's tail in every
+/// failure.
+class LockstepRun {
+ public:
+  LockstepRun(const ResimulateOptions& o, const rec::ExtractedScenes& scenes, std::uint32_t domain, const std::string& partition, const fs::path& log)
+      : o_(o),
+        driver_(domain, partition),
+        server_({o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--station", partition, "--quiet"},
+                log.string()) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.server_timeout_s);
+    while (!driver_.wait_for_server(std::chrono::milliseconds(200))) {
+      if (!server_.alive()) fail("the lockstep server (" + o.server + ") stopped before it was ready");
+      if (std::chrono::steady_clock::now() > end)
+        fail("no lockstep server ready within " + std::to_string(static_cast<int>(o.server_timeout_s)) + " s");
+    }
+  }
+
+  /// Every step of the plan, a window of them in flight, each result checked in order; the
+  /// seconds it took.
+  double run(const rec::LockstepPlan& plan, rec::ResimulationCheck& check) {
+    std::uint64_t next_send = plan.first_tick, next_result = plan.first_tick;
+    const auto start = std::chrono::steady_clock::now();
+    auto last_status = start;
+    while (next_result <= plan.last_tick) {
+      for (; next_send <= plan.last_tick && next_send < next_result + static_cast<std::uint64_t>(o_.window); ++next_send) {
+        proto::LockstepStep step = plan.step(next_send);
+        if (next_send == plan.first_tick) step.sim_time_s = plan.sim_time_s;
+        driver_.send(step);
+      }
+      const auto result = driver_.next_result(std::chrono::seconds(30));
+      if (!result) {
+        if (!server_.alive()) fail("the lockstep server stopped at tick " + std::to_string(next_result));
+        fail("no result for tick " + std::to_string(next_result) + " within 30 s");
+      }
+      if (result->tick != next_result)
+        fail("result for tick " + std::to_string(result->tick) + " where tick " + std::to_string(next_result) + " was due" +
+             (result->error.empty() ? "" : " (" + result->error + ")"));
+      check.check(*result);
+      ++next_result;
+      const auto now = std::chrono::steady_clock::now();
+      if (!o_.quiet && now - last_status >= std::chrono::seconds(1)) {
+        last_status = now;
+        const auto ticks = static_cast<double>(plan.last_tick - plan.first_tick + 1);
+        const double done = static_cast<double>(next_result - plan.first_tick) / ticks;
+        const double elapsed = std::chrono::duration<double>(now - start).count();
+        std::printf("viscera-replay: tick %llu of %llu (%.0f%%), %.0f s left; %llu forces identical%s\n", ull(next_result - plan.first_tick),
+                    ull(plan.last_tick - plan.first_tick + 1), 100 * done, done > 0 ? elapsed * (1 - done) / done : 0.0,
+                    ull(check.counts().forces_identical), check.first_divergence() ? ", diverged" : "");
+        std::fflush(stdout);
+      }
+    }
+    server_.stop();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) {
+    const std::string tail = server_.log_tail();
+    throw std::runtime_error(what + (tail.empty() ? "" : "; the lockstep server said:\n" + tail));
+  }
+
+  const ResimulateOptions& o_;
+  client::LockstepDriver driver_;
+  process::ChildProcess server_;
+};
+
+/// The outcome in one line; 0 when bit-identical, else 1.
+int print_outcome(const rec::ResimulationCheck& check, const rec::LockstepPlan& plan) {
+  const auto& c = check.counts();
+  if (check.identical()) {
+    std::printf(
+        "viscera-replay: bit-identical: %llu ticks, %llu forces, %llu events, %llu frames (%llu forces' stiffness differs: the live server's "
+        "compliance timing)\n",
+        ull(c.ticks), ull(c.forces_identical), ull(c.events_identical), ull(c.frames_identical), ull(c.stiffness_differences));
+    return 0;
+  }
+  if (const auto& d = check.first_divergence())
+    std::printf("viscera-replay: diverged: first at tick %llu, %s, %s: %s recorded %s, recomputed %s\n", ull(d->tick), d->topic.c_str(),
+                d->what.c_str(), d->field.c_str(), d->recorded.c_str(), d->recomputed.c_str());
+  else
+    std::printf("viscera-replay: not identical: %llu of %llu forces, %llu of %llu events, %llu of %llu frames reproduced\n", ull(c.forces_identical),
+                ull(plan.recorded_forces), ull(c.events_identical), ull(plan.recorded_events), ull(c.frames_identical), ull(plan.recorded_frames));
+  return 1;
+}
+
 }  // namespace
 
 int resimulate(const ResimulateOptions& o) {
@@ -52,100 +149,23 @@ int resimulate(const ResimulateOptions& o) {
   const rec::ExtractedScenes scenes = rec::extract_scenes(recording, dir.path.string(), o.scene);
   const std::uint32_t domain = o.domain ? *o.domain : recording.domain_id();
   const std::string partition = "viscera-resimulate-" + std::to_string(::getpid()) + "-" + std::to_string(proto::now_ns() % 1000000000);
-  const std::uint64_t ticks = plan.last_tick - plan.first_tick + 1;
-  if (!o.quiet) {
-    std::printf("viscera-replay: re-simulating %s: ticks %llu to %llu (%llu), %llu forces, %llu events, %llu frames recorded\n", o.recording.c_str(),
-                static_cast<unsigned long long>(plan.first_tick), static_cast<unsigned long long>(plan.last_tick),
-                static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(plan.recorded_forces),
-                static_cast<unsigned long long>(plan.recorded_events), static_cast<unsigned long long>(plan.recorded_frames));
-    std::printf("viscera-replay: recorded by %s\n", plan.scene.server_version.c_str());
-    for (const auto& d : scenes.differences) std::printf("viscera-replay: what-if: %s\n", d.c_str());
-    for (const auto& n : plan.notes) std::printf("viscera-replay: note: %s\n", n.c_str());
-    std::fflush(stdout);
-  }
-
-  client::LockstepDriver driver(domain, partition);
-  process::ChildProcess server(
-      {o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--station", partition, "--quiet"},
-      (dir.path / "server.log").string());
-  const auto fail = [&](const std::string& what) -> int {
-    const std::string tail = server.log_tail();
-    throw std::runtime_error(what + (tail.empty() ? "" : "; the lockstep server said:\n" + tail));
-  };
-  {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.server_timeout_s);
-    while (!driver.wait_for_server(std::chrono::milliseconds(200))) {
-      if (!server.alive()) return fail("the lockstep server (" + o.server + ") stopped before it was ready");
-      if (std::chrono::steady_clock::now() > end)
-        return fail("no lockstep server ready within " + std::to_string(static_cast<int>(o.server_timeout_s)) + " s");
-    }
-  }
+  if (!o.quiet) print_plan(o, plan, scenes);
 
   rec::ResimulationCheck check(plan, recording);
-  std::uint64_t next_send = plan.first_tick, next_result = plan.first_tick;
-  const auto start = std::chrono::steady_clock::now();
-  auto last_status = start;
-  while (next_result <= plan.last_tick) {
-    while (next_send <= plan.last_tick && next_send < next_result + static_cast<std::uint64_t>(o.window)) {
-      proto::LockstepStep step = plan.step(next_send);
-      if (next_send == plan.first_tick) step.sim_time_s = plan.sim_time_s;
-      driver.send(step);
-      ++next_send;
-    }
-    const auto result = driver.next_result(std::chrono::seconds(30));
-    if (!result) {
-      if (!server.alive()) return fail("the lockstep server stopped at tick " + std::to_string(next_result));
-      return fail("no result for tick " + std::to_string(next_result) + " within 30 s");
-    }
-    if (result->tick != next_result)
-      return fail("result for tick " + std::to_string(result->tick) + " where tick " + std::to_string(next_result) + " was due" +
-                  (result->error.empty() ? "" : " (" + result->error + ")"));
-    check.check(*result);
-    ++next_result;
-    const auto now = std::chrono::steady_clock::now();
-    if (!o.quiet && now - last_status >= std::chrono::seconds(1)) {
-      last_status = now;
-      const double done = static_cast<double>(next_result - plan.first_tick) / static_cast<double>(ticks);
-      const double elapsed = std::chrono::duration<double>(now - start).count();
-      std::printf("viscera-replay: tick %llu of %llu (%.0f%%), %.0f s left; %llu forces identical%s\n",
-                  static_cast<unsigned long long>(next_result - plan.first_tick), static_cast<unsigned long long>(ticks), 100 * done,
-                  done > 0 ? elapsed * (1 - done) / done : 0.0, static_cast<unsigned long long>(check.counts().forces_identical),
-                  check.first_divergence() ? ", diverged" : "");
-      std::fflush(stdout);
-    }
-  }
-  server.stop();
+  const double seconds = LockstepRun(o, scenes, domain, partition, dir.path / "server.log").run(plan, check);
 
   nlohmann::json report = check.report();
   report["recording"] = o.recording;
   report["recorded_by"] = plan.scene.server_version;
   report["scene"] = o.scene ? *o.scene : plan.scene.file("scene") ? plan.scene.file("scene")->path : "";
   report["what_if"] = scenes.differences;
-  report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report["seconds"] = seconds;
   if (o.report) {
     std::ofstream out(*o.report);
     out << report.dump(2) << "\n";
     if (!out) throw common::InputError(*o.report, 0, "", "cannot write the report");
   }
-  const auto& c = check.counts();
-  if (check.identical()) {
-    std::printf(
-        "viscera-replay: bit-identical: %llu ticks, %llu forces, %llu events, %llu frames (%llu forces' stiffness differs: the live server's "
-        "compliance timing)\n",
-        static_cast<unsigned long long>(c.ticks), static_cast<unsigned long long>(c.forces_identical),
-        static_cast<unsigned long long>(c.events_identical), static_cast<unsigned long long>(c.frames_identical),
-        static_cast<unsigned long long>(c.stiffness_differences));
-    return 0;
-  }
-  if (const auto& d = check.first_divergence())
-    std::printf("viscera-replay: diverged: first at tick %llu, %s, %s: %s recorded %s, recomputed %s\n", static_cast<unsigned long long>(d->tick),
-                d->topic.c_str(), d->what.c_str(), d->field.c_str(), d->recorded.c_str(), d->recomputed.c_str());
-  else
-    std::printf("viscera-replay: not identical: %llu of %llu forces, %llu of %llu events, %llu of %llu frames reproduced\n",
-                static_cast<unsigned long long>(c.forces_identical), static_cast<unsigned long long>(plan.recorded_forces),
-                static_cast<unsigned long long>(c.events_identical), static_cast<unsigned long long>(plan.recorded_events),
-                static_cast<unsigned long long>(c.frames_identical), static_cast<unsigned long long>(plan.recorded_frames));
-  return 1;
+  return print_outcome(check, plan);
 }
 
 }  // namespace viscera::replay

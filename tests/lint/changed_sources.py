@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""The C++ sources a change touches: every .cpp changed since BASE, and every .cpp whose object
+file includes (directly or not) a header changed since BASE, read from the build's dependency log
+(ninja -t deps). Prints repository-relative paths, one a line, sorted.
+
+Usage: changed_sources.py BUILD_DIR SOURCE_DIR BASE   (BASE: a commit; "all": every .cpp)"""
+import os
+import subprocess
+import sys
+
+
+def git(src, *args):
+    return subprocess.run(["git", "-C", src, *args], check=True, capture_output=True, text=True).stdout.split("\n")
+
+
+def main():
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    build, src, base = (os.path.realpath(sys.argv[1]), os.path.realpath(sys.argv[2]), sys.argv[3])
+    if base == "all":
+        sources = {f for f in git(src, "ls-files", "*.cpp") if f}
+    else:
+        changed = {f for f in git(src, "diff", "--name-only", "--diff-filter=d", base, "--") if f}
+        sources = {f for f in changed if f.endswith(".cpp")}
+        headers = {f for f in changed if f.endswith((".hpp", ".h", ".inl"))}
+        if headers:
+            deps = subprocess.run(["ninja", "-C", build, "-t", "deps"], check=True, capture_output=True, text=True).stdout
+            source, includes = None, False
+            for line in deps.split("\n"):
+                if line and not line.startswith(" "):  # an object: its source is the next line
+                    source, includes = None, False
+                    continue
+                path = line.strip()
+                if not path:
+                    continue
+                rel = os.path.relpath(os.path.normpath(os.path.join(build, path)), src)
+                if source is None:
+                    source = rel
+                elif not includes and rel in headers:
+                    includes = True
+                    if source.endswith(".cpp") and not source.startswith(".."):
+                        sources.add(source)
+    for f in sorted(sources):
+        if not f.startswith("tests/fuzz/") and os.path.exists(os.path.join(src, f)):
+            print(f)
+
+
+if __name__ == "__main__":
+    main()
