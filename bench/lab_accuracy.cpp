@@ -2,11 +2,16 @@
 // independent generator (lab_protocols.hpp), one truth each, at today's effect sizes and at 0.3x
 // and 0.1x; the lab sees only the folder. Prints the accuracy per truth and size, the confusion
 // between causes and the false-positive rate on the "none" sets, as Markdown (docs/LAB.md).
-//   lab_accuracy [--seeds N] [--none N] [--dir DIR]
+// With --adequacy, the adequacy verdict instead (issue 36): how often the final model is said not to
+// explain the data, on truths inside the catalogue (should be rare) and outside it (permanent set,
+// instrument drift, rate thinning, grip slip: should be nearly always), seeds from --first-seed.
+//   lab_accuracy [--seeds N] [--none N] [--dir DIR] [--adequacy] [--first-seed K]
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -24,19 +29,49 @@ std::string causes_of(const Analysis& a) {
   return s.empty() ? "none" : s;
 }
 
+/// The adequacy table: per truth, on how many sets the final model was said not to explain the data.
+void adequacy_table(const std::function<Analysis(test::LabTruth, double, unsigned)>& run, int seeds, int first_seed) {
+  std::printf("| truth | in the catalogue | said not explained | residual / noise (min - max) |\n|---|---|---|---|\n");
+  int flagged[2] = {0, 0}, total[2] = {0, 0};
+  for (int t = 0; t <= static_cast<int>(test::LabTruth::grip_slip); ++t) {
+    const auto truth = static_cast<test::LabTruth>(t);
+    const bool outside = test::out_of_catalogue(truth);
+    int n = 0;
+    double lo = 1e300, hi = 0;
+    for (int s = first_seed; s < first_seed + seeds; ++s) {
+      const Analysis a = run(truth, 1.0, static_cast<unsigned>(s));
+      n += !a.adequacy.explained;
+      lo = std::min(lo, a.adequacy.residual_to_noise);
+      hi = std::max(hi, a.adequacy.residual_to_noise);
+    }
+    flagged[outside] += n;
+    total[outside] += seeds;
+    std::printf("| %s | %s | %d of %d | %.2f - %.2f |\n", test::name(truth), outside ? "no" : "yes", n, seeds, lo, hi);
+    std::fflush(stdout);
+  }
+  std::printf("\nInside the catalogue: said not explained on %d of %d sets; outside it: on %d of %d.\n", flagged[0], total[0], flagged[1], total[1]);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int seeds = 20, nones = 100;
+  int seeds = 20, nones = 100, first_seed = 1;
+  bool adequacy = false;
   std::string dir = (std::filesystem::temp_directory_path() / "viscera_lab_accuracy").string();
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
+    if (a == "--adequacy") {
+      adequacy = true;
+      continue;
+    }
     if (a == "--help" || a == "-h") {
       std::printf(
-          "Usage: lab_accuracy [--seeds N] [--none N] [--dir DIR]\n"
+          "Usage: lab_accuracy [--seeds N] [--none N] [--dir DIR] [--adequacy] [--first-seed K]\n"
           "Runs viscera-lab on data sets from the independent generator of tests/lab (N seeds per truth and effect size,\n"
           "and N 'none' sets) and prints accuracy per truth, the confusion between causes and the false-positive rate\n"
-          "as Markdown. Defaults: 20 seeds, 100 none sets, data sets written under the system's temporary folder.\n");
+          "as Markdown. Defaults: 20 seeds, 100 none sets, data sets written under the system's temporary folder.\n"
+          "--adequacy: instead, per truth inside and outside the catalogue of causes, how often the final model is said not to\n"
+          "explain the data (N seeds from K, default 1).\n");
       return 0;
     }
     if (k + 1 >= argc) {
@@ -50,6 +85,8 @@ int main(int argc, char** argv) {
       nones = std::atoi(v.c_str());
     else if (a == "--dir")
       dir = v;
+    else if (a == "--first-seed")
+      first_seed = std::atoi(v.c_str());
     else {
       std::fprintf(stderr, "lab_accuracy: unknown option %s (see --help)\n", a.c_str());
       return 2;
@@ -64,8 +101,13 @@ int main(int argc, char** argv) {
     const std::string folder = dir + "/" + test::name(truth) + "_" + std::to_string(size) + "_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
     test::write_lab_dataset(seed, truth, size, folder);
-    return analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});
+    return analyze(read_dataset(folder), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0});
   };
+  if (adequacy) {
+    adequacy_table(run, seeds, first_seed);
+    std::fprintf(stderr, "[%6.0f s] done\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    return 0;
+  }
   std::printf("| truth | in the lab's forms | size | right | named instead (count) |\n|---|---|---|---|---|\n");
   const std::vector<test::LabTruth> truths = {test::LabTruth::exponential_stiffening,
                                               test::LabTruth::polynomial_stiffening,

@@ -441,11 +441,15 @@ std::string verdict_of(const Analysis& a, bool odd_only) {
          "isotropic solid's shear stress is odd in the shear strain).";
   if (a.supported_model().has(Mechanism::strain_stiffening))
     v << " Stiffening form chosen by the fit: " << name(a.supported_model().stiffening_form) << ".";
-  const double supported_rms = a.causes_status == CausesStatus::not_confirmed ? a.baseline.heldout_rms_pa : a.final.heldout_rms_pa;
-  const double excess = supported_rms / std::max(a.noise_pa, 1e-300);
-  if (excess > 2.0)
-    v << " The model it stands by is still " << excess
-      << "x the noise on held-out tests: something the candidate mechanisms do not describe remains.";
+  if (const Adequacy& q = a.adequacy; q.explained) {
+    v << " The model it stands by explains the data within the noise: its residual is " << q.residual_to_noise << "x the noise.";
+  } else {
+    v << " The model it stands by does not explain the data: its residual is " << q.residual_to_noise << "x the noise (at most " << kAdequacyFactor
+      << "x over the tests and " << kAdequacyTestFactor
+      << "x on any strain-controlled test would be explained). Something outside the lab's catalogue remains";
+    for (std::size_t k = 0; k < q.findings.size(); ++k) v << (k ? "; " : ": ") << q.findings[k];
+    v << "." << (a.named_causes().empty() ? "" : " The causes named are the catalogue's best help, not the whole explanation.");
+  }
   if (const NoiseCheck& c = a.noise_check; !c.agree)
     v << " The two noise estimates disagree: " << c.first_pa
       << (c.first_stated ? " Pa from the data's stress_sd_pa, " : " Pa from the differences between neighbouring samples, ") << c.holds_pa
@@ -499,6 +503,12 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
     a.causes_status = !a.nested_not_run.empty()                                                    ? CausesStatus::tentative
                       : gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa) ? CausesStatus::confirmed
                                                                                                    : CausesStatus::not_confirmed;
+  a.adequacy = judge_adequacy(a.supported_model(), d);
+  say(a.adequacy.explained ? fmt("adequacy: explained (residual %.3gx the noise)", a.adequacy.residual_to_noise)
+                           : fmt("adequacy: not explained (residual %.3gx the noise)", a.adequacy.residual_to_noise));
+  if (options.bootstrap_replicates > 0 && d.tests.size() >= 3)
+    say("parameter uncertainties: a bootstrap over tests, " + std::to_string(options.bootstrap_replicates) + " draws");
+  a.uncertainty = bootstrap_over_tests(a.supported_model(), d, options.bootstrap_replicates);
   if (options.specimen) {
     say("simulating baseline and final model on the tetrahedral specimen (GPS, implicit, inertia)");
     a.specimen.push_back(check_on_specimen(a.baseline.model, d, say));

@@ -20,7 +20,8 @@ TEST(HiddenEffect, NamedCorrectlyIn95PercentOf40SeedsWithGainAboveNoise) {
     const std::string folder = root + "/seed_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
     const test::Truth truth = test::write_synthetic_dataset(seed, folder);
-    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});  // the lab sees only the folder
+    const Analysis a =
+        analyze(read_dataset(folder), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0});  // the lab sees only the folder
     const std::string expected = test::effect_name(truth.effect);
     std::string found = a.causes.empty() ? "none" : name(a.causes.front());
     const bool ok = (truth.effect == test::Effect::none) ? a.causes.empty() : (a.causes.size() == 1 && found == expected);
@@ -55,7 +56,7 @@ TEST(HiddenEffect, ContinuousPowerLawRelaxationOutsideTheFamilyIsNamedBroadband)
     const std::string folder = root + "/seed_" + std::to_string(seed);
     std::filesystem::remove_all(folder);
     const test::Truth truth = test::write_power_law_dataset(seed, folder);
-    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false, .nested = false});
+    const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0});
     const bool ok = a.causes.size() == 1 && a.causes.front() == Mechanism::broadband_relaxation;
     correct += ok;
     std::cout << "[ power-law seed " << seed << " ] alpha " << truth.power_alpha << ", tau0 " << truth.power_tau0_s << " s: found";
@@ -150,7 +151,7 @@ ShapeCheck check_shape_on_specimen(unsigned seed, Mechanism mechanism, Mode mode
   test::write_synthetic_dataset(seed, folder);
   const Dataset d = read_dataset(folder);
   EXPECT_EQ(d.mode, mode);
-  const MaterialModel m = analyze(d, {}, {.specimen = false, .nested = false}).final.model;
+  const MaterialModel m = analyze(d, {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0}).final.model;
   EXPECT_TRUE(m.has(mechanism)) << m.describe();
   ShapeCheck check{calibrate_elastic_shape(m, d), {}};
   const auto& c = check.calibration;
@@ -267,7 +268,7 @@ TEST(Specimen, FirstLoadSofteningRunsPerEdgeInBothModes) {
     std::filesystem::remove_all(folder);
     test::write_synthetic_dataset(seed, folder);
     const Dataset d = read_dataset(folder);
-    const MaterialModel m = analyze(d, {}, {.specimen = false}).final.model;
+    const MaterialModel m = analyze(d, {}, {.specimen = false, .bootstrap_replicates = 0}).final.model;
     ASSERT_TRUE(m.has(Mechanism::first_load_softening)) << m.describe();
     std::string why;
     ASSERT_TRUE(specimen_supports(m, d.mode, &why)) << why;

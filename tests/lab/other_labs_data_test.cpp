@@ -157,13 +157,13 @@ TEST(HonestGain, CorrelatedNoiseIsReportedAsTwoEstimatesThatDisagree) {
   truth.noise_correlation = 0.9;
   truth.rate_hz = 100.0;
   truth.hold_s = 30.0;
-  const Analysis a = analyze(clot_like(truth), {}, {.specimen = false, .nested = false});
+  const Analysis a = analyze(clot_like(truth), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0});
   EXPECT_EQ(a.noise_check.tests, 4);
   EXPECT_FALSE(a.noise_check.agree);
   EXPECT_GT(a.noise_check.holds_pa, kNoiseAgreementFactor * a.noise_check.first_pa);
   EXPECT_NE(a.verdict.find("The two noise estimates disagree"), std::string::npos) << a.verdict;
   truth.noise_correlation = 0.0;
-  EXPECT_TRUE(analyze(clot_like(truth), {}, {.specimen = false, .nested = false}).noise_check.agree);
+  EXPECT_TRUE(analyze(clot_like(truth), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0}).noise_check.agree);
 }
 
 // A force logger's resolution coarser than its noise (the pig discs: 0.1 N, 1.3 kPa, over noise
@@ -206,7 +206,7 @@ TEST(SpecimenLimits, ARunPastItsTimeLimitStopsAndSaysWhere) {
   Truth truth;
   truth.tests = 2;
   const Dataset d = clot_like(truth);
-  const MaterialModel m = analyze(d, {}, {.specimen = false, .nested = false}).baseline.model;
+  const MaterialModel m = analyze(d, {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0}).baseline.model;
   try {
     simulate_specimen(m, d, d.tests[0], nullptr, 1e-6);
     FAIL() << "a run with a microsecond to go finished";
@@ -257,7 +257,7 @@ TEST(SpecimenLimits, EachTestRunsOnItsOwnSpecimen) {
   }
   // The specimen of each test: on a box twice as long the same material still misses the data by
   // what the law misses them (a homogeneous uniaxial stretch does not depend on the length).
-  const MaterialModel m = analyze(d, {}, {.specimen = false, .nested = false}).baseline.model;
+  const MaterialModel m = analyze(d, {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0}).baseline.model;
   for (const auto& t : d.tests) {
     const SpecimenResult r = simulate_specimen(m, d, t);
     EXPECT_NEAR(r.rms_pa, rms_error_pa(m, t), 0.02 * rms_error_pa(m, t)) << t.file;

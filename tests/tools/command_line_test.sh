@@ -101,6 +101,7 @@ expect lab-import-no-geometry 2 "import needs --length-m" -- "$lab" import "$tmp
 fi
 if [ "$part" != programs ]; then
 expect lab-analyze 0 "causes (confirmed): broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet
+cp "$tmp/out" "$tmp/lab-analyze.out"
 expect lab-predict 0 "wrote" -- "$lab" predict "$tmp/titin/model.json" "$src/data/titin-passive-muscle" --out "$tmp/predicted"
 # A model file edited by hand: each mistake named by file and field.
 model_case() {  # model_case NAME PATTERN PYTHON-EDIT
@@ -113,7 +114,10 @@ model_case relaxation "relaxation.json: relaxation_time_s\[1\]: 0 is outside" "m
 model_case text "text.json: viscosity_pa_s: \"a lot\" is not a number" "m['viscosity_pa_s'] = 'a lot'"
 model_case softening "softening.json: softening_d: 1.5 is outside" "m['mechanisms'].append('first_load_softening'); m['softening_d'] = 1.5"
 grep -q '"rms_pa"' "$tmp/predicted/report.json" || { echo "FAIL lab-predict: no rms_pa"; failures=$((failures+1)); }
-for key in baseline.model baseline.heldout_rms_pa causes final.model final.heldout_rms_pa gain; do
+grep -q "^adequacy: explained" "$tmp/lab-analyze.out" ||
+  { echo "FAIL lab-analyze: no 'adequacy: explained' line"; failures=$((failures+1)); }
+for key in baseline.model baseline.heldout_rms_pa causes final.model final.heldout_rms_pa gain adequacy.explained adequacy.residual_to_noise \
+  adequacy.findings parameters.method parameters.parameters; do
   python3 -c "import json,sys; r=json.load(open('$tmp/titin/report.json')); v=r
 for k in '$key'.split('.'): v=v[k]" || { echo "FAIL report.json lacks $key"; failures=$((failures+1)); }
 done

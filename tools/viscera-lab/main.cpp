@@ -36,6 +36,8 @@ void print_summary(const Analysis& a, double seconds, const std::string& out) {
   }
   std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
               a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
+  std::printf("adequacy: %s (residual %.3gx the noise)%s\n", a.adequacy.explained ? "explained" : "not explained", a.adequacy.residual_to_noise,
+              a.adequacy.explained ? "" : ": something outside the catalogue remains (report.md)");
   if (!a.nested.empty())
     std::printf("honest gain (nested leave-one-out: mechanisms chosen without the test predicted): %.3gx, held-out RMS %.4g Pa\n", a.nested_gain,
                 a.nested_heldout_rms_pa);

@@ -83,6 +83,45 @@ json specimen_json(const Analysis& a) {
   return out;
 }
 
+json adequacy_json(const Adequacy& q) {
+  json j{{"explained", q.explained},
+         {"residual_to_noise", q.residual_to_noise},
+         {"rule", "explained when the residual of the model fitted to all tests is at most " + std::to_string(kAdequacyFactor) +
+                      "x the noise over the tests (RMS) and at most " + std::to_string(kAdequacyTestFactor) + "x on every strain-controlled test"},
+         {"tests", json::array()},
+         {"phases", json::array()},
+         {"correlation_with_strain_amplitude", q.correlation_amplitude},
+         {"correlation_with_log_strain_rate", q.correlation_rate},
+         {"correlation_with_session_time", q.correlation_session_time},
+         {"set_at_zero_to_noise", q.set_at_zero_to_noise},
+         {"set_samples", q.set_samples},
+         {"findings", q.findings}};
+  for (const auto& t : q.tests)
+    j["tests"].push_back({{"file", t.file},
+                          {"residual_to_noise", t.residual_to_noise},
+                          {"mean_to_noise", t.mean_to_noise},
+                          {"session_start_s", t.session_start_s},
+                          {"judged", t.judged}});
+  for (const auto& p : q.phases) j["phases"].push_back({{"phase", p.phase}, {"residual_to_noise", p.rms_to_noise}, {"samples", p.samples}});
+  return j;
+}
+
+json uncertainty_json(const ParameterUncertainty& u) {
+  json j{{"method", u.method}, {"replicates", u.replicates}, {"parameters", json::array()}};
+  if (!u.not_run.empty()) j["not_run"] = u.not_run;
+  if (u.replicates > 0 && u.same_form != u.replicates) j["draws_with_the_same_stiffening_form"] = u.same_form;
+  for (const auto& p : u.parameters) {
+    json jp{{"name", p.name}, {"unit", p.unit}, {"value", p.value}};
+    if (u.replicates > 0) {
+      jp["standard_error"] = p.standard_error;
+      jp["interval_95"] = {p.low, p.high};
+      jp["determined"] = p.determined;
+    }
+    j["parameters"].push_back(jp);
+  }
+  return j;
+}
+
 /// report.json: every figure of the analysis.
 json report_json(const Analysis& a, const Dataset& d, double seconds) {
   json j;
@@ -105,6 +144,8 @@ json report_json(const Analysis& a, const Dataset& d, double seconds) {
                                {"heldout_rms_after_pa", c.heldout_after_pa},
                                {"accepted", c.accepted},
                                {"evidence", c.evidence}});
+  j["adequacy"] = adequacy_json(a.adequacy);
+  j["parameters"] = uncertainty_json(a.uncertainty);
   j["verdict"] = a.verdict;
   j["specimen"] = specimen_json(a);
   j["seconds"] = seconds;
@@ -174,6 +215,43 @@ void md_candidates(std::ostream& md, const Analysis& a) {
         "held-out RMS by at least 5%; rounds add the best accepted mechanism and try the rest on top.\n\n";
 }
 
+void md_adequacy(std::ostream& md, const Analysis& a) {
+  const Adequacy& q = a.adequacy;
+  md << "## Does the model explain the data?\n\n"
+     << (q.explained ? "**Yes**" : "**No**") << ": the residual of the model the analysis stands by (fitted to all tests) is " << q.residual_to_noise
+     << "x the noise over the tests. Explained means at most " << kAdequacyFactor << "x over the tests and " << kAdequacyTestFactor
+     << "x on every strain-controlled test (a stress-controlled test's strain error, times its apparent modulus, is shown but not "
+        "judged alone).\n\n| test | residual / noise | mean / noise | began in the session [s] |\n|---|---|---|---|\n";
+  for (const auto& t : q.tests)
+    md << "| " << t.file << (t.judged ? "" : " (stress control)") << " | " << t.residual_to_noise << " | " << t.mean_to_noise << " | "
+       << t.session_start_s << " |\n";
+  md << "\n| phase | residual / noise | samples |\n|---|---|---|\n";
+  for (const auto& p : q.phases) md << "| " << p.phase << " | " << p.rms_to_noise << " | " << p.samples << " |\n";
+  md << "\nCorrelation of the squared residual with the strain amplitude " << q.correlation_amplitude << ", with log |strain rate| "
+     << q.correlation_rate << "; of the signed residual with the time since the session began " << q.correlation_session_time
+     << "; mean residual where the command is back at zero after a large excursion " << q.set_at_zero_to_noise << "x the noise (" << q.set_samples
+     << " samples).\n\n";
+  for (const auto& f : q.findings) md << "- " << f << "\n";
+  md << (q.findings.empty() ? "" : "\n");
+}
+
+void md_parameters(std::ostream& md, const Analysis& a) {
+  const ParameterUncertainty& u = a.uncertainty;
+  md << "## Parameters and their uncertainty\n\n" << u.method << ".";
+  if (!u.not_run.empty()) md << " Not measured: " << u.not_run << ".";
+  if (u.replicates > 0 && u.same_form != u.replicates)
+    md << " The stiffening form was chosen again in " << u.same_form << " of " << u.replicates << " draws; B's figures come from those.";
+  md << "\n\n| parameter | value | standard error | 95% interval | determined by the data |\n|---|---|---|---|---|\n";
+  for (const auto& p : u.parameters) {
+    md << "| " << p.name << " [" << p.unit << "] | " << p.value << " | ";
+    if (u.replicates > 0)
+      md << p.standard_error << " | " << p.low << " to " << p.high << " | " << (p.determined ? "yes" : "**no**") << " |\n";
+    else
+      md << "- | - | - |\n";
+  }
+  md << "\n";
+}
+
 void md_specimen(std::ostream& md, const Analysis& a) {
   md << "## On the tetrahedral specimen\n\nEach model also runs on the specimen meshed with tetrahedra (viscera's GPS with memory "
         "variables, backward Euler with adaptive steps, inertia from the specimen's density), driven by the measured history. "
@@ -240,6 +318,8 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   md_noise(md, a, seconds);
   md_errors(md, a, d);
   md_nested(md, a);
+  md_adequacy(md, a);
+  md_parameters(md, a);
   md_candidates(md, a);
   md_specimen(md, a);
   md << "\n## Models\n\n- baseline: `" << a.baseline.model.describe() << "`, E = " << a.baseline.model.modulus_pa

@@ -18,6 +18,10 @@ const char* name(LabTruth t) {
     case LabTruth::broadband: return "broadband";
     case LabTruth::power_law: return "power_law";
     case LabTruth::broadband_and_stiffening: return "broadband_and_stiffening";
+    case LabTruth::permanent_set: return "permanent_set";
+    case LabTruth::instrument_drift: return "instrument_drift";
+    case LabTruth::rate_thinning: return "rate_thinning";
+    case LabTruth::grip_slip: return "grip_slip";
   }
   return "?";
 }
@@ -33,6 +37,10 @@ std::vector<std::string> expected_causes(LabTruth t) {
     case LabTruth::broadband:
     case LabTruth::power_law: return {"broadband_relaxation"};
     case LabTruth::broadband_and_stiffening: return {"broadband_relaxation", "strain_stiffening"};
+    case LabTruth::permanent_set:
+    case LabTruth::instrument_drift:
+    case LabTruth::rate_thinning:
+    case LabTruth::grip_slip: return {};  // none of the catalogue's: whatever is named helps only in part
   }
   return {};
 }
@@ -48,7 +56,13 @@ bool names_expected_causes(LabTruth t, const std::vector<Mechanism>& causes) {
   return true;
 }
 
-bool out_of_family(LabTruth t) { return t == LabTruth::polynomial_stiffening || t == LabTruth::recovering_softening || t == LabTruth::power_law; }
+bool out_of_family(LabTruth t) {
+  return t == LabTruth::polynomial_stiffening || t == LabTruth::recovering_softening || t == LabTruth::power_law || out_of_catalogue(t);
+}
+
+bool out_of_catalogue(LabTruth t) {
+  return t == LabTruth::permanent_set || t == LabTruth::instrument_drift || t == LabTruth::rate_thinning || t == LabTruth::grip_slip;
+}
 
 namespace {
 
@@ -120,9 +134,13 @@ Command growing_cycles(double amplitude, double period_s) {
 struct Elastic {
   const LabDatasetTruth& tr;
   double peak_tension = 0, peak_compression = 0;
+  double plastic = 0;  // permanent_set: the plastic strain
+  double slipped = 0;  // grip_slip: the strain lost in the grips (once)
   double value(double e) const {
     const double E = tr.modulus_pa, B = tr.stiffening_b;
     switch (tr.truth) {
+      case LabTruth::permanent_set: return E * std::clamp(e - plastic, -tr.yield_strain, tr.yield_strain);
+      case LabTruth::grip_slip: return E * (e - slipped);
       case LabTruth::exponential_stiffening:
       case LabTruth::broadband_and_stiffening:
         if (tr.mode == Mode::simple_shear) return (e < 0 ? -1.0 : 1.0) * E / B * std::expm1(B * std::abs(e));
@@ -140,6 +158,8 @@ struct Elastic {
   double slope(double e) const { return (value(e + 1e-8) - value(e - 1e-8)) / 2e-8; }
   // Moves the history over a time step h at strain e (recovery only for recovering softening).
   void advance(double e, double h) {
+    if (tr.truth == LabTruth::permanent_set) plastic = std::clamp(plastic, e - tr.yield_strain, e + tr.yield_strain);
+    if (tr.truth == LabTruth::grip_slip && slipped == 0 && std::abs(value(e)) > tr.slip_stress_pa) slipped = tr.slip_fraction * e;
     double& m = e >= 0 ? peak_tension : peak_compression;
     m = std::max(m, std::abs(e));
     if (tr.truth == LabTruth::recovering_softening && tr.recovery_s > 0) {
@@ -161,7 +181,9 @@ std::vector<double> stress_under_strain(const LabDatasetTruth& tr, const Command
     const double h = std::max((t - walked) / 50, 1e-6);
     for (double u = walked + h; u < t; u += h) f.advance(c.at(u), h);
     walked = t;
-    double sigma = f.value(c.at(t)) + tr.viscosity_pa_s * c.slope(c.piece(t));
+    const double rate = c.slope(c.piece(t));
+    double sigma = f.value(c.at(t)) + tr.viscosity_pa_s * rate;
+    if (tr.thinning_pa > 0) sigma += (rate < 0 ? -1.0 : 1.0) * tr.thinning_pa * std::pow(std::abs(rate) / tr.thinning_rate, tr.thinning_n);
     f.advance(c.at(t), 0.0);
     // Hereditary relaxation on the strain, each linear piece in closed form.
     for (std::size_t k = 1; k < c.t.size() && c.t[k - 1] < t; ++k) {
@@ -244,6 +266,16 @@ LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, co
       tr.spectrum_pa[l] = tr.modulus_pa * between(0.3, 1.0) * size;
       tr.spectrum_tau_s[l] = l == 0 ? log_between(0.3, 3.0) : log_between(5.0, 40.0);
     }
+  if (truth == LabTruth::permanent_set) tr.yield_strain = strain * (1 - between(0.3, 0.6) * size);
+  if (truth == LabTruth::rate_thinning) {
+    tr.thinning_n = between(0.2, 0.5);
+    tr.thinning_rate = strain;  // a strain per second
+    tr.thinning_pa = tr.modulus_pa * strain * between(0.15, 0.4) * size;
+  }
+  if (truth == LabTruth::grip_slip) {
+    tr.slip_stress_pa = tr.modulus_pa * strain * between(0.4, 0.7);
+    tr.slip_fraction = between(0.1, 0.25) * size;
+  }
   if (truth == LabTruth::power_law) {
     tr.power_pa = tr.modulus_pa * between(0.5, 1.5) * size;
     tr.power_alpha = between(0.1, 0.4);
@@ -273,6 +305,19 @@ LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, co
     stresses.push_back(stress_under_strain(tr, s.c, times.back()));
     for (double v : stresses.back()) peak = std::max(peak, std::abs(v));
   }
+  // The session: the tests in the order listed, 60 s apart; a drifting load cell's zero moves by
+  // 4-12% of the peak stress over it.
+  std::vector<double> session_start;
+  double session_s = 0;
+  for (const auto& s : strain_tests) {
+    session_start.push_back(session_s);
+    session_s += s.c.end() + 60.0;
+  }
+  if (truth == LabTruth::instrument_drift) {
+    tr.drift_pa_per_s = (u(rng) < 0.5 ? -1.0 : 1.0) * peak * between(0.04, 0.12) * size / session_s;
+    for (std::size_t k = 0; k < strain_tests.size(); ++k)
+      for (std::size_t i = 0; i < times[k].size(); ++i) stresses[k][i] += tr.drift_pa_per_s * (session_start[k] + times[k][i]);
+  }
   tr.stress_noise_pa = peak * between(0.005, 0.02);
   std::normal_distribution<double> stress_noise(0.0, tr.stress_noise_pa);
   for (std::size_t k = 0; k < strain_tests.size(); ++k) {
@@ -288,7 +333,7 @@ LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, co
     d.tests.push_back(std::move(t));
   }
 
-  if (truth != LabTruth::power_law) {
+  if (truth != LabTruth::power_law && truth != LabTruth::rate_thinning) {
     // Creep and recovery: stress ramped in 0.05 s to what the virgin material carries at a
     // fraction of the strain, held, released in 0.05 s, recovery.
     const Elastic virgin{tr};
@@ -302,7 +347,11 @@ LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, co
     creep.file = "creep_recovery.csv";
     creep.control = Control::stress;
     creep.time_s = sample_times(c, rng);
-    const std::vector<double> exact = strain_under_stress(tr, c, creep.time_s, 1000);
+    // A drifting load cell reads the true stress plus its zero; the machine holds the reading at
+    // the command, so the specimen carries the command less the drift (linear between knots).
+    Command applied = c;
+    for (std::size_t k = 0; k < applied.t.size(); ++k) applied.v[k] -= tr.drift_pa_per_s * (session_s + applied.t[k]);
+    const std::vector<double> exact = strain_under_stress(tr, applied, creep.time_s, 1000);
     double largest = 0;
     for (double e : exact) largest = std::max(largest, std::abs(e));
     tr.strain_noise = largest * between(0.005, 0.02);

@@ -6,9 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "viscera/lab/adequacy.hpp"
 #include "viscera/lab/dataset.hpp"
 #include "viscera/lab/material_model.hpp"
 #include "viscera/lab/noise_check.hpp"
+#include "viscera/lab/parameter_uncertainty.hpp"
 
 namespace viscera::lab {
 
@@ -53,6 +55,8 @@ struct AnalyzeOptions {
   std::size_t max_fit_points = 2000;
   /// Also run the whole selection once per test without it (nested leave-one-out): the honest gain.
   bool nested = true;
+  /// Draws of the bootstrap over tests for the parameters' uncertainties (0: none).
+  int bootstrap_replicates = 40;
 };
 
 /// One fold of the nested leave-one-out: the mechanisms chosen without the test, and the error of
@@ -100,6 +104,10 @@ struct Analysis {
   const MaterialModel& supported_model() const { return causes_status == CausesStatus::not_confirmed ? baseline.model : final.model; }
   /// The causes named as found or tentative: `causes`, or none when they were not confirmed.
   std::vector<Mechanism> named_causes() const { return causes_status == CausesStatus::not_confirmed ? std::vector<Mechanism>{} : causes; }
+  /// Whether the model the analysis stands by explains the data, and what its residual looks like.
+  Adequacy adequacy;
+  /// The standard errors and intervals of that model's parameters.
+  ParameterUncertainty uncertainty;
   std::string verdict;  ///< one paragraph: what is wrong, why, what still does not fit
   std::vector<std::string> decimated;  ///< "file: N rows, fitted on M" for the tests decimated for the fit
   std::vector<SpecimenCheck> specimen;  ///< baseline and final on the specimen

@@ -30,6 +30,11 @@ enum class LabTruth {
   broadband,  // two relaxation times off the lab's decade grid
   power_law,  // E_p (1 + t/tau0)^-alpha relaxation (outside; no creep test: nonlocal in time)
   broadband_and_stiffening,  // two effects at once
+  // Outside the lab's catalogue of causes (issue 36): what real tissue and real instruments add.
+  permanent_set,  // plastic flow: f = E (eps - p), p moving so that |eps - p| <= the yield strain (set left at zero stress)
+  instrument_drift,  // the load cell's zero drifts linearly over the session (tests in a row, 60 s apart)
+  rate_thinning,  // viscous stress a power of the strain rate, |rate|^n with n 0.2-0.5, besides the linear damping
+  grip_slip,  // the specimen slips in its grips once the stress first passes a threshold: a part of the strain is lost
 };
 const char* name(LabTruth t);
 /// What the lab should name for this truth (mechanism names, strongest expected first; empty: none).
@@ -38,6 +43,9 @@ std::vector<std::string> expected_causes(LabTruth t);
 bool names_expected_causes(LabTruth t, const std::vector<Mechanism>& causes);
 /// Whether the truth lies outside the lab's candidate forms.
 bool out_of_family(LabTruth t);
+/// Whether the truth holds an effect outside the lab's catalogue of causes altogether (no mechanism
+/// of the lab's describes it): the adequacy verdict must say the model does not explain the data.
+bool out_of_catalogue(LabTruth t);
 
 struct LabDatasetTruth {
   LabTruth truth = LabTruth::none;
@@ -46,6 +54,10 @@ struct LabDatasetTruth {
   double stiffening_b = 0, compression_ratio = 1, softening_d = 0, recovery_s = 0;
   double spectrum_pa[2] = {0, 0}, spectrum_tau_s[2] = {1, 1};
   double power_pa = 0, power_alpha = 0, power_tau0_s = 1;
+  double yield_strain = 0;  ///< permanent_set
+  double drift_pa_per_s = 0;  ///< instrument_drift: the load cell's zero, per second of the session
+  double thinning_pa = 0, thinning_n = 1, thinning_rate = 1;  ///< rate_thinning: thinning_pa (|rate| / thinning_rate)^n [Pa, -, 1/s]
+  double slip_stress_pa = 0, slip_fraction = 0;  ///< grip_slip: at the first |stress| above slip_stress_pa, this fraction of the strain is lost
   double stress_noise_pa = 0;  ///< SD of the stress noise of the strain-controlled tests
   double strain_noise = 0;  ///< SD of the strain noise of the stress-controlled test
   double creep_stress_noise_pa = 0;  ///< SD of the load cell's noise in the creep test
