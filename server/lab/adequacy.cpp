@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "viscera/lab/format_figures.hpp"
 #include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/stress_controlled.hpp"
 
@@ -49,43 +50,40 @@ Phase phase_of(const std::vector<double>& c, std::size_t i, double still) {
   return direction * c[i] > 0 ? loading : unloading;
 }
 
-std::string fmt(const char* format, double a, double b = 0.0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, format, a, b);
-  return buffer;
-}
-
 /// What stands out in the residual, one sentence each.
 std::vector<std::string> findings_of(const Adequacy& r) {
   std::vector<std::string> out;
   for (const auto& t : r.tests)
     if (t.judged && t.residual_to_noise > kAdequacyTestFactor)
-      out.push_back(t.file + fmt(": the residual is %.3gx its noise (its mean %.3gx)", t.residual_to_noise, t.mean_to_noise));
+      out.push_back(t.file + format_figures(": the residual is %.3gx its noise (its mean %.3gx)", t.residual_to_noise, t.mean_to_noise));
   const auto worst = std::max_element(r.phases.begin(), r.phases.end(), [](const auto& a, const auto& b) { return a.rms_to_noise < b.rms_to_noise; });
   if (worst != r.phases.end() && worst->samples > 0) {
-    std::string s = "the residual is largest in the " + worst->phase + " phase" + fmt(" (%.3gx the noise; ", worst->rms_to_noise);
+    std::string s = "the residual is largest in the " + worst->phase + " phase" + format_figures(" (%.3gx the noise; ", worst->rms_to_noise);
     bool first = true;
     for (const auto& p : r.phases)
       if (&p != &*worst && p.samples > 0) {
-        s += (first ? "" : ", ") + p.phase + fmt(" %.3gx", p.rms_to_noise);
+        s += (first ? "" : ", ") + p.phase + format_figures(" %.3gx", p.rms_to_noise);
         first = false;
       }
     out.push_back(s + ")");
   }
   if (std::abs(r.correlation_amplitude) >= 0.3)
-    out.push_back(fmt(r.correlation_amplitude > 0 ? "it grows with the strain amplitude (correlation %.2f)" : "it is largest at small strains (correlation %.2f)",
-                      r.correlation_amplitude));
+    out.push_back(format_figures(
+        r.correlation_amplitude > 0 ? "it grows with the strain amplitude (correlation %.2f)" : "it is largest at small strains (correlation %.2f)",
+        r.correlation_amplitude));
   if (std::abs(r.correlation_rate) >= 0.3)
-    out.push_back(fmt(r.correlation_rate > 0 ? "it grows with the strain rate (correlation %.2f with log |rate|): a damping that is not linear in the rate?"
-                                             : "it is largest at slow strain rates (correlation %.2f with log |rate|)",
-                      r.correlation_rate));
+    out.push_back(format_figures(r.correlation_rate > 0
+                                     ? "it grows with the strain rate (correlation %.2f with log |rate|): a damping that is not linear in the rate?"
+                                     : "it is largest at slow strain rates (correlation %.2f with log |rate|)",
+                                 r.correlation_rate));
   if (std::abs(r.correlation_session_time) >= 0.5)
-    out.push_back(fmt("its sign follows the time since the session began (correlation %.2f): an instrument whose zero drifts?",
-                      r.correlation_session_time));
+    out.push_back(format_figures("its sign follows the time since the session began (correlation %.2f): an instrument whose zero drifts?",
+                                 r.correlation_session_time));
   if (r.set_samples >= 10 && std::abs(r.set_at_zero_to_noise) >= 2.0)
-    out.push_back(fmt("where the command comes back to zero after a large excursion the model is off by %.3gx the noise on average (%g samples): "
-                      "a set that remains (permanent deformation, or a slip in the grips)?",
-                      r.set_at_zero_to_noise, static_cast<double>(r.set_samples)));
+    out.push_back(
+        format_figures("where the command comes back to zero after a large excursion the model is off by %.3gx the noise on average (%g samples): "
+                       "a set that remains (permanent deformation, or a slip in the grips)?",
+                       r.set_at_zero_to_noise, static_cast<double>(r.set_samples)));
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/lab/decimation.hpp"
 #include "viscera/lab/fit.hpp"
+#include "viscera/lab/format_figures.hpp"
 #include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
 #include "viscera/lab/stress_controlled.hpp"
@@ -30,12 +31,6 @@ constexpr double kSofteningZ = 3.0;
 constexpr std::size_t kBlocks = 4;
 // Wall time one test may take on the specimen before its run stops and says where it was.
 constexpr double kSpecimenSecondsPerTest = 60.0;
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 // First-load softening's physical evidence: at the same strain, the stress on reloading below the
 // previous peak differs from the stress on first loading. A stiffening response
@@ -129,17 +124,17 @@ std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) 
   const auto mean = [](double s, double n) { return n > 0 ? s / n : 0.0; };
   switch (m) {
     case Mechanism::broadband_relaxation:
-      return fmt("during holds the measured stress keeps changing against the model: mean drift %.3g Pa per sample over %.0f hold samples",
-                 mean(hold_drift, hold_n), hold_n);
+      return format_figures("during holds the measured stress keeps changing against the model: mean drift %.3g Pa per sample over %.0f hold samples",
+                            mean(hold_drift, hold_n), hold_n);
     case Mechanism::strain_stiffening:
-      return fmt("secant stiffness grows with strain: mean residual %.3g Pa above 70%% of the largest strain, %.3g Pa at 20-70%%", mean(big, big_n),
-                 mean(mid, mid_n));
+      return format_figures("secant stiffness grows with strain: mean residual %.3g Pa above 70%% of the largest strain, %.3g Pa at 20-70%%",
+                            mean(big, big_n), mean(mid, mid_n));
     case Mechanism::tension_compression_asymmetry:
-      return fmt("tension and compression differ: mean residual %.3g Pa in tension, %.3g Pa (sign-corrected) in compression", mean(tens, tens_n),
-                 mean(comp, comp_n));
+      return format_figures("tension and compression differ: mean residual %.3g Pa in tension, %.3g Pa (sign-corrected) in compression",
+                            mean(tens, tens_n), mean(comp, comp_n));
     case Mechanism::first_load_softening:
-      return fmt("first loading stiffer than reloading: mean residual %.3g Pa on virgin loading, %.3g Pa on reloading", mean(virgin, virgin_n),
-                 mean(reload, reload_n));
+      return format_figures("first loading stiffer than reloading: mean residual %.3g Pa on virgin loading, %.3g Pa on reloading",
+                            mean(virgin, virgin_n), mean(reload, reload_n));
   }
   return "";
 }
@@ -240,7 +235,7 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d, const 
     for (std::size_t k = 0; k < d.tests.size(); ++k) {
       const TestData& t = d.tests[k];
       say("  " + c.model + " on the specimen: " + t.file + " (" + std::to_string(k + 1) + " of " + std::to_string(d.tests.size()) +
-          fmt(", %.4g s of history; at most %.0f s)", t.time_s.back() - t.time_s.front(), kSpecimenSecondsPerTest));
+          format_figures(", %.4g s of history; at most %.0f s)", t.time_s.back() - t.time_s.front(), kSpecimenSecondsPerTest));
       const SpecimenResult r = simulate_specimen(m, d, t, &calibration, kSpecimenSecondsPerTest);
       c.files.push_back(t.file);
       c.specimen_rms_pa.push_back(r.rms_pa);
@@ -296,14 +291,14 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
       s.mechanisms |= 1u << static_cast<unsigned>(m);
       const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       say(std::string("round ") + std::to_string(round) + ": trying " + name(m) + " (candidate " + std::to_string(evaluated + 1) + " of at most " +
-          std::to_string(at_most) + (evaluated > 0 ? fmt("; at most about %.0f s left", spent / evaluated * (at_most - evaluated)) : std::string()) +
-          ")");
+          std::to_string(at_most) +
+          (evaluated > 0 ? format_figures("; at most about %.0f s left", spent / evaluated * (at_most - evaluated)) : std::string()) + ")");
       const ModelEvaluation ev = evaluate(s, d);
       ++evaluated;
       Candidate c{m, round, current.heldout_rms_pa, ev.heldout_rms_pa, false, evidence(m, current.model, d)};
       const double reduction = current.heldout_rms_pa * current.heldout_rms_pa - ev.heldout_rms_pa * ev.heldout_rms_pa;
       bool above_noise = gain_holds(current.heldout_rms_pa, ev.heldout_rms_pa, noise_pa);
-      say(fmt("  held-out RMS %.4g -> %.4g Pa (noise %.4g Pa)", current.heldout_rms_pa, ev.heldout_rms_pa, noise_pa) +
+      say(format_figures("  held-out RMS %.4g -> %.4g Pa (noise %.4g Pa)", current.heldout_rms_pa, ev.heldout_rms_pa, noise_pa) +
           (above_noise ? ": gain above noise" : ": no gain above noise"));
       double gain_measure = reduction;
       if (m == Mechanism::first_load_softening) {
@@ -318,7 +313,7 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
         c.evidence += text;
         if (above_noise && se.z <= kSofteningZ) {
           above_noise = false;
-          say(fmt("  rejected: no first loading stiffer than reloading at the same strain (z = %.2f)", se.z));
+          say(format_figures("  rejected: no first loading stiffer than reloading at the same strain (z = %.2f)", se.z));
         }
         if (!above_noise && se.z > kSofteningZ) {
           // Reloading is often in one test only (the cyclic one), so no other test can show the
@@ -328,9 +323,9 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
           const double rb = current_blocks->heldout_rms_pa * current_blocks->heldout_rms_pa - eb.heldout_rms_pa * eb.heldout_rms_pa;
           above_noise = gain_holds(current_blocks->heldout_rms_pa, eb.heldout_rms_pa, noise_pa);
           gain_measure = rb;
-          c.evidence += fmt("; on held-out blocks of the tests (reloading shows within a test): held-out RMS %.4g -> %.4g Pa",
-                            current_blocks->heldout_rms_pa, eb.heldout_rms_pa);
-          say(fmt("  on held-out blocks: %.4g -> %.4g Pa", current_blocks->heldout_rms_pa, eb.heldout_rms_pa) +
+          c.evidence += format_figures("; on held-out blocks of the tests (reloading shows within a test): held-out RMS %.4g -> %.4g Pa",
+                                       current_blocks->heldout_rms_pa, eb.heldout_rms_pa);
+          say(format_figures("  on held-out blocks: %.4g -> %.4g Pa", current_blocks->heldout_rms_pa, eb.heldout_rms_pa) +
               (above_noise ? ": gain above noise" : ": no gain above noise"));
         }
       }
@@ -389,9 +384,9 @@ void measure_nested(Analysis& a, const Dataset& d, const MaterialModel& structur
   }
   a.nested_heldout_rms_pa = std::sqrt(sq / static_cast<double>(d.tests.size()));
   a.nested_gain = a.baseline.heldout_rms_pa / a.nested_heldout_rms_pa;
-  say(fmt("nested leave-one-out: held-out RMS %.4g Pa (gain %.3gx) where the selection never saw the test; ", a.nested_heldout_rms_pa,
-          a.nested_gain) +
-      fmt("%.4g Pa (gain %.3gx) for the model chosen on all tests", a.final.heldout_rms_pa, a.gain));
+  say(format_figures("nested leave-one-out: held-out RMS %.4g Pa (gain %.3gx) where the selection never saw the test; ", a.nested_heldout_rms_pa,
+                     a.nested_gain) +
+      format_figures("%.4g Pa (gain %.3gx) for the model chosen on all tests", a.final.heldout_rms_pa, a.gain));
 }
 
 /// The verdict in words: what the baseline misses, whether the choice holds on data it did not see,
@@ -479,14 +474,14 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
   a.noise_pa = noise_of(d);
   a.noise_check = check_noise(measured);  // every row: the holds' running means need the original sampling
   if (a.noise_check.tests > 0)
-    say(fmt("noise: %.4g Pa from second differences; %.4g Pa from the spread in ", a.noise_check.first_pa, a.noise_check.holds_pa) +
+    say(format_figures("noise: %.4g Pa from second differences; %.4g Pa from the spread in ", a.noise_check.first_pa, a.noise_check.holds_pa) +
         std::to_string(a.noise_check.holds) + " holds" + (a.noise_check.agree ? " (they agree)" : " (they disagree)"));
   MaterialModel structure;
   structure.relaxation_time_s = relaxation_times_for(d);
   structure.odd_only = d.mode == Mode::simple_shear;
   say("fitting the baseline (linear elastic + Kelvin-Voigt) to " + std::to_string(d.tests.size()) + " tests, leaving each out in turn");
   a.baseline = evaluate(structure, d);
-  say(fmt("baseline: fit RMS %.4g Pa, held-out RMS %.4g Pa, noise %.4g Pa", a.baseline.fit_rms_pa, a.baseline.heldout_rms_pa, a.noise_pa));
+  say(format_figures("baseline: fit RMS %.4g Pa, held-out RMS %.4g Pa, noise %.4g Pa", a.baseline.fit_rms_pa, a.baseline.heldout_rms_pa, a.noise_pa));
   Selection sel = select_mechanisms(a.baseline, d, a.noise_pa, say);
   a.causes = sel.causes;
   a.candidates = sel.candidates;
@@ -504,8 +499,8 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
                       : gain_holds(a.baseline.heldout_rms_pa, a.nested_heldout_rms_pa, a.noise_pa) ? CausesStatus::confirmed
                                                                                                    : CausesStatus::not_confirmed;
   a.adequacy = judge_adequacy(a.supported_model(), d);
-  say(a.adequacy.explained ? fmt("adequacy: explained (residual %.3gx the noise)", a.adequacy.residual_to_noise)
-                           : fmt("adequacy: not explained (residual %.3gx the noise)", a.adequacy.residual_to_noise));
+  say(a.adequacy.explained ? format_figures("adequacy: explained (residual %.3gx the noise)", a.adequacy.residual_to_noise)
+                           : format_figures("adequacy: not explained (residual %.3gx the noise)", a.adequacy.residual_to_noise));
   if (options.bootstrap_replicates > 0 && d.tests.size() >= 3)
     say("parameter uncertainties: a bootstrap over tests, " + std::to_string(options.bootstrap_replicates) + " draws");
   a.uncertainty = bootstrap_over_tests(a.supported_model(), d, options.bootstrap_replicates);

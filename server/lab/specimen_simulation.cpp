@@ -22,6 +22,11 @@ namespace viscera::lab {
 
 using namespace viscera::tissue;
 
+Mat6 specimen_elasticity(double modulus_pa, bool shear) {
+  const double nu = kSpecimenPoissonRatio;
+  return elasticity_matrix(IsotropicElasticity{shear ? 2 * modulus_pa * (1 + nu) : modulus_pa, nu});
+}
+
 bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why) {
   if (m.has(Mechanism::strain_stiffening) && m.stiffening_form == StiffeningForm::ogden) {
     *why = "the GPS's energy form has the exponential and odd laws (gps/fung_map.hpp), not Ogden's: not simulated on the specimen";
@@ -98,12 +103,6 @@ Rig make_rig(Mode mode, const Specimen& sp) {
   rig.gauge = rig.shear ? sp.thickness_m : sp.length_m;
   rig.area = rig.shear ? sp.length_m * sp.width_m : sp.width_m * sp.thickness_m;
   return rig;
-}
-
-/// The law's modulus in GPS terms: uniaxial, it is Young's; simple shear, the shear modulus.
-Mat6 specimen_elasticity(double modulus_pa, bool shear) {
-  const double nu = 0.3;
-  return elasticity_matrix(IsotropicElasticity{shear ? 2 * modulus_pa * (1 + nu) : modulus_pa, nu});
 }
 
 /// The specimen's instantaneous elastic stress at each strain (static solves in order, each from
@@ -206,39 +205,6 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
 
 namespace {
 
-/// The fitted law in GPS terms: unrelaxed modulus E_U = E + sum E_l, weights E_l / E_U on both
-/// shear and bulk parts (the whole D relaxes alike), Kelvin-Voigt time eta / E_U; softening per
-/// edge, as the law per specimen (under the mode's proportional loading the same factor); the
-/// elastic shape in the conservative (energy) form with its constants calibrated to the law's
-/// curve (`shape`, filled when the law has one).
-GpsOptions specimen_gps(const MaterialModel& m, const Dataset& d, const ShapeCalibration* calibration, double* unrelaxed_modulus_pa,
-                        ShapeCalibration* shape) {
-  GpsMechanisms ve;
-  double relaxing = 0.0;
-  if (m.has(Mechanism::broadband_relaxation))
-    for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
-      if (m.relaxation_modulus_pa[l] > 0) relaxing += m.relaxation_modulus_pa[l];
-  const double E_u = m.modulus_pa + relaxing;
-  if (m.has(Mechanism::broadband_relaxation))
-    for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
-      if (m.relaxation_modulus_pa[l] > 0) {
-        ve.viscous.omega_rad_s.push_back(1.0 / m.relaxation_time_s[l]);
-        ve.viscous.shear_weight.push_back(m.relaxation_modulus_pa[l] / E_u);
-      }
-  ve.viscous.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
-  if (m.has(Mechanism::first_load_softening)) ve.softening.d = m.softening_d;
-  if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
-    *shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
-    ve.stiffening = {shape->gps_b, GpsStiffening::Form::energy, gps_shape(m.stiffening_form)};
-    ve.asymmetry.compression_ratio = shape->gps_r;
-  }
-  GpsOptions options;
-  options.variant = GpsVariant::energy_consistent;
-  options.mechanisms = ve;
-  *unrelaxed_modulus_pa = E_u;
-  return options;
-}
-
 /// The test's loading on the rig's moving face: its strain history prescribed on the moving
 /// nodes' x, or its stress history as a traction on the moving face (per pascal, scaled by the
 /// history), along its command path (command_path.hpp), which must outlive them.
@@ -302,21 +268,59 @@ void advance_to(ImplicitIntegrator& integrator, State& s, double end, double int
 
 }  // namespace
 
+GpsLaw gps_law(const MaterialModel& m, const Dataset& d, const ShapeCalibration* calibration) {
+  GpsLaw law;
+  GpsMechanisms& ve = law.mechanisms;
+  double relaxing = 0.0;
+  if (m.has(Mechanism::broadband_relaxation))
+    for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
+      if (m.relaxation_modulus_pa[l] > 0) relaxing += m.relaxation_modulus_pa[l];
+  const double E_u = m.modulus_pa + relaxing;
+  if (m.has(Mechanism::broadband_relaxation))
+    for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l)
+      if (m.relaxation_modulus_pa[l] > 0) {
+        ve.viscous.omega_rad_s.push_back(1.0 / m.relaxation_time_s[l]);
+        ve.viscous.shear_weight.push_back(m.relaxation_modulus_pa[l] / E_u);
+      }
+  ve.viscous.kelvin_voigt_time_s = m.viscosity_pa_s / E_u;
+  if (m.has(Mechanism::first_load_softening)) ve.softening.d = m.softening_d;
+  if (m.has(Mechanism::strain_stiffening) || m.has(Mechanism::tension_compression_asymmetry)) {
+    law.shape = calibration ? *calibration : calibrate_elastic_shape(m, d);
+    ve.stiffening = {law.shape.gps_b, GpsStiffening::Form::energy, gps_shape(m.stiffening_form)};
+    ve.asymmetry.compression_ratio = law.shape.gps_r;
+  }
+  law.unrelaxed_modulus_pa = E_u;
+  return law;
+}
+
 SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration,
+                                 double max_seconds) {
+  SpecimenResult r;
+  r.supported = specimen_supports(m, d.mode, &r.note);
+  if (!r.supported) return r;
+  const GpsLaw law = gps_law(m, d, calibration);
+  const std::string note = r.note;
+  r = simulate_specimen(law.mechanisms, specimen_elasticity(law.unrelaxed_modulus_pa, d.mode == Mode::simple_shear), d, t, max_seconds);
+  r.note = note;
+  r.shape = law.shape;
+  return r;
+}
+
+SpecimenResult simulate_specimen(const GpsMechanisms& mechanisms, const Mat6& unrelaxed_elasticity, const Dataset& d, const TestData& t,
                                  double max_seconds) {
   const auto deadline = max_seconds > 0
                             ? std::chrono::steady_clock::now() +
                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(max_seconds))
                             : std::chrono::steady_clock::time_point::max();
   SpecimenResult r;
-  r.supported = specimen_supports(m, d.mode, &r.note);
-  if (!r.supported) return r;
+  r.supported = true;
   const Specimen& sp = specimen_of(d, t);
   const Rig rig = make_rig(d.mode, sp);
   const auto& mesh = rig.mesh;
-  double E_u = 0.0;
-  const GpsOptions options = specimen_gps(m, d, calibration, &E_u, &r.shape);
-  const GpsModel model(mesh, {specimen_elasticity(E_u, rig.shear)}, {}, options);
+  GpsOptions options;
+  options.variant = GpsVariant::energy_consistent;
+  options.mechanisms = mechanisms;
+  const GpsModel model(mesh, {unrelaxed_elasticity}, {}, options);
   const CommandPath path = command_path(t.time_s, t.control == Control::strain ? t.strain : t.stress_pa);
   ImplicitIntegrator integrator(model, std::vector<double>(mesh->tet_count(), sp.density_kg_m3), specimen_loading(rig, sp, t, path),
                                 {1e-3, 0.0, 1e-8, 25, kSpecimenResidualToNoise * noise_level_pa(t) * rig.area});

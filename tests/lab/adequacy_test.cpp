@@ -11,6 +11,8 @@
 //   independent_data_test (at most 5% flagged).
 // - The bootstrap over tests: on Kelvin-Voigt data whose every test is slow, the viscosity is said
 //   not to be determined while the modulus is, with an interval that holds the truth.
+#include "viscera/lab/adequacy.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -19,7 +21,6 @@
 
 #include <gtest/gtest.h>
 
-#include "viscera/lab/adequacy.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/fit.hpp"
 #include "viscera/lab/lab_protocols.hpp"
@@ -142,7 +143,8 @@ TEST(Adequacy, ASlipInTheGripsIsFlagged) {
 
 TEST(Adequacy, OutsideTheCatalogueTheLabSaysItsModelDoesNotExplainTheData) {
   int flagged = 0, total = 0;
-  for (test::LabTruth truth : {test::LabTruth::permanent_set, test::LabTruth::instrument_drift, test::LabTruth::rate_thinning, test::LabTruth::grip_slip})
+  for (test::LabTruth truth :
+       {test::LabTruth::permanent_set, test::LabTruth::instrument_drift, test::LabTruth::rate_thinning, test::LabTruth::grip_slip})
     for (unsigned seed = 1; seed <= 10; ++seed) {
       const std::string folder = std::string(VISCERA_TEST_TMP) + "/adequacy/" + test::name(truth) + "_" + std::to_string(seed);
       std::filesystem::remove_all(folder);
@@ -150,8 +152,8 @@ TEST(Adequacy, OutsideTheCatalogueTheLabSaysItsModelDoesNotExplainTheData) {
       const Analysis a = analyze(read_dataset(folder), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0});
       ++total;
       flagged += !a.adequacy.explained;
-      std::cout << "[ " << test::name(truth) << " seed " << seed << " ] residual " << a.adequacy.residual_to_noise << "x the noise: "
-                << (a.adequacy.explained ? "explained  <- missed" : "not explained") << "\n";
+      std::cout << "[ " << test::name(truth) << " seed " << seed << " ] residual " << a.adequacy.residual_to_noise
+                << "x the noise: " << (a.adequacy.explained ? "explained  <- missed" : "not explained") << "\n";
       if (!a.adequacy.explained) {
         EXPECT_NE(a.verdict.find("does not explain the data"), std::string::npos);
       }

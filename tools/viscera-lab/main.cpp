@@ -34,7 +34,7 @@ void print_summary(const Analysis& a, double seconds, const std::string& out) {
     std::printf(" none named; chosen on all tests but not held by the honest gain:");
     for (Mechanism m : a.causes) std::printf(" %s", name(m));
   }
-  std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md\n",
+  std::printf("%s\nbaseline held-out RMS %.4g Pa, final %.4g Pa, gain %.3gx, noise %.4g Pa; %.1f s; wrote %s/report.md and model.json\n",
               a.causes.empty() ? " none" : "", a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.gain, a.noise_pa, seconds, out.c_str());
   std::printf("adequacy: %s (residual %.3gx the noise)%s\n", a.adequacy.explained ? "explained" : "not explained", a.adequacy.residual_to_noise,
               a.adequacy.explained ? "" : ": something outside the catalogue remains (report.md)");
@@ -59,6 +59,8 @@ void run_analyze(const std::vector<std::string>& positional, const std::string& 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_report(a, decimate(d, AnalyzeOptions{}.max_fit_points), out, seconds);  // plots of what was fitted
   print_summary(a, seconds, out);
+  if (std::filesystem::exists(out + "/material.json"))
+    std::printf("wrote %s/material.json: the model for the server's organs (a scene's \"material\")\n", out.c_str());
 }
 
 void run_import(const std::vector<std::string>& positional, const std::string& out, const viscera::common::CommandLine& cl) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "viscera/lab/fit.hpp"
+#include "viscera/lab/material_export.hpp"
 #include "viscera/lab/model_file.hpp"
 #include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/stress_controlled.hpp"
@@ -310,7 +311,13 @@ void md_test_plots(std::ostream& md, const Analysis& a, const TestData& t, const
 
 void write_report(const Analysis& a, const Dataset& d, const std::string& out_dir, double seconds) {
   fs::create_directories(out_dir);
-  std::ofstream(fs::path(out_dir) / "report.json") << report_json(a, d, seconds).dump(2) << "\n";
+  // The organ's material: the model the analysis stands by, in the server's GPS as it is.
+  std::string why;
+  const std::string material = material_file_text(a.supported_model(), d, a.dataset + " (viscera-lab)", &why);
+  if (!material.empty()) std::ofstream(fs::path(out_dir) / "material.json") << material;
+  json j = report_json(a, d, seconds);
+  j["material_file"] = material.empty() ? json{{"written", false}, {"why", why}} : json{{"written", true}, {"file", "material.json"}};
+  std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
   write_model((fs::path(out_dir) / "model.json").string(), a.supported_model(), a.dataset);
 
   std::ofstream md(fs::path(out_dir) / "report.md");
@@ -324,6 +331,11 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
   md_specimen(md, a);
   md << "\n## Models\n\n- baseline: `" << a.baseline.model.describe() << "`, E = " << a.baseline.model.modulus_pa
      << " Pa, eta = " << a.baseline.model.viscosity_pa_s << " Pa s\n- final: `" << a.final.model.describe() << "` (parameters in `model.json`)\n\n";
+  md << "The organ's material file: "
+     << (material.empty() ? "not written: " + why
+                          : std::string("`material.json` (docs/MATERIAL.md, model `relaxation_spectrum`): the model above in the server's GPS, its "
+                                        "elastic shape calibrated on this specimen; a scene names it as its material"))
+     << ".\n\n";
   md << "## Data, baseline and final model\n\n";
   for (const TestData& t : d.tests) md_test_plots(md, a, t, out_dir);
 }

@@ -45,11 +45,25 @@ Material parse_material(const std::string& text, const std::string& source) {
   }
   if (top.has("viscoelasticity")) {
     const JsonObject v = top.object("viscoelasticity");
-    v.require_known(
-        {"model", "shear_q", "bulk_q", "band_hz", "mechanisms", "reference_frequency_hz", "qlv_stiffening", "qlv_form", "compression_ratio"});
+    v.require_known({"model", "shear_q", "bulk_q", "band_hz", "mechanisms", "reference_frequency_hz", "qlv_stiffening", "qlv_form",
+                     "compression_ratio", "qlv_shape", "relaxation_times_s", "relaxation_weights", "kelvin_voigt_time_s", "softening_d"});
     ViscoelasticSpec spec;
-    if (v.choice("model", {"constant_q", "kelvin_voigt"}, "constant_q") == "kelvin_voigt") spec.model = ViscoelasticSpec::Model::kelvin_voigt;
-    spec.shear_q = v.number("shear_q", 0.5, 1e4);
+    const std::string model = v.choice("model", {"constant_q", "kelvin_voigt", "relaxation_spectrum"}, "constant_q");
+    if (model == "kelvin_voigt") spec.model = ViscoelasticSpec::Model::kelvin_voigt;
+    if (model == "relaxation_spectrum") {
+      spec.model = ViscoelasticSpec::Model::relaxation_spectrum;
+      const std::size_t n = v.has("relaxation_times_s") ? v.value()["relaxation_times_s"].size() : 0;
+      if (n > 0) {
+        spec.relaxation_times_s = v.numbers("relaxation_times_s", n, 1e-9, 1e9);
+        spec.relaxation_weights = v.numbers("relaxation_weights", n, 0, 1);
+      }
+      spec.kelvin_voigt_time_s = v.number("kelvin_voigt_time_s", 0, 1e6, 0.0);
+      spec.softening_d = v.number("softening_d", 0, 0.99, 0.0);
+    } else {
+      for (const char* field : {"relaxation_times_s", "relaxation_weights", "kelvin_voigt_time_s", "softening_d"})
+        if (v.has(field)) v.fail(field, "belongs to \"model\": \"relaxation_spectrum\"");
+      spec.shear_q = v.number("shear_q", 0.5, 1e4);
+    }
     if (v.has("bulk_q") && !v.value()["bulk_q"].is_null()) spec.bulk_q = v.number("bulk_q", 0.5, 1e4);
     if (v.has("band_hz")) {
       const auto b = v.numbers("band_hz", 2, 1e-9, 1e9);
@@ -64,6 +78,11 @@ Material parse_material(const std::string& text, const std::string& source) {
     spec.compression_ratio = v.number("compression_ratio", 1e-3, 1e3, spec.compression_ratio);
     if (spec.compression_ratio != 1.0 && spec.qlv_form != GpsStiffening::Form::energy)
       v.fail("compression_ratio", short_number(spec.compression_ratio) + " needs \"qlv_form\": \"energy\"");
+    const std::string shape = v.choice("qlv_shape", {"exponential", "odd_exponential", "odd_polynomial"}, "exponential");
+    if (shape == "odd_exponential") spec.qlv_shape = StiffeningShape::odd_exponential;
+    if (shape == "odd_polynomial") spec.qlv_shape = StiffeningShape::odd_polynomial;
+    if (spec.qlv_shape != StiffeningShape::exponential && spec.qlv_form != GpsStiffening::Form::energy)
+      v.fail("qlv_shape", shape + " needs \"qlv_form\": \"energy\"");
     m.viscoelasticity = spec;
   }
   return m;

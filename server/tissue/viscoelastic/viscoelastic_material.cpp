@@ -16,6 +16,49 @@ Mat6 volumetric_part(const Mat6& D) {
   m << 1, 1, 1, 0, 0, 0;
   return reuss_bulk_modulus(D) * m * m.transpose();
 }
+/// The spectrum as stated: D is the unrelaxed elasticity, each weight the share of it that relaxes
+/// with its time, in shear and bulk alike (the whole elastic tension relaxes, as the lab's law).
+ViscoelasticSetup relaxation_spectrum(const Mat6& D, const ViscoelasticSpec& spec, const std::string& source, ViscoelasticSetup& out) {
+  const auto& tau = spec.relaxation_times_s;
+  const auto& w = spec.relaxation_weights;
+  if (tau.size() != w.size())
+    throw InputError(source, 0, "relaxation_weights", std::to_string(w.size()) + " weights for " + std::to_string(tau.size()) + " relaxation times");
+  if (tau.size() > GpsViscous::kMaxMechanisms)
+    throw InputError(source, 0, "relaxation_times_s", std::to_string(tau.size()) + " times: at most " + std::to_string(GpsViscous::kMaxMechanisms));
+  double sum = 0.0;
+  for (std::size_t l = 0; l < tau.size(); ++l) {
+    if (!(tau[l] > 0) || !std::isfinite(tau[l]))
+      throw InputError(source, 0, "relaxation_times_s[" + std::to_string(l) + "]", std::to_string(tau[l]) + " must be a positive number");
+    if (!(w[l] >= 0) || !std::isfinite(w[l]))
+      throw InputError(source, 0, "relaxation_weights[" + std::to_string(l) + "]", std::to_string(w[l]) + " must be >= 0");
+    sum += w[l];
+  }
+  if (!(sum < 1.0))
+    throw InputError(source, 0, "relaxation_weights",
+                     "sum to " + std::to_string(sum) + ": the relaxed modulus would be <= 0 (the sum must be below 1)");
+  if (!(spec.kelvin_voigt_time_s >= 0) || !std::isfinite(spec.kelvin_voigt_time_s))
+    throw InputError(source, 0, "kelvin_voigt_time_s", std::to_string(spec.kelvin_voigt_time_s) + " must be >= 0");
+  if (!(spec.softening_d >= 0 && spec.softening_d < 1))
+    throw InputError(source, 0, "softening_d", std::to_string(spec.softening_d) + " must lie in [0, 1)");
+  std::ostringstream table;
+  table << "relaxation spectrum (unrelaxed elasticity as given; shear and bulk relax alike):\n";
+  for (std::size_t l = 0; l < tau.size(); ++l) {
+    if (w[l] <= 0) continue;
+    out.gps.viscous.omega_rad_s.push_back(1.0 / tau[l]);
+    out.gps.viscous.shear_weight.push_back(w[l]);
+    table << "  tau " << tau[l] << " s: weight " << w[l] << "\n";
+  }
+  out.gps.viscous.bulk_weight = out.gps.viscous.shear_weight;
+  out.gps.viscous.kelvin_voigt_time_s = spec.kelvin_voigt_time_s;
+  out.gps.softening.d = spec.softening_d;
+  table << "  relaxed share " << 1.0 - sum << ", Kelvin-Voigt time " << spec.kelvin_voigt_time_s << " s";
+  if (spec.softening_d > 0) table << ", first-load softening d = " << spec.softening_d;
+  table << "\n";
+  out.unrelaxed_elasticity = D;
+  out.table = table.str();
+  return out;
+}
+
 }  // namespace
 
 ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec, const std::string& source) {
@@ -36,9 +79,12 @@ ViscoelasticSetup make_viscoelastic(const Mat6& D, const ViscoelasticSpec& spec,
     throw InputError(source, 0, "qlv_form",
                      "\"energy\" relaxes the whole elastic tension, so it needs bulk_q equal to shear_q (" +
                          (spec.bulk_q ? std::to_string(*spec.bulk_q) : std::string("absent")) + " against " + std::to_string(spec.shear_q) + ")");
+  if (spec.qlv_shape != StiffeningShape::exponential && spec.qlv_form != GpsStiffening::Form::energy)
+    throw InputError(source, 0, "qlv_shape", "an odd shape needs \"qlv_form\": \"energy\"");
   ViscoelasticSetup out;
-  out.gps.stiffening = {spec.qlv_stiffening, spec.qlv_form};
+  out.gps.stiffening = {spec.qlv_stiffening, spec.qlv_form, spec.qlv_shape};
   out.gps.asymmetry.compression_ratio = spec.compression_ratio;
+  if (spec.model == ViscoelasticSpec::Model::relaxation_spectrum) return relaxation_spectrum(D, spec, source, out);
   const Mat6 D_vol = volumetric_part(D), D_dev = D - D_vol;
   const double w_ref = 2 * M_PI * spec.reference_frequency_hz;
   if (spec.model == ViscoelasticSpec::Model::kelvin_voigt) {

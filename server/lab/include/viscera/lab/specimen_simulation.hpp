@@ -12,6 +12,8 @@
 
 #include "viscera/lab/dataset.hpp"
 #include "viscera/lab/material_model.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"
+#include "viscera/tissue/gps/gps_mechanisms.hpp"
 
 namespace viscera::lab {
 
@@ -54,10 +56,34 @@ bool specimen_supports(const MaterialModel& m, Mode mode, std::string* why);
 /// energy map's h'' jumps there: fung_map.hpp), so a tolerance that means nothing costs runs.
 inline constexpr double kSpecimenResidualToNoise = 1e-2;
 
+/// The law in the GPS's terms, as the specimen takes it and as a material file hands it to an
+/// organ: unrelaxed modulus E_U = E + sum E_l, weights E_l / E_U on shear and bulk alike (the whole
+/// elastic tension relaxes, as the law's), Kelvin-Voigt time eta / E_U; softening per edge; the
+/// elastic shape in the energy form with its constants calibrated to the law's curve.
+struct GpsLaw {
+  tissue::GpsMechanisms mechanisms;
+  double unrelaxed_modulus_pa = 0.0;  ///< the law's (uniaxial: Young's; simple shear: the shear modulus)
+  ShapeCalibration shape;  ///< when the law stiffens or is asymmetric
+};
+GpsLaw gps_law(const MaterialModel& m, const Dataset& d, const ShapeCalibration* calibration = nullptr);
+
+/// The specimen's Poisson's ratio: a uniaxial test with free lateral faces, or simple shear, does
+/// not determine it, and at small strain the GPS's response to either does not depend on it.
+inline constexpr double kSpecimenPoissonRatio = 0.3;
+
+/// The specimen's isotropic elasticity for a law's modulus: uniaxial, it is Young's; simple
+/// shear, the shear modulus (Young's = 2 G (1 + nu)).
+tissue::Mat6 specimen_elasticity(double modulus_pa, bool shear);
+
 /// `calibration`: calibrate_elastic_shape(m, d), if already known (it is computed otherwise).
 /// `max_seconds` > 0: a run still going after this much wall time stops with a SimulationError
 /// naming where it was (simulated time, steps, step cuts), so that an analysis never hangs.
 SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const TestData& t, const ShapeCalibration* calibration = nullptr,
                                  double max_seconds = 0.0);
+
+/// The same test on the specimen built from given GPS mechanisms and unrelaxed elasticity (what a
+/// material file gives the server: tissue::make_viscoelastic), not from a law.
+SpecimenResult simulate_specimen(const tissue::GpsMechanisms& mechanisms, const tissue::Mat6& unrelaxed_elasticity, const Dataset& d,
+                                 const TestData& t, double max_seconds = 0.0);
 
 }  // namespace viscera::lab

@@ -5,6 +5,7 @@
 // Kelvin-Voigt baseline matched at the reference frequency.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/viscoelastic/constant_q_fit.hpp"
@@ -12,7 +13,10 @@
 namespace viscera::tissue {
 
 struct ViscoelasticSpec {
-  enum class Model { constant_q, kelvin_voigt } model = Model::constant_q;
+  /// constant_q: Q over a band (the paper's liver); kelvin_voigt: one relaxation time matched at
+  /// the reference frequency; relaxation_spectrum: the moduli and times stated as they are (what
+  /// viscera-lab fits: docs/LAB.md), the elasticity then being the unrelaxed one.
+  enum class Model { constant_q, kelvin_voigt, relaxation_spectrum } model = Model::constant_q;
   double shear_q = 4.8;
   std::optional<double> bulk_q;  ///< none: the bulk response does not relax
   double band_low_hz = 0.01, band_high_hz = 10.0;
@@ -23,6 +27,12 @@ struct ViscoelasticSpec {
   /// conservative energy form.
   GpsStiffening::Form qlv_form = GpsStiffening::Form::edge_map;
   double compression_ratio = 1.0;  ///< tension/compression asymmetry r (energy form only; 1: none)
+  StiffeningShape qlv_shape = StiffeningShape::exponential;  ///< the stiffening law (odd shapes: energy form only)
+  // relaxation_spectrum only: shear and bulk relax alike.
+  std::vector<double> relaxation_times_s;  ///< tau_l
+  std::vector<double> relaxation_weights;  ///< E_l / E_unrelaxed, one per time; their sum below 1
+  double kelvin_voigt_time_s = 0.0;  ///< eta / E_unrelaxed
+  double softening_d = 0.0;  ///< first-load softening (GpsSoftening)
 
   bool operator==(const ViscoelasticSpec&) const = default;
 };
