@@ -2,8 +2,8 @@
 # Runs every test: installs and builds what is missing, then
 #  1. the whole suite in Release with ctest (unit, lab, physics, tools, integration over a real DDS
 #     domain, the fuzz targets, the soak, and lint: clang-format on every file, clang-tidy on the
-#     sources a change touches: changed, or including a changed header, since the merge base with
-#     origin/main on a branch, in the last 3 commits on main);
+#     sources a change touches: those changed, and one includer of each changed header, since the
+#     merge base with origin/main on a branch, in the last 3 commits on main);
 #  2. under AddressSanitizer + UndefinedBehaviorSanitizer (built at -O1), every test that can run under them: the
 #     unit, lab and command-line tests, but for the lab's long numeric analyses (below). Left out, with the reason: the three "physics" tests (12k
 #     liver presses, ten minutes of sanitized tissue loop; the same code runs sanitized in the unit

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""The C++ sources a change touches: every .cpp changed since BASE, and every .cpp whose object
-file includes (directly or not) a header changed since BASE, read from the build's dependency log
-(ninja -t deps). Prints repository-relative paths, one a line, sorted.
+"""The C++ sources a change touches: every .cpp changed since BASE, and for each header changed
+since BASE that none of those includes, one source that does (its own .cpp where it has one), read
+from the build's dependency log (ninja -t deps): clang-tidy reports a header's findings in any
+source that includes it, and checking every includer of a widely used header took ten minutes.
+Prints repository-relative paths, one a line, sorted.
 
 Usage: changed_sources.py BUILD_DIR SOURCE_DIR BASE   (BASE: a commit; "all": every .cpp)"""
 import os
@@ -24,11 +26,12 @@ def main():
         sources = {f for f in changed if f.endswith(".cpp")}
         headers = {f for f in changed if f.endswith((".hpp", ".h", ".inl"))}
         if headers:
+            includers = {h: [] for h in headers}  # header -> sources whose objects include it
             deps = subprocess.run(["ninja", "-C", build, "-t", "deps"], check=True, capture_output=True, text=True).stdout
-            source, includes = None, False
+            source = None
             for line in deps.split("\n"):
                 if line and not line.startswith(" "):  # an object: its source is the next line
-                    source, includes = None, False
+                    source = None
                     continue
                 path = line.strip()
                 if not path:
@@ -36,10 +39,15 @@ def main():
                 rel = os.path.relpath(os.path.normpath(os.path.join(build, path)), src)
                 if source is None:
                     source = rel
-                elif not includes and rel in headers:
-                    includes = True
-                    if source.endswith(".cpp") and not source.startswith(".."):
-                        sources.add(source)
+                elif rel in includers and source.endswith(".cpp") and not source.startswith(".."):
+                    includers[rel].append(source)
+            for header, users in includers.items():
+                users = sorted(set(users))
+                if not users or any(u in sources for u in users):
+                    continue
+                stem = os.path.splitext(os.path.basename(header))[0]
+                own = [u for u in users if os.path.splitext(os.path.basename(u))[0] == stem]
+                sources.add((own or users)[0])
     for f in sorted(sources):
         if not f.startswith("tests/fuzz/") and os.path.exists(os.path.join(src, f)):
             print(f)
