@@ -118,4 +118,5 @@ TEST(MaterialFile, ARelaxationSpectrumIsCheckedFieldByField) {
   EXPECT_NE(error_of(R"({"model": "relaxation_spectrum", "qlv_stiffening": 5, "qlv_shape": "odd_exponential"})").find("qlv_shape"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"model": "relaxation_spectrum", "softening_d": 1.5})").find("softening_d"), std::string::npos);
+  EXPECT_NE(error_of(R"({"model": "relaxation_spectrum", "shear_q": 3})").find("shear_q"), std::string::npos);  // never silently ignored
 }

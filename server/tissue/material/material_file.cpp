@@ -59,6 +59,8 @@ Material parse_material(const std::string& text, const std::string& source) {
       }
       spec.kelvin_voigt_time_s = v.number("kelvin_voigt_time_s", 0, 1e6, 0.0);
       spec.softening_d = v.number("softening_d", 0, 0.99, 0.0);
+      for (const char* field : {"shear_q", "bulk_q", "band_hz", "mechanisms", "reference_frequency_hz"})
+        if (v.has(field)) v.fail(field, "belongs to \"model\": \"constant_q\" or \"kelvin_voigt\" (a spectrum states its times and weights)");
     } else {
       for (const char* field : {"relaxation_times_s", "relaxation_weights", "kelvin_voigt_time_s", "softening_d"})
         if (v.has(field)) v.fail(field, "belongs to \"model\": \"relaxation_spectrum\"");
