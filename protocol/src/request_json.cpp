@@ -27,6 +27,10 @@ nlohmann::json to_json(const SessionRequest& r) {
     put("density_kg_m3", r.material.density_kg_m3);
     put("shear_q", r.material.shear_q);
     put("damping_per_s", r.material.damping_per_s);
+    if (r.material.file_text) {
+      m["file_name"] = r.material.file_name;
+      m["file_text"] = *r.material.file_text;
+    }
     j["material"] = m;
   }
   return j;
@@ -62,6 +66,10 @@ std::optional<SessionRequest> session_request_from_json(const nlohmann::json& j,
       get("density_kg_m3", r.material.density_kg_m3);
       get("shear_q", r.material.shear_q);
       get("damping_per_s", r.material.damping_per_s);
+      if (m->contains("file_text")) {
+        r.material.file_text = m->at("file_text").get<std::string>();
+        r.material.file_name = m->value("file_name", std::string());
+      }
     }
     return decode_session_request(encode(r), why);  // the checks every received request passes
   } catch (const nlohmann::json::exception& e) {

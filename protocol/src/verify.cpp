@@ -62,12 +62,19 @@ std::vector<std::uint8_t> encode(const SessionRequest& r) {
   const auto name = r.scene_name.empty() ? 0 : b.CreateString(r.scene_name);
   flatbuffers::Offset<fb::MaterialChange> material = 0;
   if (!r.material.empty()) {
+    // Strings before the table that refers to them (FlatBuffers builds bottom-up).
+    const auto file_name = r.material.file_text ? b.CreateString(r.material.file_name) : 0;
+    const auto file_text = r.material.file_text ? b.CreateString(*r.material.file_text) : 0;
     fb::MaterialChangeBuilder m(b);
     if (r.material.youngs_modulus_pa) m.add_youngs_modulus_pa(*r.material.youngs_modulus_pa);
     if (r.material.poisson_ratio) m.add_poisson_ratio(*r.material.poisson_ratio);
     if (r.material.density_kg_m3) m.add_density_kg_m3(*r.material.density_kg_m3);
     if (r.material.shear_q) m.add_shear_q(*r.material.shear_q);
     if (r.material.damping_per_s) m.add_damping_per_s(*r.material.damping_per_s);
+    if (r.material.file_text) {
+      m.add_file_name(file_name);
+      m.add_file_text(file_text);
+    }
     material = m.Finish();
   }
   return finish(b, fb::CreateSessionRequest(b, r.client_id, static_cast<fb::SessionAction>(r.action), r.instrument_id, r.request_seq, name, material,
@@ -253,6 +260,19 @@ std::optional<SessionRequest> decode_session_request(std::span<const std::uint8_
         !take(c->shear_q(), "shear_q", 0.5, 1e4, false, r.material.shear_q) ||
         !take(c->damping_per_s(), "damping_per_s", 0.0, 1e4, false, r.material.damping_per_s))
       return std::nullopt;
+    if (c->file_text()) {
+      if (c->file_text()->size() > kMaxMaterialFileBytes) {
+        *why = "material.file_text of " + std::to_string(c->file_text()->size()) + " bytes is longer than " + std::to_string(kMaxMaterialFileBytes);
+        return std::nullopt;
+      }
+      r.material.file_name = c->file_name() ? c->file_name()->str() : "";
+      if (!common::is_plain_name(r.material.file_name)) {
+        *why = "material.file_name '" + r.material.file_name.substr(0, 64) +
+               "' is not a plain file name ([A-Za-z0-9._-], 1-64 characters, no leading '.')";
+        return std::nullopt;
+      }
+      r.material.file_text = c->file_text()->str();
+    }
     if (r.material.empty()) {
       *why = "set_material with no parameter";
       return std::nullopt;

@@ -203,8 +203,10 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   next->sources = organ.sources;
   next->regions = organ.regions;
   next->region_materials = organ.region_materials;
+  // The request's outcome names the file; its errors name the field.
+  if (change.file_text) next->material = parse_material(*change.file_text, "set_material");
   Material& m = next->material;
-  const std::string source = "set_material (material " + m.name + ")";
+  const std::string source = change.file_text ? std::string("set_material") : "set_material (material " + m.name + ")";
   if (change.youngs_modulus_pa || change.poisson_ratio) {
     if (!m.isotropic) throw InputError(source, 0, change.youngs_modulus_pa ? "youngs_modulus_pa" : "poisson_ratio", "the material is not isotropic");
     if (change.youngs_modulus_pa) m.isotropic->youngs_modulus_pa = *change.youngs_modulus_pa;
@@ -220,11 +222,12 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   if (change.damping_per_s) next->scene.damping_per_s = *change.damping_per_s;
   const std::string mark = " (changed at run time)";
   if ((change.youngs_modulus_pa || change.poisson_ratio || change.shear_q || change.density_kg_m3) && !m.name.ends_with(mark)) m.name += mark;
-  const char* changed = change.youngs_modulus_pa ? "youngs_modulus_pa"
-                        : change.poisson_ratio   ? "poisson_ratio"
-                        : change.density_kg_m3   ? "density_kg_m3"
-                        : change.shear_q         ? "shear_q"
-                                                 : "damping_per_s";
+  const char* changed = change.file_text           ? "file_text"
+                        : change.youngs_modulus_pa ? "youngs_modulus_pa"
+                        : change.poisson_ratio     ? "poisson_ratio"
+                        : change.density_kg_m3     ? "density_kg_m3"
+                        : change.shear_q           ? "shear_q"
+                                                   : "damping_per_s";
   build_physics(*next, rate_hz, budget, source, changed);
   return next;
 }

@@ -109,6 +109,7 @@ std::string describe_change(const protocol::MaterialChange& m) {
   add("density_kg_m3", m.density_kg_m3);
   add("shear_q", m.shear_q);
   add("damping_per_s", m.damping_per_s);
+  if (m.file_text) out = "file " + m.file_name + (out.empty() ? "" : " with " + out);
   return out;
 }
 

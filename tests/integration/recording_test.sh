@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Integration, separate processes over a real DDS domain: a scripted session (a press, a material
-# change, a grasp and lift, an annotation, the first client pressing again under the same id)
+# change, a material file refused and one taken whole, a grasp and lift, an annotation, the first client pressing again under the same id)
 # recorded by viscera-record; the file judged by the
 # official MCAP reader (@mcap/core under Node: channels, schemas, counts against the writers'
 # sequence numbers, no gaps, monotonic log times, attachments) and every payload by viscera's own
@@ -33,6 +33,12 @@ sleep 1.5
 "$ctl" annotate "bookmark: first press" --domain "$domain" --client-id 901 > "$tmp/control.log" 2>&1; rc_note=$?
 wait $press; rc_press=$?
 "$ctl" material --youngs-modulus-pa 6500 --domain "$domain" >> "$tmp/control.log" 2>&1; rc_material=$?
+# A material file that does not read (a shape of the energy form without the energy form), refused
+# naming its field; then the lab's fitted titin material, sent whole (schema 14), for the rest.
+printf '{"name": "bad", "density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.4},
+ "viscoelasticity": {"model": "relaxation_spectrum", "qlv_stiffening": 2, "qlv_shape": "odd_polynomial"}}' > "$tmp/bad shape.json"
+"$ctl" material --file "$tmp/bad shape.json" --domain "$domain" > "$tmp/bad-material.log" 2>&1; rc_bad_material=$?
+"$ctl" material --file "$src/docs/lab/titin/material.json" --domain "$domain" >> "$tmp/control.log" 2>&1; rc_file=$?
 "$hc" --domain "$domain" --client-id 12 --instrument 3 --script grasp --duration 3 --depth 0.004 --pull 0.01 --quiet > "$tmp/grasp.log" 2>&1 & grasp=$!
 sleep 1.5
 kill -KILL "$victim"
@@ -46,6 +52,11 @@ cat "$tmp/control.log" "$tmp/press.log" "$tmp/grasp.log"; tail -3 "$tmp/rec.log"
 check "the session ran (press $rc_press, annotation $rc_note, material $rc_material, grasp $rc_grasp, press again $rc_press2, server $rc_server)" \
   "[ $rc_press -eq 0 ] && [ $rc_note -eq 0 ] && [ $rc_material -eq 0 ] && [ $rc_grasp -eq 0 ] && [ $rc_press2 -eq 0 ] && [ $rc_server -eq 0 ]"
 check "the recorder closed its file (rc $rc_rec)" "[ $rc_rec -eq 0 ]"
+cat "$tmp/bad-material.log"
+check "a material file that does not read is refused naming its field (rc $rc_bad_material)" \
+  "[ $rc_bad_material -eq 1 ] && grep -q 'refused: material file bad_shape.json: set_material: viscoelasticity.qlv_shape' '$tmp/bad-material.log'"
+check "the lab's titin material file is taken whole (rc $rc_file)" \
+  "[ $rc_file -eq 0 ] && grep -q 'changed to material file material.json' '$tmp/control.log' && grep -q 'material titin-passive-muscle' '$tmp/control.log'"
 
 # --- The official reader's verdict -----------------------------------------------------------
 node "$node_dir/check_mcap.mjs" "$tmp/session.mcap" > "$tmp/official.json"; rc_official=$?

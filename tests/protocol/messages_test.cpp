@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "viscera/protocol/request_json.hpp"
+
 using namespace viscera::protocol;
 
 namespace {
@@ -253,6 +255,34 @@ TEST(Messages, RunTimeControlRequestsRoundTripAndBadOnesAreRejected) {
   rejects({{}, {}, {}, std::numeric_limits<double>::infinity(), {}}, "shear_q");
   rejects({{}, {}, {}, {}, -1.0}, "damping_per_s");
   rejects({}, "material");  // nothing to change
+  // Schema 14: a whole material file travels as text under a plain name, up to 64 KiB; the
+  // recorded form (request_json) keeps it, so a re-simulation sends the same bytes.
+  MaterialChange file;
+  file.file_name = "material.json";
+  file.file_text = R"({"name": "fitted", "density_kg_m3": 1060})";
+  file.youngs_modulus_pa = 9000;
+  SessionRequest with_file = mat;
+  with_file.material = file;
+  const auto f = decode_session_request(encode(with_file), &why);
+  ASSERT_TRUE(f) << why;
+  EXPECT_EQ(f->material.file_name, "material.json");
+  EXPECT_EQ(f->material.file_text, file.file_text);
+  EXPECT_EQ(f->material.youngs_modulus_pa, 9000);
+  const auto again = session_request_from_json(to_json(*f), &why);
+  ASSERT_TRUE(again) << why;
+  EXPECT_EQ(again->material.file_text, file.file_text);
+  EXPECT_EQ(again->material.file_name, "material.json");
+  file.youngs_modulus_pa.reset();
+  file.file_text = std::string(kMaxMaterialFileBytes, ' ');
+  with_file.material = file;
+  EXPECT_TRUE(decode_session_request(encode(with_file), &why)) << why;  // the limit itself passes
+  file.file_text->push_back(' ');
+  rejects(file, "file_text");
+  file.file_text = "{}";
+  for (const std::string& bad : std::vector<std::string>{"", "../material.json", "/etc/passwd", ".hidden", "a b.json", std::string(65, 'a')}) {
+    file.file_name = bad;
+    rejects(file, "file_name");
+  }
   SessionRequest rate;
   rate.client_id = 900;
   rate.action = Action::set_physics_rate;

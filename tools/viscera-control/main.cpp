@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <thread>
@@ -16,6 +17,7 @@
 #include "viscera/client/session_limits.hpp"
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/json_input.hpp"
 #include "viscera/common/number_text.hpp"
 #include "viscera/protocol/dds.hpp"
 
@@ -27,6 +29,23 @@ std::string shown(const std::string& text) { return viscera::common::printable(t
 
 /// Exit status when the server went away while watched.
 constexpr int kServerGone = 4;
+
+/// `change` with the material file at `path` (docs/MATERIAL.md), read and checked as JSON here:
+/// the server checks its fields and answers naming the file. Its name travels as a plain name.
+viscera::protocol::MaterialChange with_material_file(viscera::protocol::MaterialChange change, const std::string& path) {
+  try {
+    change.file_text = viscera::common::read_text_file(path, viscera::protocol::kMaxMaterialFileBytes);
+    viscera::common::parse_json(*change.file_text, path);
+  } catch (const viscera::common::InputError& e) {
+    throw viscera::common::UsageError(std::string("--file: ") + e.what());
+  }
+  std::string name = std::filesystem::path(path).filename().string().substr(0, 64);
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+  if (name.empty() || name[0] == '.') name.insert(0, "m");
+  change.file_name = name.substr(0, 64);
+  return change;
+}
 
 /// True (after saying so) when the server is gone.
 bool server_gone(viscera::client::Client& client) {
@@ -108,10 +127,12 @@ Request parse(const viscera::common::CommandLine& cl) {
       if (const auto why = viscera::client::outside_range(std::string("--") + p.name, v, p.lo, p.hi)) throw UsageError(*why);
       r.change.*p.field = v;
     }
+  if (cl.has("file")) r.change = with_material_file(r.change, cl.text("file"));
   if ((r.action == "material") != !r.change.empty())
-    throw UsageError(r.action == "material"
-                         ? "material needs at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
-                         : "material flags are for the material action");
+    throw UsageError(
+        r.action == "material"
+            ? "material needs --file or at least one of --youngs-modulus-pa, --poisson-ratio, --density-kg-m3, --shear-q, --damping-per-s"
+            : "material flags are for the material action");
   if (r.action == "load") {
     if (!viscera::client::is_scene_name(r.argument)) throw UsageError(viscera::client::not_a_scene_name(r.argument));
     if (cl.has("seed")) r.seed = cl.integer_in("seed", 0, 9007199254740991);
@@ -222,7 +243,8 @@ int main(int argc, char** argv) {
       "  pause           the organ stops; forces are still answered from its frozen state\n"
       "  resume, reset   reset: the organ back at rest, graspers let go\n"
       "  load SCENE      load a scene of the server's scene directory (show lists them); instruments are released\n"
-      "  material        change material parameters (the flags below; the organ keeps its deformation)\n"
+      "  material        change material parameters (the flags below), or switch to a material file (--file, docs/MATERIAL.md:\n"
+      "                  a lab's material.json); the organ keeps its deformation, its regions their materials\n"
       "  rate HZ         change the physics rate [Hz]\n"
       "  seek S          a replay (viscera-replay play, with --station): jump to S seconds from the recording's start\n"
       "  show            print the scene state\n"
@@ -241,6 +263,7 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "events, health: how long to follow them [s]", "10");
   cl.flag("timeout", "S", "load, material, rate: how long to wait for the server's outcome [s]", "60");
   cl.flag("seed", "N", "load: the seed of the scene's drawn material regions (a hidden nodule elsewhere; default: the scene file's)");
+  cl.flag("file", "MATERIAL.json", "material: the organ's new material, a material file (at most 64 KiB); the parameter flags then change it");
   for (const auto& p : viscera::client::material_parameters()) cl.flag(p.name, p.value_name, std::string("material: ") + p.help);
   cl.allow_positional(2);
   try {

@@ -55,10 +55,17 @@ enum class Action : std::int8_t {
 };
 const char* action_name(Action a);
 
-/// Material parameters to change at run time (SI); empty ones keep their values.
+/// The longest material file a set_material request carries [bytes] (a material file is about 1 KiB).
+inline constexpr std::size_t kMaxMaterialFileBytes = 64 * 1024;
+
+/// Material parameters to change at run time (SI); empty ones keep their values. Schema 14: or a
+/// whole material file (docs/MATERIAL.md) that replaces the organ's material, the parameters then
+/// applied to it.
 struct MaterialChange {
   std::optional<double> youngs_modulus_pa, poisson_ratio, density_kg_m3, shear_q, damping_per_s;
-  bool empty() const { return !youngs_modulus_pa && !poisson_ratio && !density_kg_m3 && !shear_q && !damping_per_s; }
+  std::optional<std::string> file_text;  ///< the file's JSON, at most kMaxMaterialFileBytes
+  std::string file_name;  ///< with file_text: the file's name, for people ([A-Za-z0-9._-], 1-64)
+  bool empty() const { return !youngs_modulus_pa && !poisson_ratio && !density_kg_m3 && !shear_q && !damping_per_s && !file_text; }
 };
 
 struct SessionRequest {
@@ -240,7 +247,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 13;
+inline constexpr int kSchemaVersion = 14;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);
