@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Regenerates the tables of docs/PERFORMANCE.md from the benchmarks' results in bench/results:
-tissue.json (bench/run.sh), tick.json (bench/tick.sh), haptics.json (bench/haptics.sh),
+tissue.json (bench/run.sh), tick.json (bench/tick.sh: the ticks and the materials), haptics.json (bench/haptics.sh),
 soak.json (bench/soak.sh), record.json (bench/record.sh) and console.json (bench/console.sh). Each table goes between its markers <!-- begin NAME --> and
 <!-- end NAME -->, with the machine and the date of the run it comes from; the prose around the
 markers is left as it is. Usage: performance_tables.py [ROOT]"""
@@ -38,6 +38,26 @@ def tick(path):
         us = lambda b: f"{b['real_time']:.0f}" if b else "-"
         rows.append(f"| {s} | {int(ref['tets'])} | {int(ref['sub_steps'])} | {us(one)} | {us(two)} | {ref['tick_budget_us']:.0f} |")
     return f"Run of {ctx.get('date', '?')[:16]} (`bench/tick.sh`), {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, medians of 3:\n\n" + "\n".join(rows) + "\n"
+
+
+def materials(path):
+    data = json.load(open(path))
+    ctx = data["context"]
+    med = {b["run_name"].removesuffix("/real_time"): b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
+    variants = [n.split("/")[1] for n in med if n.startswith("Material/") and n.endswith("/liver")]
+    if not variants:
+        return None
+    rows = ["| material | liver: sub-steps | tick [us] | per sub-step [us] | x elastic | liver-12k: sub-steps | tick [us] | per sub-step [us] | x elastic |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    per = lambda b: b["real_time"] / b["sub_steps"]
+    for v in variants:
+        cells = []
+        for scene in ("liver", "liver-12k"):
+            b, e = med.get(f"Material/{v}/{scene}"), med.get(f"Material/elastic/{scene}")
+            cells += [f"{int(b['sub_steps'])}", f"{b['real_time']:.0f}", f"{per(b):.0f}", f"{per(b) / per(e):.2f}"] if b and e else ["-"] * 4
+        rows.append(f"| {v} | " + " | ".join(cells) + " |")
+    return (f"Run of {ctx.get('date', '?')[:16]} (`bench/tick.sh`), {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, "
+            "medians of 3, forces on the scene's threads (liver 1, liver-12k 2):\n\n" + "\n".join(rows) + "\n")
 
 
 def haptics(path):
@@ -120,11 +140,14 @@ def main(root):
     doc_path = os.path.join(root, "docs", "PERFORMANCE.md")
     doc = open(doc_path).read()
     results = os.path.join(root, "bench", "results")
-    for name, fn in [("tissue", tissue), ("tick", tick), ("haptics", haptics), ("soak", soak), ("record", record), ("console", console)]:
-        path = os.path.join(results, f"{name}.json")
+    for name, file, fn in [("tissue", "tissue", tissue), ("tick", "tick", tick), ("materials", "tick", materials), ("haptics", "haptics", haptics),
+                           ("soak", "soak", soak), ("record", "record", record), ("console", "console", console)]:
+        path = os.path.join(results, f"{file}.json")
         if not os.path.exists(path):
             continue
         table = fn(path)
+        if table is None:
+            continue
         pattern = re.compile(rf"(<!-- begin {name} -->\n).*?(<!-- end {name} -->)", re.S)
         if not pattern.search(doc):
             print(f"performance_tables: no markers for {name} in {doc_path}", file=sys.stderr)

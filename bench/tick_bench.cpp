@@ -2,13 +2,16 @@
 // scaling, fixed slab) advanced by one tick, 1 / physics_rate_hz, in the integrator's equal
 // sub-steps, with the internal forces on one thread and on the scene's threads. No DDS, no
 // instruments: what the tick costs before anything else shares the cores (docs/PERFORMANCE.md).
+// Material/...: the same tick with the organ switched to each mechanism the lab can hand over.
 // Run: build/bench/tick_bench [--benchmark_filter=liver-12k]
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "viscera/common/json_input.hpp"
 #include "viscera/runtime/organ.hpp"
 #include "viscera/runtime/scene_file.hpp"
 
@@ -34,6 +37,62 @@ void tick(benchmark::State& st, const std::string& scene_name, int threads) {
   st.counters["tick_budget_us"] = 1e6 * dt;
 }
 
+/// The tick of `scene` with its organ switched to another material (as viscera-control material
+/// --file does): the cost of each mechanism the lab can hand over. The variants share the unrelaxed
+/// modulus (5 kPa, nu 0.45), so they take the same sub-steps and their ratios are the mechanisms'
+/// own cost; the lab's titin files run with their own moduli and steps.
+struct MaterialVariant {
+  const char* name;
+  std::string viscoelasticity;  ///< the material file's "viscoelasticity" object, or empty; "@file" names a file of data/materials
+};
+
+const std::vector<MaterialVariant>& material_variants() {
+  static const std::vector<MaterialVariant> v{
+      {"elastic", ""},
+      {"spectrum-1", R"({"model": "relaxation_spectrum", "relaxation_times_s": [1], "relaxation_weights": [0.3]})"},
+      {"spectrum-3", R"({"model": "relaxation_spectrum", "relaxation_times_s": [0.1, 1, 10], "relaxation_weights": [0.2, 0.2, 0.2]})"},
+      {"spectrum-5", R"({"model": "relaxation_spectrum", "relaxation_times_s": [0.01, 0.1, 1, 10, 1000],
+                         "relaxation_weights": [0.15, 0.15, 0.15, 0.15, 0.15]})"},
+      {"spectrum-5+stiffening", R"({"model": "relaxation_spectrum", "relaxation_times_s": [0.01, 0.1, 1, 10, 1000],
+                         "relaxation_weights": [0.15, 0.15, 0.15, 0.15, 0.15], "qlv_stiffening": 5, "qlv_form": "energy",
+                         "qlv_shape": "odd_exponential"})"},
+      {"spectrum-5+stiffening+asymmetry", R"({"model": "relaxation_spectrum", "relaxation_times_s": [0.01, 0.1, 1, 10, 1000],
+                         "relaxation_weights": [0.15, 0.15, 0.15, 0.15, 0.15], "qlv_stiffening": 5, "qlv_form": "energy",
+                         "qlv_shape": "odd_exponential", "compression_ratio": 2})"},
+      {"spectrum-5+softening", R"({"model": "relaxation_spectrum", "relaxation_times_s": [0.01, 0.1, 1, 10, 1000],
+                         "relaxation_weights": [0.15, 0.15, 0.15, 0.15, 0.15], "softening_d": 0.3})"},
+      {"constant-q-3", R"({"model": "constant_q", "shear_q": 4.8, "band_hz": [0.01, 10], "mechanisms": 3, "reference_frequency_hz": 2})"},
+      {"titin-fitted", "@titin-fitted.json"},
+      {"titin-linear", "@titin-linear.json"}};
+  return v;
+}
+
+void tick_with_material(benchmark::State& st, const std::string& scene_name, const MaterialVariant& variant) {
+  const runtime::SceneSpec scene = runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
+  const auto built = runtime::build_organ(scene);
+  protocol::MaterialChange change;
+  change.file_name = variant.name;
+  if (variant.viscoelasticity.starts_with("@"))
+    change.file_text = common::read_text_file(std::string(VISCERA_DATA_DIR) + "/materials/" + variant.viscoelasticity.substr(1), 1 << 20);
+  else
+    change.file_text = R"({"name": ")" + std::string(variant.name) +
+                       R"(", "density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45})" +
+                       (variant.viscoelasticity.empty() ? "" : ", \"viscoelasticity\": " + variant.viscoelasticity) + "}";
+  const auto organ = runtime::rebuild_with_material(*built, change, scene.physics_rate_hz);
+  if (organ->mesh->node_count() > 0) organ->compliance->wait_node(0);
+  tissue::State state = tissue::State::at_rest(*organ->mesh);
+  // A small stretch and velocity field, so that stiffening, asymmetry and softening act.
+  for (std::size_t i = 0; i < state.v.size(); ++i) {
+    state.x[i] *= 1.002;
+    state.v[i] = 1e-3 * tissue::Vec3(std::sin(0.7 * static_cast<double>(i)), std::cos(1.3 * static_cast<double>(i)), 0.0);
+  }
+  const double dt = 1.0 / scene.physics_rate_hz;
+  long sub_steps = 0;
+  for (auto _ : st) sub_steps = organ->integrator->advance(state, dt);
+  st.counters["sub_steps"] = static_cast<double>(sub_steps);
+  st.counters["tets"] = static_cast<double>(organ->mesh->tet_count());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -41,6 +100,11 @@ int main(int argc, char** argv) {
   for (const std::string scene : {"liver", "liver-12k", "liver-96k"})
     for (const int threads : {1, 2})
       benchmark::RegisterBenchmark(("Tick/" + scene + "/threads:" + std::to_string(threads)).c_str(), tick, scene, threads)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
+  for (const std::string scene : {"liver", "liver-12k"})
+    for (const MaterialVariant& v : material_variants())
+      benchmark::RegisterBenchmark(("Material/" + std::string(v.name) + "/" + scene).c_str(), tick_with_material, scene, v)
           ->Unit(benchmark::kMicrosecond)
           ->UseRealTime();
   benchmark::RunSpecifiedBenchmarks();

@@ -7,6 +7,9 @@
 # print live: the server its physics rate, step times, jitter, late ticks, missed slots and the force on the
 # tools; the client the force it feels, the command-to-force round trip and the surface frames it
 # receives; the console what the server did, and the server's health reports while the probe presses again.
+# Then the liver takes the tissue viscera-lab fitted to the bundled titin data, and the lab's linear
+# baseline for it, one after the other (viscera-control material --file); the probe presses each,
+# and viscera-plot draws both force curves in out/titin-vs-linear.svg.
 # viscera-record records the whole session to out/demo.mcap; at the end the demo prints the
 # recording's summary and re-runs the session on a fresh server in lockstep, bit for bit.
 # The instructor's console (viscera-console) runs beside it all: open the address it prints in a
@@ -51,6 +54,16 @@ console=$!
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
   --duration "$duration" 2>&1 | sed -u 's/^/[haptic] /'
 wait "$console" || true
+echo "[demo] the tissue viscera-lab fitted to the titin data set (docs/lab/titin) replaces the liver's, then the lab's linear baseline"
+echo "[demo] for the same data; probe 1 presses 2 cm into each (6 s), and viscera-plot draws both force curves in one plot"
+for tissue in titin-fitted titin-linear; do
+  "$bin/tools/viscera-control/viscera-control" material --file "$root/data/materials/$tissue.json" --domain "$domain" 2>&1 | head -1 | sed -u 's/^/[console] /'
+  "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.02 --duration 6 \
+    --report "$root/out/press-$tissue.json" 2>&1 | sed -u 's/^/[haptic] /'
+done
+"$bin/tools/viscera-plot/viscera-plot" "$root/out/press-titin-fitted.json=titin as fitted (spectrum, stiffening)" \
+  "$root/out/press-titin-linear.json=its linear baseline (Kelvin-Voigt)" --svg "$root/out/titin-vs-linear.svg" \
+  --title "The same 2 cm press on the liver's shape: titin as fitted against its linear baseline" 2>&1 | sed -u 's/^/[plot] /'
 if [ -n "${KEEP:-}" ]; then
   echo "[demo] done; the server and the console keep running (KEEP=1): open the console's address above; Ctrl-C ends them"
   wait "$server" || true

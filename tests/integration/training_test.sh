@@ -20,13 +20,15 @@ ctl="$build/tools/viscera-control/viscera-control"
 # The scene folder: the liver and the liver with a hidden nodule, on this test's domain.
 scenes="$tmp/scenes"; mkdir -p "$scenes"
 cp "$scene" "$scenes/liver.json"
-sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" \
-  "$src/data/scenes/liver-nodule.json" > "$scenes/liver-nodule.json"
+for scene_name in liver-nodule liver-titin; do
+  sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" \
+    "$src/data/scenes/$scene_name.json" > "$scenes/$scene_name.json"
+done
 # The shipped exercises with shorter time limits, so that a bad performance ends soon.
 ex="$tmp/exercises"; mkdir -p "$ex"
 python3 - "$src/data/exercises" "$ex" <<'PY'
 import json, sys
-for name, limit in (("force-drill", 20), ("retraction", 15), ("palpation", 90)):
+for name, limit in (("force-drill", 20), ("force-drill-titin", 20), ("retraction", 15), ("palpation", 90)):
     e = json.load(open(f"{sys.argv[1]}/{name}.json"))
     e["time_limit_s"] = limit
     json.dump(e, open(f"{sys.argv[2]}/{name}.json", "w"), indent=1)
@@ -54,6 +56,8 @@ perform() {
 
 perform drill_good force-drill - --instrument 1 --script hold --force 1.0 --duration 15 --quiet
 perform drill_bad force-drill - --instrument 1 --script hold --force 2.4 --duration 8 --quiet
+# The drill on the tissue viscera-lab fitted to the titin data (its material file, by a scene).
+perform drill_titin force-drill-titin - --instrument 1 --script hold --force 1.0 --duration 18 --quiet
 perform retraction_good retraction - --instrument 3 --script grasp --depth 0.005 --pull 0.02 --hold 7 --duration 12 --quiet
 perform retraction_bad retraction - --instrument 3 --script grasp --depth 0.005 --pull 0.02 --hold 1 --duration 6 --quiet
 perform palpation_good palpation 3 --instrument 1 --script palpate --depth 0.006 --duration 80
@@ -89,6 +93,8 @@ grep region "$tmp/nodule.log"
 check "force drill, held at 1.0 N: passed (rc $rc_live_drill_good)" "[ $rc_live_drill_good -eq 0 ] && grep -q 'PASSED' '$tmp/drill_good.live.log'"
 check "force drill, pressed at 2.4 N: failed for too much force (rc $rc_live_drill_bad)" \
   "[ $rc_live_drill_bad -eq 1 ] && grep -q 'too much force' '$tmp/drill_bad.live.log'"
+check "force drill on the lab-fitted titin tissue, held at 1.0 N: passed (rc $rc_live_drill_titin)" \
+  "[ $rc_live_drill_titin -eq 0 ] && grep -q 'PASSED' '$tmp/drill_titin.live.log' && grep -q 'liver-titin' '$tmp/drill_titin.live.log'"
 check "retraction, lifted and held: passed (rc $rc_live_retraction_good)" "[ $rc_live_retraction_good -eq 0 ]"
 check "retraction, let go after 1 s: failed, the lobe dropped (rc $rc_live_retraction_bad)" \
   "[ $rc_live_retraction_bad -eq 1 ] && grep -q 'the lobe was dropped' '$tmp/retraction_bad.live.log'"
@@ -104,7 +110,7 @@ print(f"palpation by touch: {len(rows)} presses, the force at 6 mm below the for
 PY
 check "palpation marked elsewhere: failed, the wrong place marked (rc $rc_live_palpation_bad)" \
   "[ $rc_live_palpation_bad -eq 1 ] && grep -q 'the wrong place was marked' '$tmp/palpation_bad.live.log'"
-for n in drill_good drill_bad retraction_good retraction_bad palpation_good palpation_bad; do
+for n in drill_good drill_bad drill_titin retraction_good retraction_bad palpation_good palpation_bad; do
   live_rc="rc_live_$n"; score_rc="rc_score_$n"
   check "$n: the score from the recording gives the same verdict (rc ${!live_rc} ${!score_rc})" "[ ${!live_rc} -eq ${!score_rc} ]"
 done

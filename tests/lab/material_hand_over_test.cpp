@@ -67,6 +67,12 @@ TEST(MaterialHandOver, TitinsFittedLawRunsFromItsMaterialFile) {
   const double worst = hand_over_error(a.supported_model(), d, "titin");
   std::cout << "[ figure ] titin: worst test " << 100 * worst << "% of its range\n";
   EXPECT_LT(worst, 0.05);
+  // The linear baseline: its Kelvin-Voigt dashpot (17 ms) goes over as a Maxwell branch, which
+  // must hold on the fastest ramp (0.1 s) too.
+  ASSERT_GT(a.baseline.model.viscosity_pa_s, 0);
+  const double baseline = hand_over_error(a.baseline.model, d, "titin-baseline");
+  std::cout << "[ figure ] titin's linear baseline (dashpot as a Maxwell branch): worst test " << 100 * baseline << "% of its range\n";
+  EXPECT_LT(baseline, 0.05);
 }
 
 TEST(MaterialHandOver, EachMechanismRunsFromItsMaterialFile) {

@@ -26,6 +26,16 @@ printf '$NOD\n1\n1 0 0 0\n$ENDNOD\n$ELM\n1\n1 4 1 1 4 1 1 1 2\n$ENDELM\n' >"$tmp
 echo '{"density_kg_m3": 1000, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.7}}' >"$tmp/bad.json"
 expect sim-help 0 "Usage: viscera-sim" -- "$sim" --help
 expect fig-help 0 "Usage: viscera-figure2" -- "$fig" --help
+plot="$build/tools/viscera-plot/viscera-plot"
+expect plot-help 0 "Usage: viscera-plot" -- "$plot" --help
+expect plot-nothing 2 "no REPORT.json to plot" -- "$plot" --svg "$tmp/p.svg"
+echo '{"samples": [{"t_s": 0, "tip_z_m": 0.01, "force_n": [0, 0, 1], "in_contact": true}]}' > "$tmp/report.json"
+expect plot-over-input 2 "which this program reads" -- "$plot" "$tmp/report.json" --svg "$tmp/report.json"
+expect plot-axis 2 "--x: 'speed' is not depth or time" -- "$plot" "$tmp/report.json" --svg "$tmp/p.svg" --x speed
+echo '{"samples": [{"t_s": 0, "tip_z_m": 0.01, "force_n": [0, 1], "in_contact": true}]}' > "$tmp/short.json"
+expect plot-bad-sample 2 "short.json: samples.0..force_n: .0,1. must be 3 numbers" -- "$plot" "$tmp/short.json" --svg "$tmp/p.svg"
+echo '{"samples": [{"t_s": 0, "tip_z_m": 0.01, "force_n": [0, 0, 0], "in_contact": false}]}' > "$tmp/apart.json"
+expect plot-no-contact 2 "apart.json: samples: the tool never touched the organ" -- "$plot" "$tmp/apart.json" --svg "$tmp/p.svg"
 expect sim-unknown 2 "unknown option --frobnicate" -- "$sim" --frobnicate 3
 expect sim-missing-mesh 2 "mesh is required" -- "$sim"
 expect sim-no-file 2 "nowhere.msh: cannot open file" -- "$sim" --mesh "$tmp/nowhere.msh"
@@ -75,7 +85,13 @@ expect control-annotate-no-text 2 "annotate needs its argument" -- "$build/tools
 expect control-load-path 2 "SCENE '../x' is not a scene name" -- "$build/tools/viscera-control/viscera-control" load ../x
 expect control-load-no-name 2 "load needs its argument" -- "$build/tools/viscera-control/viscera-control" load
 expect control-rate-range 2 "rate: 5 is outside \[10, 10000\] Hz" -- "$build/tools/viscera-control/viscera-control" rate 5
-expect control-material-empty 2 "material needs at least one of" -- "$build/tools/viscera-control/viscera-control" material
+expect control-material-empty 2 "material needs --file or at least one of" -- "$build/tools/viscera-control/viscera-control" material
+expect control-material-file-dir 2 "--file: $tmp: is a directory" -- "$build/tools/viscera-control/viscera-control" material --file "$tmp"
+printf '{"name": "x",\n "density_kg_m3": }' > "$tmp/half.json"
+expect control-material-file-json 2 "--file: $tmp/half.json:2: JSON: parse error" -- "$build/tools/viscera-control/viscera-control" material --file "$tmp/half.json"
+head -c 70000 /dev/zero | tr '\0' ' ' > "$tmp/huge.json"
+expect control-material-file-size 2 "huge.json: is 70000 bytes, more than the 65536" -- "$build/tools/viscera-control/viscera-control" material --file "$tmp/huge.json"
+expect control-material-file-elsewhere 2 "material flags are for the material action" -- "$build/tools/viscera-control/viscera-control" pause --file "$tmp/half.json"
 expect control-material-flag-elsewhere 2 "material flags are for the material action" -- "$build/tools/viscera-control/viscera-control" pause --shear-q 3
 expect control-material-range 2 "poisson-ratio" -- "$build/tools/viscera-control/viscera-control" material --poisson-ratio 0.7
 expect control-health-argument 2 "unexpected argument 'now'" -- "$build/tools/viscera-control/viscera-control" health now

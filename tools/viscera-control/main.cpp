@@ -127,6 +127,7 @@ Request parse(const viscera::common::CommandLine& cl) {
       if (const auto why = viscera::client::outside_range(std::string("--") + p.name, v, p.lo, p.hi)) throw UsageError(*why);
       r.change.*p.field = v;
     }
+  if (cl.has("file") && r.action != "material") throw UsageError("material flags are for the material action");
   if (cl.has("file")) r.change = with_material_file(r.change, cl.text("file"));
   if ((r.action == "material") != !r.change.empty())
     throw UsageError(

@@ -60,7 +60,10 @@ void run_analyze(const std::vector<std::string>& positional, const std::string& 
   write_report(a, decimate(d, AnalyzeOptions{}.max_fit_points), out, seconds);  // plots of what was fitted
   print_summary(a, seconds, out);
   if (std::filesystem::exists(out + "/material.json"))
-    std::printf("wrote %s/material.json: the model for the server's organs (a scene's \"material\")\n", out.c_str());
+    std::printf("wrote %s/material.json: the model for the server's organs (a scene's \"material\", or viscera-control material --file)\n",
+                out.c_str());
+  if (std::filesystem::exists(out + "/material-baseline.json"))
+    std::printf("wrote %s/material-baseline.json: the linear baseline's, to compare with\n", out.c_str());
 }
 
 void run_import(const std::vector<std::string>& positional, const std::string& out, const viscera::common::CommandLine& cl) {

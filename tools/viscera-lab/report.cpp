@@ -312,11 +312,17 @@ void md_test_plots(std::ostream& md, const Analysis& a, const TestData& t, const
 void write_report(const Analysis& a, const Dataset& d, const std::string& out_dir, double seconds) {
   fs::create_directories(out_dir);
   // The organ's material: the model the analysis stands by, in the server's GPS as it is.
-  std::string why;
-  const std::string material = material_file_text(a.supported_model(), d, a.dataset + " (viscera-lab)", &why);
+  std::string why, note;
+  const std::string material = material_file_text(a.supported_model(), d, a.dataset + " (viscera-lab)", &why, &note);
   if (!material.empty()) std::ofstream(fs::path(out_dir) / "material.json") << material;
+  // And the baseline's, the linear tissue to compare it with (the same press on both).
+  std::string why_baseline;
+  const std::string baseline = material_file_text(a.baseline.model, d, a.dataset + " (viscera-lab, linear baseline)", &why_baseline);
+  if (!baseline.empty()) std::ofstream(fs::path(out_dir) / "material-baseline.json") << baseline;
   json j = report_json(a, d, seconds);
   j["material_file"] = material.empty() ? json{{"written", false}, {"why", why}} : json{{"written", true}, {"file", "material.json"}};
+  if (!baseline.empty()) j["material_file"]["baseline_file"] = "material-baseline.json";
+  if (!note.empty()) j["material_file"]["note"] = note;
   std::ofstream(fs::path(out_dir) / "report.json") << j.dump(2) << "\n";
   write_model((fs::path(out_dir) / "model.json").string(), a.supported_model(), a.dataset);
 
@@ -335,7 +341,8 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
      << (material.empty() ? "not written: " + why
                           : std::string("`material.json` (docs/MATERIAL.md, model `relaxation_spectrum`): the model above in the server's GPS, its "
                                         "elastic shape calibrated on this specimen; a scene names it as its material"))
-     << ".\n\n";
+     << (baseline.empty() ? std::string() : "; the baseline's, the linear tissue to compare it with: `material-baseline.json`")
+     << (note.empty() ? std::string() : " (" + note + ")") << ".\n\n";
   md << "## Data, baseline and final model\n\n";
   for (const TestData& t : d.tests) md_test_plots(md, a, t, out_dir);
 }

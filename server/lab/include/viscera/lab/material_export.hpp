@@ -12,8 +12,16 @@
 
 namespace viscera::lab {
 
+/// A Kelvin-Voigt dashpot eta = E_u tau_kv is handed over as a Maxwell branch of this many times
+/// the unrelaxed modulus and time tau_kv / it: the same viscosity below 1 / (2 pi tau), a bounded
+/// stiffness above. The organ's explicit integrator cannot take the dashpot itself: its stable step
+/// falls like dt_e^2 / (2 tau_kv) (dt_e the elastic step; 1.7 us for the titin baseline's 17 ms on
+/// the 1.5k liver), while the branch shortens it by sqrt(1 + kDashpotBranchStiffness) = 1.41.
+inline constexpr double kDashpotBranchStiffness = 1.0;
+
 /// The material file's text for `m` fitted to `d`, named `name`; empty, with `why`, for a law the
 /// GPS cannot represent (specimen_supports: Ogden's form; stiffening or asymmetry in simple shear).
-std::string material_file_text(const MaterialModel& m, const Dataset& d, const std::string& name, std::string* why);
+/// A Kelvin-Voigt time becomes a Maxwell branch (kDashpotBranchStiffness), said in `note`.
+std::string material_file_text(const MaterialModel& m, const Dataset& d, const std::string& name, std::string* why, std::string* note = nullptr);
 
 }  // namespace viscera::lab
