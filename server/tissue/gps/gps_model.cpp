@@ -193,10 +193,12 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     if (qlv > 0 || qlv_energy) {  // Fung: elongation measure L0 g(e) or L0 h(e), e = dL / L0
       if (qlv_energy) {
         for (int k = 0; k < 6; ++k)
+#pragma omp simd
           for (int j = 0; j < L; ++j) {
-            const FungEnergyMap m = edge_energy_map(qlv, ratio, dL[k][j] * b.inv_rest_length[k][j], shape);
-            dL[k][j] = b.rest_length[k][j] * m.h;
-            dh[k][j] = m.dh;
+            double h, dhk;
+            lanes::edge_energy_map(qlv, ratio, shape, dL[k][j] * b.inv_rest_length[k][j], h, dhk);
+            dL[k][j] = b.rest_length[k][j] * h;
+            dh[k][j] = dhk;
           }
       } else {
         for (int k = 0; k < 6; ++k)
