@@ -51,7 +51,7 @@ ImportColumn parse_import_column(const std::string& flag, const std::string& tex
   throw common::UsageError("--" + flag + ": unit '" + c.unit + "' is not a " + quantity_name(q) + " unit (" + known + ")");
 }
 
-TestData import_test(const std::string& path, const ImportOptions& o) {
+TestData import_test(const std::string& path, const ImportOptions& o, ImportOffsets* taken_off) {
   const std::string content = common::read_text_file(path, kMaxExportBytes);
   CsvLines lines(content);
   const auto first = lines.next();
@@ -93,6 +93,23 @@ TestData import_test(const std::string& path, const ImportOptions& o) {
     t.stress_pa.push_back(value(cf, o.force) / area);
   }
   if (t.time_s.size() < 3) throw InputError(path, row, "rows", std::to_string(t.time_s.size()) + " rows of data: a test needs at least 3");
+  ImportOffsets off;
+  if (o.tare) {
+    // The force at rest: the mean over the leading rows whose displacement is the first row's
+    // (the machine holding the specimen before it moves it), at least the first row.
+    std::size_t rest = 1;
+    while (rest < t.strain.size() && t.strain[rest] == t.strain.front()) ++rest;
+    double first = 0.0;
+    for (std::size_t i = 0; i < rest; ++i) first += t.stress_pa[i] / static_cast<double>(rest);
+    off.force_n = first * area;
+    for (double& s : t.stress_pa) s -= first;
+  }
+  if (o.zero_displacement) {
+    off.displacement_m = t.strain.front() * gauge;
+    const double first = t.strain.front();
+    for (double& e : t.strain) e -= first;
+  }
+  if (taken_off) *taken_off = off;
   return t;
 }
 
@@ -104,8 +121,13 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   d.mode = o.mode;
   d.specimen = o.specimen;
   std::set<std::string> names;
+  std::string offsets;
   for (const auto& f : files) {
-    d.tests.push_back(import_test(f, o));
+    ImportOffsets off;
+    d.tests.push_back(import_test(f, o, &off));
+    if (o.tare || o.zero_displacement)
+      offsets += (offsets.empty() ? "" : ", ") + d.tests.back().file + ":" + (o.tare ? " force " + common::short_number(off.force_n) + " N" : "") +
+                 (o.zero_displacement ? " displacement " + common::short_number(off.displacement_m) + " m" : "");
     if (!names.insert(d.tests.back().file).second)
       throw InputError(f, 0, "", "a second export named " + d.tests.back().file + ": each test is written under its file's name");
   }
@@ -115,6 +137,9 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
                   "; strain = '" + o.displacement.name + "' [" + o.displacement.unit + "] x " + common::short_number(o.displacement.to_si) +
                   " / specimen." + gauge + "; stress_pa = '" + o.force.name + "' [" + o.force.unit + "] x " + common::short_number(o.force.to_si) +
                   " / (specimen." + area + ")";
+  if (o.tare) d.import_note += "; tare: each test's force at rest (its leading rows before the displacement moves) subtracted (a preload)";
+  if (o.zero_displacement) d.import_note += "; displacement from each test's first row";
+  if (!offsets.empty()) d.import_note += " (taken off: " + offsets + ")";
   write_dataset(d, folder);
   return read_dataset(folder);
 }

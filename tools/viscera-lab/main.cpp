@@ -84,6 +84,8 @@ void run_import(const std::vector<std::string>& positional, const std::string& o
   o.time = parse_import_column("time", cl.text("time"), ImportQuantity::time);
   o.force = parse_import_column("force", cl.text("force"), ImportQuantity::force);
   o.displacement = parse_import_column("displacement", cl.text("displacement"), ImportQuantity::displacement);
+  o.tare = cl.has("tare");
+  o.zero_displacement = cl.has("zero-displacement");
   const Dataset d = import_dataset(files, o, out);
   for (const auto& t : d.tests)
     std::printf("%s: %zu rows, %.4g s, strain %.4g to %.4g, stress %.4g to %.4g Pa\n", t.file.c_str(), t.time_s.size(),
@@ -134,6 +136,9 @@ int main(int argc, char** argv) {
   cl.flag("force", "COLUMN[:UNIT]", "import: the force column, N | mN | kN");
   cl.flag("displacement", "COLUMN[:UNIT]", "import: the displacement column (from the unloaded specimen), m | mm | um");
   cl.flag("name", "NAME", "import: the data set's name (default: the --out folder's)");
+  cl.option_switch("tare",
+                   "import: subtract each export's first force from its forces (a preload at the start: the test then starts at zero stress)");
+  cl.option_switch("zero-displacement", "import: displacements from each export's first row, not from the export's own zero");
   cl.allow_positional(1000);
   const auto usage_error = [](const std::string& what) {
     std::fprintf(stderr, "viscera-lab: %s (see --help)\n", what.c_str());

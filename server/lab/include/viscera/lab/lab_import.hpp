@@ -31,15 +31,27 @@ struct ImportOptions {
   Control control = Control::strain;
   Specimen specimen;
   ImportColumn time{"time", "s", 1.0}, force{"force", "N", 1.0}, displacement{"displacement", "m", 1.0};
+  /// A preload taken off: each export's force at rest (the mean over its leading rows whose
+  /// displacement is the first row's; at least the first row, whose noise a single row carries
+  /// into the whole test) is subtracted from all of its forces, as a machine's "zero force"
+  /// button does, so that the test starts at zero stress.
+  bool tare = false;
+  /// Displacements from each export's first row instead of the export's own zero.
+  bool zero_displacement = false;
+};
+
+/// What import_test took off an export (SI): its first force and first displacement, 0 when not asked.
+struct ImportOffsets {
+  double force_n = 0.0, displacement_m = 0.0;
 };
 
 /// One export as a test: the file separated by commas, semicolons or tabs (the first line's most
 /// frequent one), a header row naming the columns, empty lines skipped. Throws common::InputError
 /// naming the file, the line and the column.
-TestData import_test(const std::string& path, const ImportOptions& o);
+TestData import_test(const std::string& path, const ImportOptions& o, ImportOffsets* taken_off = nullptr);
 
 /// The exports `files` as a data set in `folder`: one CSV per file (named after it), dataset.json
-/// with the conversion under "import"; then read back with read_dataset, so that every check a
+/// with the conversion under "import" (with each test's tare and displacement zero); then read back with read_dataset, so that every check a
 /// data set gets (units that cannot be right, times that do not increase) applies. Refuses a
 /// folder that already holds a dataset.json, and two files with the same name.
 Dataset import_dataset(const std::vector<std::string>& files, const ImportOptions& o, const std::string& folder);
