@@ -108,6 +108,9 @@ expect lab-no-dataset 2 "nowhere/dataset.json: cannot open file" -- "$lab" analy
 printf 'Time;Force;Disp\n0;0;0\n1;30;0.5\n2;60;1\n3;58;1\n4;57;1\n' > "$tmp/export.txt"
 import=(--length-m 0.01 --width-m 0.003 --thickness-m 0.002 --force Force:mN --displacement Disp:mm --time Time)
 expect lab-import 0 "export.csv: 5 rows, 4 s, strain 0 to 0.1, stress 0 to 1e+04 Pa" -- "$lab" import "$tmp/export.txt" --out "$tmp/imported" "${import[@]}"
+# A preload of 12 mN held for two rows and a displacement zero 0.4 mm away, taken off.
+printf 'Time;Force;Disp\n0;12;0.4\n1;12;0.4\n2;42;0.9\n3;72;1.4\n4;70;1.4\n' > "$tmp/preloaded.txt"
+expect lab-import-tare 0 "preloaded.csv: 5 rows, 4 s, strain 0 to 0.1, stress 0 to 1e+04 Pa" -- "$lab" import "$tmp/preloaded.txt" --out "$tmp/tared" "${import[@]}" --tare --zero-displacement
 expect lab-import-again 2 "imported/dataset.json: already exists" -- "$lab" import "$tmp/export.txt" --out "$tmp/imported" "${import[@]}"
 expect lab-import-unit 2 "--force: unit 'lbf' is not a force unit" -- "$lab" import "$tmp/export.txt" --out "$tmp/i2" "${import[@]}" --force Force:lbf
 mkdir -p "$tmp/in" && cp "$tmp/export.txt" "$tmp/in/export.csv"
