@@ -5,6 +5,8 @@
 // 10-40% strain, like the blood clots of issue 38. Only the noise is random. Truths and forms the lab's catalogue was not
 // built on: one relaxation time (not a broad band), specimens that differ from test to test, and
 // noise that a logger's filter has correlated over many samples.
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -379,4 +381,77 @@ TEST(Import, APreloadAndAnotherZeroAreTakenOffWhenAsked) {
   std::printf("[ figure ] preload left in: baseline held-out RMS %.1f Pa (with the tare %.1f Pa)\n", c.baseline.heldout_rms_pa,
               b.baseline.heldout_rms_pa);
   EXPECT_GT(c.baseline.heldout_rms_pa, 3 * b.baseline.heldout_rms_pa);
+}
+
+namespace {
+
+/// Two discs (10 mm across, 4.37 and 3.78 mm thick) compressed in six steps of 10% to 60%, ramps at
+/// 1 um/s, holds of 800 s, sampled at 1 Hz, forces quantised at 0.1 N (1.3 kPa) over 300 Pa of
+/// noise, after a tare. The tissue: the first 4% of compression only takes up contact (a toe: no
+/// stress), then an exponential stiffening in compression (E = 15 kPa, B = 4) beside one Maxwell
+/// arm (40 kPa, 300 s). The toe lies outside the lab's catalogue.
+Dataset disc_like() {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> gauss(0.0, 300.0);
+  Dataset d;
+  d.name = "disc-like";
+  d.folder = "generated";
+  d.mode = Mode::uniaxial;
+  const double area = 3.14159265358979 * 0.005 * 0.005, quantum = 0.1 / area, toe = 0.04, tau = 300.0, E = 15e3, B = 4.0, E1 = 40e3;
+  d.specimen = {4.37e-3, 0.00886, 0.00886, 1050};  // a square of the disc's area
+  int k = 0;
+  for (const double thickness : {4.37e-3, 3.78e-3}) {
+    TestData t;
+    t.file = "disc" + std::to_string(++k) + ".csv";
+    if (k == 2) t.specimen = Specimen{thickness, 0.00886, 0.00886, 1050};
+    const double rate = 1e-6 / thickness, ramp = 0.1 / rate;  // strain per second, ramp time
+    double eps = 0, q = 0, previous_load = 0, time = 0;
+    for (int step = 0; step < 6; ++step)
+      for (double s = 0; s < ramp + 800.0; s += 1.0, time += 1.0) {
+        eps = -(0.1 * step + std::min(0.1, rate * s));
+        const double load = std::min(0.0, eps + toe);  // compression past the toe
+        if (time > 0) q = q * std::exp(-1.0 / tau) + E1 * (load - previous_load) * tau * (1 - std::exp(-1.0 / tau));
+        previous_load = load;
+        const double elastic = -(E / B) * std::expm1(-B * load);
+        t.time_s.push_back(time);
+        t.strain.push_back(eps);
+        t.stress_pa.push_back(quantum * std::round((elastic + q + gauss(rng)) / quantum));
+      }
+    d.tests.push_back(std::move(t));
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST(OtherLabs, DiscLikeCompressionToSixtyPercent) {
+  const Dataset d = disc_like();
+  const auto t0 = std::chrono::steady_clock::now();
+  const Analysis a = analyze(d, {}, {.specimen = false});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("[ figure ] disc-like: %s\n", a.verdict.c_str());
+  std::printf(
+      "[ figure ] disc-like: baseline held-out %.0f Pa, final %.0f Pa (%s), nested %.0f Pa (gain %.2f, %s), noise %.0f Pa / holds %.0f Pa, "
+      "adequacy %s (%.1fx the noise), %.1f s\n",
+      a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.final.model.describe().c_str(), a.nested_heldout_rms_pa, a.nested_gain,
+      a.nested_not_run.c_str(), a.noise_pa, a.noise_check.holds_pa, a.adequacy.explained ? "explained" : "not explained",
+      a.adequacy.residual_to_noise, seconds);
+  for (const auto& f : a.adequacy.findings) std::printf("[ figure ]   %s\n", f.c_str());
+  // Done within seconds (the material-point law; the specimen's limits are tested above).
+  EXPECT_LT(seconds, 60.0);
+  // The truth's two mechanisms, both above the noise, named; nothing else. With two tests the
+  // honest gain cannot be measured: tentative, and said why.
+  const auto named = a.named_causes();
+  const auto has = [&](Mechanism m) { return std::find(named.begin(), named.end(), m) != named.end(); };
+  EXPECT_TRUE(has(Mechanism::strain_stiffening));
+  EXPECT_TRUE(has(Mechanism::broadband_relaxation));
+  EXPECT_FALSE(has(Mechanism::tension_compression_asymmetry));
+  EXPECT_FALSE(has(Mechanism::first_load_softening));
+  EXPECT_EQ(a.causes_status, CausesStatus::tentative);
+  EXPECT_NE(a.nested_not_run.find("at least 3"), std::string::npos) << a.nested_not_run;
+  // The final model predicts each disc from the other within twice the noise, several times
+  // better than the linear baseline. (The 4% toe gives at most 600 Pa, under the 1.3 kPa quantum:
+  // the data cannot show it, and the verdict rightly does not claim it.)
+  EXPECT_LT(a.final.heldout_rms_pa, 2.0 * a.noise_pa);
+  EXPECT_GT(a.baseline.heldout_rms_pa, 3.0 * a.final.heldout_rms_pa);
 }
