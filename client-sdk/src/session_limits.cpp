@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 #include <sstream>
 
 #include "viscera/common/plain_name.hpp"
@@ -30,5 +31,13 @@ std::optional<std::string> outside_range(const std::string& name, double value, 
 bool is_scene_name(const std::string& n) { return common::is_plain_name(n); }
 
 std::string not_a_scene_name(const std::string& n) { return "SCENE '" + n + "' is not a scene name (letters, digits, '.', '_', '-'; no path)"; }
+
+std::string plain_file_name(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string().substr(0, 64);
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+  if (name.empty() || name[0] == '.') name.insert(0, "m");
+  return name.substr(0, 64);
+}
 
 }  // namespace viscera::client

@@ -97,6 +97,11 @@ TEST(BrowserRequest, AcceptsEachTypeWithItsFields) {
   ASSERT_TRUE(mv) << why;
   EXPECT_EQ(mv->instrument, 3u);
   EXPECT_EQ(mv->delta_m[1], -0.01);
+  // A material file from the page: its text whole, its name made plain as viscera-control does.
+  const auto f = vc::parse_browser_request(R"({"type":"material","file-name":"../my fit (2).json","file-text":"{\"name\": \"x\"}"})", &why);
+  ASSERT_TRUE(f) << why;
+  EXPECT_EQ(f->change.file_name, "my_fit__2_.json");
+  EXPECT_EQ(f->change.file_text, R"({"name": "x"})");
   const auto b = vc::parse_browser_request(R"({"type":"bookmark"})", &why);
   ASSERT_TRUE(b) << why;
   EXPECT_TRUE(b->text.empty());
@@ -111,7 +116,10 @@ TEST(BrowserRequest, RefusesWithTheFieldAndTheValue) {
   // viscera-control's ranges and words (client/session_limits.hpp).
   EXPECT_EQ(error_of(R"({"type":"material","youngs-modulus-pa":2e9})"), "youngs-modulus-pa: 2e+09 is outside [1, 1e+09]");
   EXPECT_EQ(error_of(R"({"type":"material","poisson-ratio":0.5})"), "poisson-ratio: 0.5 is outside [0, 0.4999]");
-  EXPECT_EQ(error_of(R"({"type":"material"})").substr(0, 30), "material: needs at least one o");
+  EXPECT_EQ(error_of(R"({"type":"material"})").substr(0, 30), "material: needs file-text or a");
+  EXPECT_EQ(error_of(R"({"type":"material","file-text":"{}"})"), "material: file-text and file-name go together");
+  EXPECT_EQ(error_of(R"({"type":"material","file-name":"","file-text":"{}"})"), "file-name: \"\" is not a file's name");
+  EXPECT_EQ(error_of(R"({"type":"material","file-name":"a.json","file-text":7})"), "file-text: not a string of at most 65536 bytes");
   EXPECT_EQ(error_of(R"({"type":"load_scene","scene":"../x"})"), "SCENE '../x' is not a scene name (letters, digits, '.', '_', '-'; no path)");
   EXPECT_EQ(error_of(R"({"type":"pause","id":-1})"), "id: -1 is not a whole number >= 0");
   EXPECT_EQ(error_of(R"({"type":"take_over"})"), "take_over: instrument missing");

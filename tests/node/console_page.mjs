@@ -3,11 +3,13 @@
 // tests/integration/console_test.sh). Checks what an instructor relies on, from the page's state
 // (window.viscera) and from the server's own streams (viscera-control), not from pixels:
 //   the page is refused without the token; with it the mesh arrives and moves during the press;
-//   the force plot rises; Pause pauses the server; a bookmark reaches the session's events.
+//   the force plot rises; Pause pauses the server; a bookmark reaches the session's events; the
+//   material form and a material file chosen in the page change the tissue.
 // Usage: node console_page.mjs URL_WITH_TOKEN SCREENSHOT_DIR CONTROL_COMMAND...
 // Prints one JSON line of measurements; exit status 0 when every check passed.
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
 
 const [url, shots, ...control] = process.argv.slice(2);
 const checks = [];
@@ -80,6 +82,12 @@ try {
   await page.click('#material button');
   const changed = await until(page, () => window.viscera.scene && Math.abs(window.viscera.scene.material.youngs_modulus_pa - 7000) < 1, null, 30000);
   check('the material form changes the tissue', changed, `E = ${await page.evaluate(() => window.viscera.scene.material.youngs_modulus_pa)} Pa`);
+  // A material file chosen in the page (the lab's fit of the titin data) becomes the organ's.
+  await page.setInputFiles('#material-file input[name="file"]', fileURLToPath(new URL('../../data/materials/titin-fitted.json', import.meta.url)));
+  await page.click('#material-file button');
+  const fromFile = await until(page, () => window.viscera.scene && window.viscera.scene.material.name.startsWith('titin-passive-muscle'), null, 30000);
+  check('a material file chosen in the page becomes the tissue', fromFile,
+    `material ${(await page.evaluate(() => window.viscera.scene.material.name)).slice(0, 40)}..., E = ${await page.evaluate(() => window.viscera.scene.material.youngs_modulus_pa)} Pa`);
 
   // Take over the trainee's probe, drive it, hand it back: ownership moves in one step each way
   // (the server's scene state, read by viscera-control; no release event in between).

@@ -26,7 +26,9 @@ const std::array<TypeInfo, 13>& types() {
       {RequestType::resume, "resume", {}},
       {RequestType::reset, "reset", {}},
       {RequestType::load_scene, "load_scene", {"scene", "seed"}},
-      {RequestType::material, "material", {"youngs-modulus-pa", "poisson-ratio", "density-kg-m3", "shear-q", "damping-per-s"}},
+      {RequestType::material,
+       "material",
+       {"youngs-modulus-pa", "poisson-ratio", "density-kg-m3", "shear-q", "damping-per-s", "file-name", "file-text"}},
       {RequestType::annotate, "annotate", {"text"}},
       {RequestType::bookmark, "bookmark", {"label"}},
       {RequestType::watch, "watch", {"station"}},
@@ -122,6 +124,15 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
       if (!s || !is_recording_name(*s))
         return fail("file: " + shown(value) + " is not a recording's name (letters, digits, '.', '_', '-', ending in .mcap; no path)");
       r.text = *s;
+    } else if (key == "file-name") {
+      // A material file's name, for people: any file name, made plain as viscera-control makes it.
+      const auto s = text(255);
+      if (!s || s->empty()) return fail("file-name: " + shown(value) + " is not a file's name");
+      r.change.file_name = client::plain_file_name(*s);
+    } else if (key == "file-text") {
+      const auto s = text(protocol::kMaxMaterialFileBytes);
+      if (!s) return fail("file-text: not a string of at most " + std::to_string(protocol::kMaxMaterialFileBytes) + " bytes");
+      r.change.file_text = *s;
     } else if (key == "station") {
       const auto s = text(64);
       if (!s) return fail("station: " + shown(value) + " is not a station name");
@@ -140,8 +151,10 @@ std::optional<BrowserRequest> parse_browser_request(std::string_view message, st
     return fail(std::string(info->name) + ": instrument missing");
   if (r.type == RequestType::open_recording && r.text.empty()) return fail("open_recording: file missing");
   if (r.type == RequestType::annotate && r.text.empty()) return fail("annotate: text missing or empty");
+  if (r.type == RequestType::material && r.change.file_text.has_value() != !r.change.file_name.empty())
+    return fail("material: file-text and file-name go together");
   if (r.type == RequestType::material && r.change.empty())
-    return fail("material: needs at least one of youngs-modulus-pa, poisson-ratio, density-kg-m3, shear-q, damping-per-s");
+    return fail("material: needs file-text or at least one of youngs-modulus-pa, poisson-ratio, density-kg-m3, shear-q, damping-per-s");
   return r;
 }
 

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <map>
 #include <optional>
 #include <thread>
@@ -39,11 +38,7 @@ viscera::protocol::MaterialChange with_material_file(viscera::protocol::Material
   } catch (const viscera::common::InputError& e) {
     throw viscera::common::UsageError(std::string("--file: ") + e.what());
   }
-  std::string name = std::filesystem::path(path).filename().string().substr(0, 64);
-  for (char& c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
-  if (name.empty() || name[0] == '.') name.insert(0, "m");
-  change.file_name = name.substr(0, 64);
+  change.file_name = viscera::client::plain_file_name(path);
   return change;
 }
 

@@ -28,6 +28,10 @@ bool is_scene_name(const std::string& name);
 /// Why `name` is not a scene name (the words both consoles use).
 std::string not_a_scene_name(const std::string& name);
 
+/// A file's name as a material change carries it (protocol: [A-Za-z0-9._-], 1-64, no leading
+/// '.'): the path's last part, other characters replaced by '_', cut to 64.
+std::string plain_file_name(const std::string& path);
+
 /// The longest annotation text [bytes].
 inline constexpr std::size_t kMaxAnnotationBytes = 1024;
 

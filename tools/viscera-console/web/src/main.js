@@ -407,6 +407,13 @@ $('material').onsubmit = (e) => {
   if (Object.keys(request).length === 1) { status('material: nothing changed.'); return; }
   send(request);
 };
+$('material-file').onsubmit = async (e) => {
+  e.preventDefault();
+  const file = e.target.file.files[0];
+  if (!file) { status('material file: choose one first.'); return; }
+  if (file.size > 12 * 1024) { status(`material file: ${file.name} is ${file.size} bytes; the console sends at most 12 KiB (viscera-control material --file takes 64 KiB)`); return; }
+  send({ type: 'material', 'file-name': file.name, 'file-text': await file.text() });
+};
 $('annotate').onsubmit = (e) => {
   e.preventDefault();
   const text = e.target.text.value.trim();
