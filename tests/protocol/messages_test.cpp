@@ -242,7 +242,7 @@ TEST(Messages, RunTimeControlRequestsRoundTripAndBadOnesAreRejected) {
   EXPECT_EQ(m->material.shear_q, 3);
   EXPECT_FALSE(m->material.poisson_ratio);  // absent stays absent (FlatBuffers optional scalar)
   EXPECT_FALSE(m->material.density_kg_m3);
-  const auto rejects = [&](MaterialChange c, const std::string& field) {
+  const auto rejects = [&](const MaterialChange& c, const std::string& field) {
     SessionRequest r = mat;
     r.material = c;
     EXPECT_FALSE(decode_session_request(encode(r), &why)) << field;
