@@ -19,22 +19,27 @@ namespace {
 
 using namespace viscera;
 
+/// Ticks of `organ` at `rate_hz` from its rest shape scaled by `stretch`, with a small velocity
+/// field (1 mm/s), so that the organ moves and the memory variables change.
+void run_ticks(benchmark::State& st, const runtime::Organ& organ, double rate_hz, double stretch) {
+  // The contact compliance factorises on a worker thread: wait for it, so it does not share the cores.
+  if (organ.mesh->node_count() > 0) organ.compliance->wait_node(0);
+  tissue::State state = tissue::State::at_rest(*organ.mesh);
+  for (std::size_t i = 0; i < state.v.size(); ++i) {
+    state.x[i] *= stretch;
+    state.v[i] = 1e-3 * tissue::Vec3(std::sin(0.7 * static_cast<double>(i)), std::cos(1.3 * static_cast<double>(i)), 0.0);
+  }
+  long sub_steps = 0;
+  for (auto _ : st) sub_steps = organ.integrator->advance(state, 1.0 / rate_hz);
+  st.counters["sub_steps"] = static_cast<double>(sub_steps);
+  st.counters["tets"] = static_cast<double>(organ.mesh->tet_count());
+}
+
 void tick(benchmark::State& st, const std::string& scene_name, int threads) {
   runtime::SceneSpec scene = runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
   scene.physics_threads = threads;
-  const auto organ = runtime::build_organ(scene);
-  // The contact compliance factorises on a worker thread: wait for it, so it does not share the cores.
-  if (organ->mesh->node_count() > 0) organ->compliance->wait_node(0);
-  tissue::State state = tissue::State::at_rest(*organ->mesh);
-  // A small velocity field (1 mm/s), so that the organ moves and the memory variables change.
-  for (std::size_t i = 0; i < state.v.size(); ++i)
-    state.v[i] = 1e-3 * tissue::Vec3(std::sin(0.7 * static_cast<double>(i)), std::cos(1.3 * static_cast<double>(i)), 0.0);
-  const double dt = 1.0 / scene.physics_rate_hz;
-  long sub_steps = 0;
-  for (auto _ : st) sub_steps = organ->integrator->advance(state, dt);
-  st.counters["sub_steps"] = static_cast<double>(sub_steps);
-  st.counters["tets"] = static_cast<double>(organ->mesh->tet_count());
-  st.counters["tick_budget_us"] = 1e6 * dt;
+  run_ticks(st, *runtime::build_organ(scene), scene.physics_rate_hz, 1.0);
+  st.counters["tick_budget_us"] = 1e6 / scene.physics_rate_hz;
 }
 
 /// The tick of `scene` with its organ switched to another material (as viscera-control material
@@ -78,19 +83,8 @@ void tick_with_material(benchmark::State& st, const std::string& scene_name, con
     change.file_text = R"({"name": ")" + std::string(variant.name) +
                        R"(", "density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45})" +
                        (variant.viscoelasticity.empty() ? "" : ", \"viscoelasticity\": " + variant.viscoelasticity) + "}";
-  const auto organ = runtime::rebuild_with_material(*built, change, scene.physics_rate_hz);
-  if (organ->mesh->node_count() > 0) organ->compliance->wait_node(0);
-  tissue::State state = tissue::State::at_rest(*organ->mesh);
-  // A small stretch and velocity field, so that stiffening, asymmetry and softening act.
-  for (std::size_t i = 0; i < state.v.size(); ++i) {
-    state.x[i] *= 1.002;
-    state.v[i] = 1e-3 * tissue::Vec3(std::sin(0.7 * static_cast<double>(i)), std::cos(1.3 * static_cast<double>(i)), 0.0);
-  }
-  const double dt = 1.0 / scene.physics_rate_hz;
-  long sub_steps = 0;
-  for (auto _ : st) sub_steps = organ->integrator->advance(state, dt);
-  st.counters["sub_steps"] = static_cast<double>(sub_steps);
-  st.counters["tets"] = static_cast<double>(organ->mesh->tet_count());
+  // A small stretch, so that stiffening, asymmetry and softening act.
+  run_ticks(st, *runtime::rebuild_with_material(*built, change, scene.physics_rate_hz), scene.physics_rate_hz, 1.002);
 }
 
 }  // namespace
