@@ -1,5 +1,6 @@
 #include "viscera/client/stream_tap.hpp"
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -16,6 +17,10 @@ std::vector<proto::Stream> session_streams() {
   return out;
 }
 
+/// The most samples per key a state stream's reader keeps (a burst of states; a surface topology
+/// is large, so not the tap's full depth).
+constexpr int kStateDepth = 16;
+
 struct StreamTap::Impl {
   proto::Participant participant;
   std::vector<std::pair<proto::Stream, std::unique_ptr<proto::Reader>>> readers;
@@ -25,9 +30,14 @@ struct StreamTap::Impl {
 StreamTap::StreamTap(std::uint32_t domain_id, const std::string& partition, const std::vector<proto::Stream>& streams, int depth)
     : impl_(std::make_unique<Impl>(domain_id, partition)) {
   for (const proto::Stream s : streams) {
-    // The streams whose history is their state (kept last per key) keep it; the others keep `depth`.
+    // Every sample that reaches the tap is kept until taken: `depth` per key, and for the streams
+    // whose newest sample is their state (the scene, its surface, its files) up to
+    // kStateDepth, so that states published milliseconds apart (a request's "preparing" and its
+    // refusal) are all recorded, not the last alone (a reader of the stream's own depth, 1, lost
+    // the first when both arrived between two takes).
     const bool state = proto::stream_info(s).state;
-    impl_->readers.emplace_back(s, std::make_unique<proto::Reader>(impl_->participant, s, proto::ReaderOptions{state ? 0 : depth}));
+    impl_->readers.emplace_back(
+        s, std::make_unique<proto::Reader>(impl_->participant, s, proto::ReaderOptions{state ? std::min(depth, kStateDepth) : depth}));
   }
 }
 

@@ -27,24 +27,27 @@ HoldNoise noise_in_holds(const TestData& t, double window_s) {
   const std::size_t n = t.time_s.size();
   HoldNoise r;
   if (n < 27) return r;
-  const double dt = (t.time_s.back() - t.time_s.front()) / static_cast<double>(n - 1);
-  const std::size_t half = std::max<std::size_t>(4, static_cast<std::size_t>(std::lround(0.5 * window_s / dt)));
-  const std::size_t w = 2 * half + 1;
-  r.window_s = static_cast<double>(w) * dt;
   const auto [lo, hi] = std::minmax_element(held.begin(), held.end());
   const double tol = 4 * noise_from_second_differences(held) + 1e-6 * (*hi - *lo);
+  // Residuals about the running mean, each divided by the share of the noise a w-sample mean
+  // leaves in it (variance sd^2 (1 - 1/w) for white noise). The window is window_s in each
+  // hold's own sampling (a logger may thin its rate in long holds), at least 9 samples.
   std::vector<double> residual;
   std::size_t start = 0;
   for (std::size_t k = 1; k <= n; ++k) {
     if (k < n && std::abs(held[k] - held[start]) <= tol) continue;
     const std::size_t end = k;  // held over [start, end)
-    if (end - start >= 3 * w) {
-      ++r.holds;
+    const double dt = end - start > 1 ? (t.time_s[end - 1] - t.time_s[start]) / static_cast<double>(end - 1 - start) : 0.0;
+    const std::size_t half = dt > 0 ? std::max<std::size_t>(4, static_cast<std::size_t>(std::lround(0.5 * window_s / dt))) : 4;
+    const std::size_t w = 2 * half + 1;
+    if (dt > 0 && end - start >= 3 * w) {
+      if (r.holds++ == 0) r.window_s = static_cast<double>(w) * dt;
+      const double share = std::sqrt(1.0 - 1.0 / static_cast<double>(w));
       double sum = 0;
       const std::size_t first = start + w;  // the first window of the hold is left out
       for (std::size_t j = first - half; j <= first + half; ++j) sum += measured[j];
       for (std::size_t c = first; c + half < end; ++c) {
-        residual.push_back(measured[c] - sum / static_cast<double>(w));
+        residual.push_back(std::abs(measured[c] - sum / static_cast<double>(w)) / share);
         if (c + half + 1 < end) sum += measured[c + half + 1] - measured[c - half];
       }
     }
@@ -52,12 +55,9 @@ HoldNoise noise_in_holds(const TestData& t, double window_s) {
   }
   if (residual.empty()) return r;
   r.samples = residual.size();
-  for (double& x : residual) x = std::abs(x);
   std::sort(residual.begin(), residual.end());
-  // A residual about a w-sample mean has variance sd^2 (1 - 1/w) for white noise.
-  const double mean_share = std::sqrt(1.0 - 1.0 / static_cast<double>(w));
   if (const double median = residual[residual.size() / 2]; median > 0) {
-    r.sd = median / 0.6745 / mean_share;
+    r.sd = median / 0.6745;
     return r;
   }
   // Quantised: most samples of a hold sit on one level, and the median residual says nothing.
@@ -65,7 +65,7 @@ HoldNoise noise_in_holds(const TestData& t, double window_s) {
   const std::size_t kept = std::max<std::size_t>(1, residual.size() * 98 / 100);
   double sq = 0;
   for (std::size_t k = 0; k < kept; ++k) sq += residual[k] * residual[k];
-  r.sd = std::max(std::sqrt(sq / static_cast<double>(kept)) / mean_share, quantum_of(measured) / std::sqrt(12.0));
+  r.sd = std::max(std::sqrt(sq / static_cast<double>(kept)), quantum_of(measured) / std::sqrt(12.0));
   return r;
 }
 

@@ -6,6 +6,7 @@
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/protocol/request_json.hpp"
+#include "viscera/tissue/material/material_file.hpp"
 
 #include "simulation_server_impl.hpp"
 
@@ -54,8 +55,9 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
       case proto::Action::load_scene:
       case proto::Action::set_material:
       case proto::Action::set_physics_rate:
-        control(*req, status);
-        changed = true;
+        // A request concluded at once has published the state; a second copy right behind it
+        // could supersede it in a keep-last-1 reader.
+        if (!control(*req, status)) changed = true;
         return;
       case proto::Action::seek: conclude(*req, false, "seek: a live session cannot seek (replayers only: viscera-replay play)", status); return;
       case proto::Action::claim_instrument:
@@ -99,8 +101,11 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
 /// Run-time control: a new physics rate at once; a scene or material is prepared in the
 /// background (finish_preparing() swaps it in). Every request gets an outcome in the scene state
 /// and an event; a refusal says why.
-void SimulationServer::Impl::control(const proto::SessionRequest& req, const Status& status) {
-  const auto refuse = [&](const std::string& why) { conclude(req, false, why, status); };
+bool SimulationServer::Impl::control(const proto::SessionRequest& req, const Status& status) {
+  const auto refuse = [&](const std::string& why) {
+    conclude(req, false, why, status);
+    return true;
+  };
   if (req.action == proto::Action::set_physics_rate) {
     // Whole hertz, as in scene files: the tick grid's period is 1/rate.
     if (req.physics_rate_hz != std::floor(req.physics_rate_hz))
@@ -114,12 +119,21 @@ void SimulationServer::Impl::control(const proto::SessionRequest& req, const Sta
     std::snprintf(text, sizeof text, "physics rate %.0f Hz (was %.0f Hz): ", req.physics_rate_hz, scene.physics_rate_hz);
     scene.physics_rate_hz = req.physics_rate_hz;
     conclude(req, true, text + tick_cost(organ->integrator->dt_s(), organ->substep_cost_s, scene.physics_rate_hz), status);
-    return;
+    return true;
+  }
+  // A material file that does not read is refused at once, as the background build would.
+  if (req.action == proto::Action::set_material && req.material.file_text) {
+    try {
+      tissue::parse_material(*req.material.file_text, "set_material");
+    } catch (const InputError& e) {
+      return refuse("material file " + req.material.file_name + ": " + e.what());
+    }
   }
   const auto refused =
       req.action == proto::Action::load_scene ? session.start_scene(req, scene.domain_id) : session.start_material(req, organ, scene.physics_rate_hz);
   if (refused) return refuse(*refused);
   if (status) status("client " + std::to_string(req.client_id) + " asked for " + session.preparing() + "; preparing it");
+  return false;
 }
 
 /// Physics thread, between ticks: a prepared scene or material that is ready replaces the organ

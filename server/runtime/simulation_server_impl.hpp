@@ -164,7 +164,8 @@ struct SimulationServer::Impl {
   /// Run-time control: a new physics rate at once; a scene or material is prepared in the
   /// background (finish_preparing() swaps it in). Every request gets an outcome in the scene state
   /// and an event; a refusal says why.
-  void control(const proto::SessionRequest& req, const Status& status);
+  /// True when it concluded the request (and so published the scene state).
+  bool control(const proto::SessionRequest& req, const Status& status);
 
   /// Physics thread, between ticks: a prepared scene or material that is ready replaces the organ
   /// (in lockstep, once it is ready: the tick that asked for it uses it).

@@ -36,6 +36,7 @@ struct Truth {
   double noise_sd_pa = 5.0;
   double noise_correlation = 0.0;  ///< AR(1) coefficient from sample to sample (0: white)
   double rate_hz = 10.0;
+  double hold_rate_hz = 0.0;  ///< sampling in the holds (0: rate_hz, one rate throughout)
   double hold_s = 300.0;
   std::size_t tests = 4;
   unsigned seed = 1;
@@ -57,12 +58,19 @@ Dataset clot_like(const Truth& truth) {
     const double e = 2000 * scale, e1 = 1500 * scale;
     TestData t;
     t.file = "s" + std::to_string(k + 1) + ".csv";
-    const auto n = static_cast<std::size_t>((amp / rate + truth.hold_s) / dt);
+    std::vector<double> times;
+    if (truth.hold_rate_hz <= 0) {
+      const auto n = static_cast<std::size_t>((amp / rate + truth.hold_s) / dt);
+      for (std::size_t i = 0; i <= n; ++i) times.push_back(static_cast<double>(i) * dt);
+    } else {  // the ramp sampled at rate_hz, the hold at hold_rate_hz from the ramp's end
+      for (std::size_t i = 0; static_cast<double>(i) * dt < amp / rate; ++i) times.push_back(static_cast<double>(i) * dt);
+      for (double s = amp / rate; s <= amp / rate + truth.hold_s; s += 1.0 / truth.hold_rate_hz) times.push_back(s);
+    }
     double q = 0, previous = 0, noise = 0;
-    for (std::size_t i = 0; i <= n; ++i) {
-      const double time = static_cast<double>(i) * dt, eps = std::min(amp, rate * time);
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      const double time = times[i], eps = std::min(amp, rate * time), h = i > 0 ? time - times[i - 1] : dt;
       // The Maxwell arm's stress, exact for a strain linear over each sample interval.
-      if (i > 0) q = q * std::exp(-dt / tau) + e1 * (eps - previous) * (tau / dt) * (1 - std::exp(-dt / tau));
+      if (i > 0) q = q * std::exp(-h / tau) + e1 * (eps - previous) * (tau / h) * (1 - std::exp(-h / tau));
       noise = rho * noise + innovation * truth.noise_sd_pa * gauss(rng);
       t.time_s.push_back(time);
       t.strain.push_back(eps);
@@ -454,4 +462,28 @@ TEST(OtherLabs, DiscLikeCompressionToSixtyPercent) {
   // the data cannot show it, and the verdict rightly does not claim it.)
   EXPECT_LT(a.final.heldout_rms_pa, 2.0 * a.noise_pa);
   EXPECT_GT(a.baseline.heldout_rms_pa, 3.0 * a.final.heldout_rms_pa);
+}
+
+// Fast ramps sampled fast and long holds sampled slowly in one test (a logger that thins its rate
+// once the machine holds): 100 Hz over the ramps, one sample every 10 s over holds of an hour.
+TEST(OtherLabs, FastRampsAndSlowHoldsInOneTest) {
+  Truth truth;
+  truth.rate_hz = 100.0;
+  truth.hold_rate_hz = 0.1;
+  truth.hold_s = 3600.0;
+  const Dataset d = clot_like(truth);
+  const Analysis a = analyze(d, {}, kWithoutSpecimen);
+  std::printf("[ figure ] fast ramps, slow holds: %s\n", a.verdict.c_str());
+  std::printf(
+      "[ figure ] fast ramps, slow holds: baseline held-out %.1f Pa, final %.1f Pa, nested gain %.2f, noise %.2f Pa / holds %.2f Pa "
+      "(window %.1f s), adequacy %s (%.2fx)\n",
+      a.baseline.heldout_rms_pa, a.final.heldout_rms_pa, a.nested_gain, a.noise_pa, a.noise_check.holds_pa, a.noise_check.window_s,
+      a.adequacy.explained ? "explained" : "not explained", a.adequacy.residual_to_noise);
+  const auto named = a.named_causes();
+  EXPECT_NE(std::find(named.begin(), named.end(), Mechanism::broadband_relaxation), named.end());
+  EXPECT_EQ(a.causes_status, CausesStatus::confirmed);
+  EXPECT_GT(a.noise_pa, 0.5 * truth.noise_sd_pa);
+  EXPECT_LT(a.noise_pa, 2.0 * truth.noise_sd_pa);
+  EXPECT_TRUE(a.noise_check.agree);
+  EXPECT_TRUE(a.adequacy.explained);
 }

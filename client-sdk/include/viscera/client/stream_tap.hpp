@@ -31,7 +31,7 @@ struct TapSample {
 
 class StreamTap {
  public:
-  /// Subscribes to `streams` keeping `depth` samples per key (their reliability and durability as
+  /// Subscribes to `streams` keeping `depth` samples per key (at most 16 of a state stream; their reliability and durability as
   /// the protocol sets them: a late joiner still gets the scene state and the surface topology).
   StreamTap(std::uint32_t domain_id, const std::string& partition, const std::vector<protocol::Stream>& streams, int depth = 4096);
   ~StreamTap();

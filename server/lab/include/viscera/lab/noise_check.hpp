@@ -26,12 +26,13 @@ struct HoldNoise {
   double sd = 0.0;  ///< of the measured quantity (stress [Pa], or strain under stress control); 0 without holds
   std::size_t samples = 0;  ///< residuals it rests on
   int holds = 0;  ///< holds used
-  double window_s = 0.0;  ///< the running mean's width [s]
+  double window_s = 0.0;  ///< the running mean's width in the first hold used [s]
 };
 
 /// The measured quantity in the holds of `t` (its command, the strain or under stress control the
 /// stress, held within its own noise for at least three windows), less its running mean over
-/// `window_s` (at least 9 samples), after the first window of each hold (where the relaxation
+/// `window_s` in that hold's own sampling (at least 9 samples: a logger may thin its rate in long
+/// holds), after the first window of each hold (where the relaxation
 /// bends fastest): the robust SD (median absolute value / 0.6745), corrected for the mean's own
 /// share of the noise.
 HoldNoise noise_in_holds(const TestData& t, double window_s = 1.0);
