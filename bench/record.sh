@@ -6,7 +6,8 @@
 # (the recorder's own count) and, independently, the forces and frames the server says it
 # published against those in the file. Writes bench/results/record.json (docs/PERFORMANCE.md's
 # table comes from it through bench/performance_tables.py) and prints a summary.
-# Usage: [SCENE=liver-12k] [COMPRESSION=zstd] bench/record.sh [SECONDS]
+# KEEP=FILE keeps the recording there (bench/python_recording.py reads it into DataFrames).
+# Usage: [SCENE=liver-12k] [COMPRESSION=zstd] [KEEP=FILE] bench/record.sh [SECONDS]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-600}"
@@ -36,6 +37,7 @@ hwm_kb=$(awk '/VmHWM/ {print $2}' "/proc/$recorder/status")
 wall=$(python3 -c "import time; print(time.time() - $start)")
 kill -INT "$recorder"; wait "$recorder"
 kill -INT "$server"; wait "$server" || true
+[ -n "${KEEP:-}" ] && cp "$tmp/session.mcap" "$KEEP"
 "$root/build/tools/viscera-record/viscera-record" info "$tmp/session.mcap" > "$tmp/info.txt"
 python3 - "$tmp" "$seconds" "$scene_name" "$utime" "$stime" "$(getconf CLK_TCK)" "$hwm_kb" "$wall" "${COMPRESSION:-zstd}" \
   "$root/bench/results/record.json" <<'PY'

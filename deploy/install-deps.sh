@@ -25,6 +25,10 @@ packages=(
   chromium                 # the browser tests of the console page (headless, driven by playwright-core)
   openssl                  # the console's access token (openssl rand), the test PKI (deploy/dds/make-test-pki.sh)
   libnss3-tools            # certutil: the browser test trusts the test CA in Chromium's certificate store (no ignored errors)
+  pybind11-dev python3-dev # the Python package's extension module (client-sdk/python, docs/PYTHON.md)
+  python3-numpy python3-pandas  # its arrays and DataFrames
+  python3-pytest python3-mypy   # its tests (pytest under ctest) and the type check of its stubs, examples and tests
+  python3-matplotlib       # plots in its examples and Analysis.plot
 )
 # Node.js and npm: the official MCAP reader (@mcap/core) that judges recordings in the tests. Debian's
 # packages, unless a node and an npm are on the PATH already (a NodeSource install bundles npm).

@@ -11,7 +11,8 @@
 # baseline for it, one after the other (viscera-control material --file); the probe presses each,
 # and viscera-plot draws both force curves in out/titin-vs-linear.svg.
 # viscera-record records the whole session to out/demo.mcap; at the end the demo prints the
-# recording's summary and re-runs the session on a fresh server in lockstep, bit for bit.
+# recording's summary and re-runs the session on a fresh server in lockstep, bit for bit, and the
+# Python package reads it into DataFrames (examples/python/analyse_session.py, out/demo-session.png).
 # The instructor's console (viscera-console) runs beside it all: open the address it prints in a
 # browser to watch the liver deform, the forces rise, and to pause, bookmark or take over.
 #   SCENE=data/scenes/liver-12k.json ./deploy/run.sh    another scene
@@ -77,4 +78,9 @@ echo "[demo] the recording ($recording):"
 echo "[demo] the session re-run on a fresh server in lockstep, compared bit for bit with the recording"
 "$bin/tools/viscera-replay/viscera-replay" resimulate "$recording" --report "$root/out/demo-resimulation.json" --domain "$domain" 2>&1 \
   | sed -u 's/^/[replay] /' || echo "[demo] the re-simulation did not reproduce the session: see the first divergence above"
+echo "[demo] the same recording in Python (numpy, pandas, matplotlib): examples/python/analyse_session.py"
+python="$(sed -n 's/^Python3_EXECUTABLE:FILEPATH=//p' "$bin/CMakeCache.txt")"
+PYTHONPATH="$bin/python" "${python:-python3}" "$root/examples/python/analyse_session.py" "$recording" --plot "$root/out/demo-session.png" 2>&1 \
+  | sed -u 's/^/[python] /' || true
+echo "[demo] the Python package (docs/PYTHON.md): PYTHONPATH=$bin/python ${python:-python3} -c 'import viscera'"
 echo "[demo] replay it: $bin/tools/viscera-replay/viscera-replay play $recording"

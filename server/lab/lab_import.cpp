@@ -99,15 +99,15 @@ TestData import_test(const std::string& path, const ImportOptions& o, ImportOffs
     // (the machine holding the specimen before it moves it), at least the first row.
     std::size_t rest = 1;
     while (rest < t.strain.size() && t.strain[rest] == t.strain.front()) ++rest;
-    double first = 0.0;
-    for (std::size_t i = 0; i < rest; ++i) first += t.stress_pa[i] / static_cast<double>(rest);
-    off.force_n = first * area;
-    for (double& s : t.stress_pa) s -= first;
+    double rest_stress = 0.0;
+    for (std::size_t i = 0; i < rest; ++i) rest_stress += t.stress_pa[i] / static_cast<double>(rest);
+    off.force_n = rest_stress * area;
+    for (double& s : t.stress_pa) s -= rest_stress;
   }
   if (o.zero_displacement) {
     off.displacement_m = t.strain.front() * gauge;
-    const double first = t.strain.front();
-    for (double& e : t.strain) e -= first;
+    const double first_strain = t.strain.front();
+    for (double& e : t.strain) e -= first_strain;
   }
   if (taken_off) *taken_off = off;
   return t;

@@ -1,0 +1,235 @@
+// viscera._viscera.session: the client SDK (viscera::client::Client) for Python. Calls that wait
+// release the interpreter lock; no Python code ever runs on a DDS thread (state is polled), so a
+// DDS callback can never wait for the lock that the main thread holds.
+#include <pybind11/chrono.h>
+#include <pybind11/stl.h>
+
+#include "viscera/client/client.hpp"
+#include "viscera/common/command_line.hpp"
+
+#include "bindings.hpp"
+#include "numpy_views.hpp"
+
+namespace viscera::python {
+
+namespace {
+
+using client::Client;
+namespace protocol = viscera::protocol;
+
+std::chrono::milliseconds ms(double seconds) {
+  if (!(seconds >= 0 && seconds <= 86400)) throw common::UsageError("timeout_s must lie in [0, 86400], not " + std::to_string(seconds));
+  return std::chrono::milliseconds(static_cast<long long>(seconds * 1e3));
+}
+
+protocol::Vector3 vector3(const std::vector<double>& v, const char* what) {
+  if (v.size() != 3) throw common::UsageError(std::string(what) + ": 3 coordinates [m], not " + std::to_string(v.size()));
+  return {v[0], v[1], v[2]};
+}
+
+}  // namespace
+
+void bind_session(py::module_& m) {
+  py::enum_<client::ServerState>(m, "ServerState")
+      .value("waiting", client::ServerState::waiting)
+      .value("alive", client::ServerState::alive)
+      .value("lost", client::ServerState::lost);
+  py::class_<protocol::InstrumentInfo>(m, "Instrument")
+      .def_readonly("instrument_id", &protocol::InstrumentInfo::instrument_id)
+      .def_readonly("grasper", &protocol::InstrumentInfo::grasper)
+      .def_readonly("tip_radius_m", &protocol::InstrumentInfo::tip_radius_m)
+      .def_readonly("owner_client_id", &protocol::InstrumentInfo::owner_client_id, "0: free");
+  py::class_<protocol::MaterialInfo>(m, "Material")
+      .def_readonly("name", &protocol::MaterialInfo::name)
+      .def_readonly("youngs_modulus_pa", &protocol::MaterialInfo::youngs_modulus_pa)
+      .def_readonly("poisson_ratio", &protocol::MaterialInfo::poisson_ratio)
+      .def_readonly("density_kg_m3", &protocol::MaterialInfo::density_kg_m3)
+      .def_readonly("shear_q", &protocol::MaterialInfo::shear_q)
+      .def_readonly("damping_per_s", &protocol::MaterialInfo::damping_per_s);
+  py::class_<protocol::RequestOutcome>(m, "RequestOutcome", "What the server did with a request.")
+      .def_readonly("accepted", &protocol::RequestOutcome::accepted)
+      .def_readonly("message", &protocol::RequestOutcome::message)
+      .def_property_readonly("action", [](const protocol::RequestOutcome& o) { return std::string(protocol::action_name(o.action)); })
+      .def("__bool__", [](const protocol::RequestOutcome& o) { return o.accepted; })
+      .def("__repr__", [](const protocol::RequestOutcome& o) {
+        return std::string("RequestOutcome(") + (o.accepted ? "accepted" : "refused") + ": " + o.message + ")";
+      });
+  py::class_<protocol::Scene>(m, "Scene", "The server's scene state.")
+      .def_readonly("name", &protocol::Scene::name)
+      .def_readonly("physics_rate_hz", &protocol::Scene::physics_rate_hz)
+      .def_readonly("paused", &protocol::Scene::paused)
+      .def_readonly("instruments", &protocol::Scene::instruments)
+      .def_readonly("bounds_min_m", &protocol::Scene::bounds_min)
+      .def_readonly("bounds_max_m", &protocol::Scene::bounds_max)
+      .def_readonly("generation", &protocol::Scene::generation)
+      .def_readonly("material", &protocol::Scene::material)
+      .def_readonly("available_scenes", &protocol::Scene::available_scenes)
+      .def_readonly("preparing", &protocol::Scene::preparing)
+      .def_readonly("unreadable_scenes", &protocol::Scene::unreadable_scenes);
+  py::class_<protocol::Force>(m, "Force", "A force on an instrument, answering a command.")
+      .def_readonly("instrument_id", &protocol::Force::instrument_id)
+      .def_readonly("command_seq", &protocol::Force::command_seq)
+      .def_readonly("force_n", &protocol::Force::force)
+      .def_readonly("torque_n_m", &protocol::Force::torque)
+      .def_readonly("in_contact", &protocol::Force::in_contact)
+      .def_readonly("contact_point_m", &protocol::Force::contact_point)
+      .def_readonly("contact_normal", &protocol::Force::contact_normal)
+      .def_readonly("penetration_m", &protocol::Force::penetration_m)
+      .def_readonly("tick", &protocol::Force::tick)
+      .def_readonly("server_stamp_ns", &protocol::Force::server_stamp_ns)
+      .def_readonly("max_edge_strain", &protocol::Force::max_edge_strain);
+  py::class_<protocol::Event>(m, "Event", "A session event (server) or an annotation (client).")
+      .def_property_readonly("kind", [](const protocol::Event& e) { return std::string(protocol::event_name(e.kind)); })
+      .def_property_readonly("reason", [](const protocol::Event& e) { return std::string(protocol::event_reason_name(e.reason)); })
+      .def_readonly("source_client_id", &protocol::Event::source_client_id)
+      .def_readonly("instrument_id", &protocol::Event::instrument_id)
+      .def_readonly("client_id", &protocol::Event::client_id)
+      .def_readonly("sim_time_s", &protocol::Event::sim_time_s)
+      .def_readonly("stamp_ns", &protocol::Event::stamp_ns)
+      .def_readonly("text", &protocol::Event::text)
+      .def_readonly("tick", &protocol::Event::tick)
+      .def_readonly("scene", &protocol::Event::scene);
+  py::class_<protocol::TelemetryReport>(m, "Telemetry", "The server's health report (about one a second).")
+      .def_readonly("steps", &protocol::TelemetryReport::steps)
+      .def_readonly("physics_rate_hz", &protocol::TelemetryReport::physics_rate_hz)
+      .def_readonly("step_p99_us", &protocol::TelemetryReport::step_p99_us)
+      .def_readonly("late_ticks", &protocol::TelemetryReport::late_ticks)
+      .def_readonly("missed_slots", &protocol::TelemetryReport::missed_slots)
+      .def_readonly("rejected_messages", &protocol::TelemetryReport::rejected_messages);
+  py::class_<protocol::SurfaceTopology, std::shared_ptr<protocol::SurfaceTopology>>(m, "SurfaceTopology", "The organ's boundary surface.")
+      .def_readonly("mesh_id", &protocol::SurfaceTopology::mesh_id)
+      .def_readonly("organ_name", &protocol::SurfaceTopology::organ_name)
+      .def_readonly("vertex_count", &protocol::SurfaceTopology::vertex_count)
+      .def_property_readonly("triangles",
+                             [](py::object self) {
+                               const auto& t = self.cast<const protocol::SurfaceTopology&>().triangles;
+                               return view_array<std::uint32_t>(t.data(), {static_cast<py::ssize_t>(t.size() / 3), 3}, {12, 4}, self);
+                             })
+      .def_property_readonly("rest_positions", [](py::object self) {
+        const auto& p = self.cast<const protocol::SurfaceTopology&>().rest_positions;
+        return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
+      });
+  py::class_<protocol::MeshFrame, std::shared_ptr<protocol::MeshFrame>>(m, "MeshFrame", "The deformed surface at one instant.")
+      .def_readonly("mesh_id", &protocol::MeshFrame::mesh_id)
+      .def_readonly("frame", &protocol::MeshFrame::frame)
+      .def_readonly("sim_time_s", &protocol::MeshFrame::sim_time_s)
+      .def_readonly("tick", &protocol::MeshFrame::tick)
+      .def_property_readonly(
+          "positions",
+          [](py::object self) {
+            const auto& p = self.cast<const protocol::MeshFrame&>().positions;
+            return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
+          },
+          "(vertices, 3) float32 [m]: a read-only view of the received frame, no copy; it keeps the frame alive");
+  py::class_<client::ClaimResult>(m, "ClaimResult")
+      .def_readonly("claimed", &client::ClaimResult::claimed)
+      .def_readonly("why", &client::ClaimResult::why)
+      .def("__bool__", [](const client::ClaimResult& c) { return c.claimed; });
+  py::class_<client::LatencyStats>(m, "LatencyStats", "Command-to-force round trips [us].")
+      .def_readonly("samples", &client::LatencyStats::samples)
+      .def_readonly("p50_us", &client::LatencyStats::p50_us)
+      .def_readonly("p99_us", &client::LatencyStats::p99_us)
+      .def_readonly("max_us", &client::LatencyStats::max_us);
+
+  using Outcome = std::optional<protocol::RequestOutcome>;
+  const auto unlocked = py::call_guard<py::gil_scoped_release>();
+  py::class_<Client>(m, "Client",
+                     "One client of a viscera-server: a DDS participant under one client id. Use it from one thread "
+                     "(send_tip may run on another thread than the requests).")
+      .def(py::init<std::uint32_t, std::uint32_t, const std::string&>(), py::arg("domain_id"), py::arg("client_id"), py::arg("partition") = "",
+           unlocked)
+      .def_property_readonly("client_id", &Client::id)
+      .def(
+          "wait_for_scene", [](Client& c, double timeout_s) { return c.wait_for_scene(ms(timeout_s)); }, py::arg("timeout_s"), unlocked,
+          "Waits up to timeout_s [s] for the server's scene state; None if none came.")
+      .def("scene", &Client::scene, unlocked, "The newest scene state, without waiting (None if none).")
+      .def(
+          "claim", [](Client& c, std::uint32_t id, double timeout_s) { return c.claim(id, ms(timeout_s)); }, py::arg("instrument_id"),
+          py::arg("timeout_s") = 2.0, unlocked)
+      .def("release", &Client::release, py::arg("instrument_id"), unlocked)
+      .def(
+          "pause", [](Client& c, double t) { return c.control(protocol::Action::pause, ms(t)); }, py::arg("timeout_s") = 2.0, unlocked)
+      .def(
+          "resume", [](Client& c, double t) { return c.control(protocol::Action::resume, ms(t)); }, py::arg("timeout_s") = 2.0, unlocked)
+      .def(
+          "reset", [](Client& c, double t) { return c.control(protocol::Action::reset, ms(t)); }, py::arg("timeout_s") = 2.0, unlocked)
+      .def(
+          "load_scene",
+          [](Client& c, const std::string& name, double t, std::optional<std::uint64_t> seed) -> Outcome { return c.load_scene(name, ms(t), seed); },
+          py::arg("name"), py::arg("timeout_s") = 30.0, py::arg("seed") = std::nullopt, unlocked)
+      .def(
+          "set_material",
+          [](Client& c, std::optional<double> e, std::optional<double> nu, std::optional<double> rho, std::optional<double> q,
+             std::optional<double> damping, std::optional<std::string> file_text, const std::string& file_name, double t) -> Outcome {
+            protocol::MaterialChange change;
+            change.youngs_modulus_pa = e;
+            change.poisson_ratio = nu;
+            change.density_kg_m3 = rho;
+            change.shear_q = q;
+            change.damping_per_s = damping;
+            change.file_text = std::move(file_text);
+            change.file_name = file_name;
+            if (change.empty()) throw common::UsageError("set_material: give at least one parameter or a file");
+            return c.set_material(change, ms(t));
+          },
+          py::kw_only(), py::arg("youngs_modulus_pa") = std::nullopt, py::arg("poisson_ratio") = std::nullopt,
+          py::arg("density_kg_m3") = std::nullopt, py::arg("shear_q") = std::nullopt, py::arg("damping_per_s") = std::nullopt,
+          py::arg("file_text") = std::nullopt, py::arg("file_name") = "material.json", py::arg("timeout_s") = 30.0, unlocked)
+      .def(
+          "set_physics_rate", [](Client& c, double hz, double t) -> Outcome { return c.set_physics_rate(hz, ms(t)); }, py::arg("rate_hz"),
+          py::arg("timeout_s") = 10.0, unlocked)
+      .def(
+          "take_over", [](Client& c, std::uint32_t id, double t) -> Outcome { return c.take_over(id, ms(t)); }, py::arg("instrument_id"),
+          py::arg("timeout_s") = 2.0, unlocked)
+      .def(
+          "hand_back", [](Client& c, std::uint32_t id, double t) -> Outcome { return c.hand_back(id, ms(t)); }, py::arg("instrument_id"),
+          py::arg("timeout_s") = 2.0, unlocked)
+      .def(
+          "send_tip",
+          [](Client& c, std::uint32_t id, const std::vector<double>& tip, double jaw, std::uint32_t buttons) {
+            const auto p = vector3(tip, "tip_m");
+            py::gil_scoped_release released;
+            c.send_tip(id, p, jaw, buttons);
+          },
+          py::arg("instrument_id"), py::arg("tip_m"), py::arg("jaw_opening_rad") = 0.5, py::arg("buttons") = 0,
+          "Sends the instrument's tip position [m] (scene frame), jaw opening [rad] and buttons (a bit mask).")
+      .def("poll_force", &Client::poll_force, py::arg("instrument_id"), unlocked, "The newest force that arrived, if any.")
+      .def(
+          "wait_force",
+          [](Client& c, std::uint32_t id, double timeout_s) { return c.wait_force(id, std::chrono::steady_clock::now() + ms(timeout_s)); },
+          py::arg("instrument_id"), py::arg("timeout_s") = 0.01, unlocked,
+          "Waits up to timeout_s [s] for the force answering the newest command; returns the newest force seen either way.")
+      .def("round_trip", &Client::round_trip, "Command-to-force round trips measured so far.")
+      .def(
+          "surface",
+          [](Client& c) -> std::shared_ptr<protocol::SurfaceTopology> {
+            std::optional<protocol::SurfaceTopology> t;
+            {
+              py::gil_scoped_release released;
+              t = c.surface();
+            }
+            return t ? std::make_shared<protocol::SurfaceTopology>(std::move(*t)) : nullptr;
+          },
+          "The organ's boundary surface once it arrived (the first call subscribes to the mesh streams); None before.")
+      .def(
+          "poll_mesh_frame",
+          [](Client& c) -> std::shared_ptr<protocol::MeshFrame> {
+            std::optional<protocol::MeshFrame> f;
+            {
+              py::gil_scoped_release released;
+              f = c.poll_mesh_frame();
+            }
+            return f ? std::make_shared<protocol::MeshFrame>(std::move(*f)) : nullptr;
+          },
+          "The newest surface frame since the last call, checked against the topology; None if none.")
+      .def_property_readonly("mesh_frames_received", &Client::mesh_frames_received)
+      .def("poll_events", &Client::poll_events, unlocked, "Events since the last call, in order (the first call subscribes).")
+      .def("poll_telemetry", &Client::poll_telemetry, unlocked, "Health reports since the last call (the first call subscribes).")
+      .def("annotate", &Client::annotate, py::arg("text"), unlocked, "Publishes an annotation (at most 1024 bytes) for recorders and consoles.")
+      .def_property_readonly("server_state", &Client::server_state)
+      .def_property_readonly("rejected", &Client::rejected, "Payloads that failed verification and were dropped.")
+      .def_property_readonly("last_rejection", &Client::last_rejection);
+  m.def("now_ns", &client::now_ns, "The protocol's clock [ns] (DDS time, the wall clock).");
+}
+
+}  // namespace viscera::python
