@@ -29,7 +29,8 @@ def main() -> int:
     forces = rec.dataframe("force_feedback")
     commands = rec.dataframe("instrument_command")
     t0 = rec.start_ns
-    print(f"{a.recording}: {(rec.end_ns - t0) / 1e9:.1f} s, {len(commands)} commands, {len(forces)} forces, drops {rec.drops}")
+    lost = rec.drops.get("missing", "?") if rec.drops is not None else "unknown (a recovered recording)"
+    print(f"{a.recording}: {(rec.end_ns - t0) / 1e9:.1f} s, {len(commands)} commands, {len(forces)} forces, samples lost by the recorder: {lost}")
     for instrument, f in forces.groupby("instrument_id"):
         magnitude = np.sqrt(f["force_x_n"] ** 2 + f["force_y_n"] ** 2 + f["force_z_n"] ** 2)
         contact = f["in_contact"].mean()

@@ -44,18 +44,25 @@ const TestData& test_named(const Dataset& d, const std::string& file) {
 
 void bind_lab(py::module_& m) {
   py::class_<TestData>(m, "Test", "One test of a data set: time [s], strain [-], stress [Pa], in SI units.")
-      .def_readonly("file", &TestData::file)
-      .def_property_readonly("control", [](const TestData& t) { return std::string(to_string(t.control)); })
-      .def_property_readonly("time_s", [](const TestData& t) { return copy_of(t.time_s); })
-      .def_property_readonly("strain", [](const TestData& t) { return copy_of(t.strain); })
-      .def_property_readonly("stress_pa", [](const TestData& t) { return copy_of(t.stress_pa); })
-      .def_property_readonly("stress_sd_pa", [](const TestData& t) { return copy_of(t.stress_sd_pa); });
+      .def_readonly("file", &TestData::file, "the test's CSV file, as dataset.json names it")
+      .def_property_readonly(
+          "control", [](const TestData& t) { return std::string(to_string(t.control)); }, "strain (stress measured) or stress (strain measured)")
+      .def_property_readonly(
+          "time_s", [](const TestData& t) { return copy_of(t.time_s); }, "[s] time of each row")
+      .def_property_readonly(
+          "strain", [](const TestData& t) { return copy_of(t.strain); }, "engineering strain [-] of each row")
+      .def_property_readonly(
+          "stress_pa", [](const TestData& t) { return copy_of(t.stress_pa); }, "[Pa] stress of each row")
+      .def_property_readonly(
+          "stress_sd_pa", [](const TestData& t) { return copy_of(t.stress_sd_pa); },
+          "[Pa] the stress's standard deviation per row (empty if not given)");
   py::class_<Dataset>(m, "Dataset", "A measured data set (dataset.json and one CSV per test).")
-      .def_readonly("name", &Dataset::name)
-      .def_readonly("folder", &Dataset::folder)
-      .def_readonly("import_note", &Dataset::import_note)
-      .def_property_readonly("mode", [](const Dataset& d) { return std::string(to_string(d.mode)); })
-      .def_readonly("tests", &Dataset::tests);
+      .def_readonly("name", &Dataset::name, "its name")
+      .def_readonly("folder", &Dataset::folder, "the data set's folder")
+      .def_readonly("import_note", &Dataset::import_note, "how viscera-lab import made it, with its units (empty otherwise)")
+      .def_property_readonly(
+          "mode", [](const Dataset& d) { return std::string(to_string(d.mode)); }, "uniaxial or simple_shear")
+      .def_readonly("tests", &Dataset::tests, "the tests, in dataset.json's order");
   m.def("read_dataset", &read_dataset, py::arg("folder"),
         "Reads DATASET_DIR/dataset.json and its CSVs; raises InputError naming file, line and field.");
 

@@ -118,7 +118,7 @@ void bind_recording(py::module_& m) {
       .def(py::init<const std::string&>(), py::arg("path"),
            "Opens a recording. Raises InputError naming the file: not MCAP, damaged, cut short (recover it with "
            "viscera-record recover), not a viscera recording, or of a newer schema.")
-      .def_property_readonly("path", &Recording::path)
+      .def_property_readonly("path", &Recording::path, "the file")
       .def_property_readonly("info", &Recording::info, "Metadata viscera.recording: schema_version, domain_id, partition, streams, recorder.")
       .def_property_readonly("drops", &Recording::drops, "Metadata viscera.drops: samples the recorder lost per stream (None if recovered).")
       .def_property_readonly("start_ns", &Recording::start_ns, "[ns] log time of the first message.")

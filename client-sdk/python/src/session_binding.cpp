@@ -34,86 +34,97 @@ void bind_session(py::module_& m) {
       .value("waiting", client::ServerState::waiting)
       .value("alive", client::ServerState::alive)
       .value("lost", client::ServerState::lost);
-  py::class_<protocol::InstrumentInfo>(m, "Instrument")
-      .def_readonly("instrument_id", &protocol::InstrumentInfo::instrument_id)
-      .def_readonly("grasper", &protocol::InstrumentInfo::grasper)
-      .def_readonly("tip_radius_m", &protocol::InstrumentInfo::tip_radius_m)
+  py::class_<protocol::InstrumentInfo>(m, "Instrument", "An instrument of the scene.")
+      .def_readonly("instrument_id", &protocol::InstrumentInfo::instrument_id, "the instrument (the scene file's id)")
+      .def_readonly("grasper", &protocol::InstrumentInfo::grasper, "True for a grasper (jaws), False for a probe")
+      .def_readonly("tip_radius_m", &protocol::InstrumentInfo::tip_radius_m, "[m] radius of the tip sphere")
       .def_readonly("owner_client_id", &protocol::InstrumentInfo::owner_client_id, "0: free");
-  py::class_<protocol::MaterialInfo>(m, "Material")
-      .def_readonly("name", &protocol::MaterialInfo::name)
-      .def_readonly("youngs_modulus_pa", &protocol::MaterialInfo::youngs_modulus_pa)
-      .def_readonly("poisson_ratio", &protocol::MaterialInfo::poisson_ratio)
-      .def_readonly("density_kg_m3", &protocol::MaterialInfo::density_kg_m3)
-      .def_readonly("shear_q", &protocol::MaterialInfo::shear_q)
-      .def_readonly("damping_per_s", &protocol::MaterialInfo::damping_per_s);
+  py::class_<protocol::MaterialInfo>(m, "Material", "The organ's material as the scene state shows it (SI).")
+      .def_readonly("name", &protocol::MaterialInfo::name, "its name")
+      .def_readonly("youngs_modulus_pa", &protocol::MaterialInfo::youngs_modulus_pa, "[Pa] Young's modulus (0: not isotropic)")
+      .def_readonly("poisson_ratio", &protocol::MaterialInfo::poisson_ratio, "Poisson ratio [-]")
+      .def_readonly("density_kg_m3", &protocol::MaterialInfo::density_kg_m3, "[kg/m^3] density")
+      .def_readonly("shear_q", &protocol::MaterialInfo::shear_q, "quality factor Q of the constant-Q shear damping (0: elastic)")
+      .def_readonly("damping_per_s", &protocol::MaterialInfo::damping_per_s, "[1/s] mass-proportional damping");
   py::class_<protocol::RequestOutcome>(m, "RequestOutcome", "What the server did with a request.")
-      .def_readonly("accepted", &protocol::RequestOutcome::accepted)
-      .def_readonly("message", &protocol::RequestOutcome::message)
-      .def_property_readonly("action", [](const protocol::RequestOutcome& o) { return std::string(protocol::action_name(o.action)); })
+      .def_readonly("accepted", &protocol::RequestOutcome::accepted, "whether the server did it")
+      .def_readonly("message", &protocol::RequestOutcome::message, "what the server did, or why not (one line)")
+      .def_property_readonly(
+          "action", [](const protocol::RequestOutcome& o) { return std::string(protocol::action_name(o.action)); },
+          "the request it answers: load_scene, set_material, ...")
       .def("__bool__", [](const protocol::RequestOutcome& o) { return o.accepted; })
       .def("__repr__", [](const protocol::RequestOutcome& o) {
         return std::string("RequestOutcome(") + (o.accepted ? "accepted" : "refused") + ": " + o.message + ")";
       });
   py::class_<protocol::Scene>(m, "Scene", "The server's scene state.")
-      .def_readonly("name", &protocol::Scene::name)
-      .def_readonly("physics_rate_hz", &protocol::Scene::physics_rate_hz)
-      .def_readonly("paused", &protocol::Scene::paused)
-      .def_readonly("instruments", &protocol::Scene::instruments)
-      .def_readonly("bounds_min_m", &protocol::Scene::bounds_min)
-      .def_readonly("bounds_max_m", &protocol::Scene::bounds_max)
-      .def_readonly("generation", &protocol::Scene::generation)
-      .def_readonly("material", &protocol::Scene::material)
-      .def_readonly("available_scenes", &protocol::Scene::available_scenes)
-      .def_readonly("preparing", &protocol::Scene::preparing)
-      .def_readonly("unreadable_scenes", &protocol::Scene::unreadable_scenes);
+      .def_readonly("name", &protocol::Scene::name, "its name")
+      .def_readonly("physics_rate_hz", &protocol::Scene::physics_rate_hz, "[Hz] the physics rate")
+      .def_readonly("paused", &protocol::Scene::paused, "whether the physics is paused")
+      .def_readonly("instruments", &protocol::Scene::instruments, "the scene's instruments and their owners")
+      .def_readonly("bounds_min_m", &protocol::Scene::bounds_min, "[m] lower corner of the organ's bounding box (x, y, z)")
+      .def_readonly("bounds_max_m", &protocol::Scene::bounds_max, "[m] upper corner of the organ's bounding box (x, y, z)")
+      .def_readonly("generation", &protocol::Scene::generation, "+1 per scene loaded: a claim made before it is gone")
+      .def_readonly("material", &protocol::Scene::material, "the organ's material")
+      .def_readonly("available_scenes", &protocol::Scene::available_scenes, "the scenes the server can load by name")
+      .def_readonly("preparing", &protocol::Scene::preparing, "the scene or material being built in the background (empty if none)")
+      .def_readonly("unreadable_scenes", &protocol::Scene::unreadable_scenes, "'name: error' for scene files that do not read");
   py::class_<protocol::Force>(m, "Force", "A force on an instrument, answering a command.")
-      .def_readonly("instrument_id", &protocol::Force::instrument_id)
-      .def_readonly("command_seq", &protocol::Force::command_seq)
-      .def_readonly("force_n", &protocol::Force::force)
-      .def_readonly("torque_n_m", &protocol::Force::torque)
-      .def_readonly("in_contact", &protocol::Force::in_contact)
-      .def_readonly("contact_point_m", &protocol::Force::contact_point)
-      .def_readonly("contact_normal", &protocol::Force::contact_normal)
-      .def_readonly("penetration_m", &protocol::Force::penetration_m)
-      .def_readonly("tick", &protocol::Force::tick)
-      .def_readonly("server_stamp_ns", &protocol::Force::server_stamp_ns)
-      .def_readonly("max_edge_strain", &protocol::Force::max_edge_strain);
+      .def_readonly("instrument_id", &protocol::Force::instrument_id, "the instrument (the scene file's id)")
+      .def_readonly("command_seq", &protocol::Force::command_seq, "the command it answers (its sequence number)")
+      .def_readonly("force_n", &protocol::Force::force, "[N] force on the tool (x, y, z)")
+      .def_readonly("torque_n_m", &protocol::Force::torque, "[N m] torque on the tool (x, y, z)")
+      .def_readonly("in_contact", &protocol::Force::in_contact, "whether the tool touches the tissue")
+      .def_readonly("contact_point_m", &protocol::Force::contact_point, "[m] where the local force model was linearised")
+      .def_readonly("contact_normal", &protocol::Force::contact_normal, "unit normal out of the tissue at the contact")
+      .def_readonly("penetration_m", &protocol::Force::penetration_m, "[m] how deep the tip is in the tissue (0 out of contact)")
+      .def_readonly("tick", &protocol::Force::tick, "the physics tick it belongs to")
+      .def_readonly("server_stamp_ns", &protocol::Force::server_stamp_ns, "[ns] the server's clock when sent (DDS time)")
+      .def_readonly("max_edge_strain", &protocol::Force::max_edge_strain, "the organ's largest edge strain |L - L0| / L0 over that tick [-]");
   py::class_<protocol::Event>(m, "Event", "A session event (server) or an annotation (client).")
-      .def_property_readonly("kind", [](const protocol::Event& e) { return std::string(protocol::event_name(e.kind)); })
-      .def_property_readonly("reason", [](const protocol::Event& e) { return std::string(protocol::event_reason_name(e.reason)); })
-      .def_readonly("source_client_id", &protocol::Event::source_client_id)
-      .def_readonly("instrument_id", &protocol::Event::instrument_id)
-      .def_readonly("client_id", &protocol::Event::client_id)
-      .def_readonly("sim_time_s", &protocol::Event::sim_time_s)
-      .def_readonly("stamp_ns", &protocol::Event::stamp_ns)
-      .def_readonly("text", &protocol::Event::text)
-      .def_readonly("tick", &protocol::Event::tick)
-      .def_readonly("scene", &protocol::Event::scene);
+      .def_property_readonly(
+          "kind", [](const protocol::Event& e) { return std::string(protocol::event_name(e.kind)); },
+          "annotation, instrument_claimed, contact_started, scene_loaded, ... (docs/PROTOCOL.md)")
+      .def_property_readonly(
+          "reason", [](const protocol::Event& e) { return std::string(protocol::event_reason_name(e.reason)); },
+          "instrument_released: by_owner, owner_silent, scene_replaced or handed_back; else unspecified")
+      .def_readonly("source_client_id", &protocol::Event::source_client_id, "who wrote it: 0 the server, else the client")
+      .def_readonly("instrument_id", &protocol::Event::instrument_id, "the instrument (the scene file's id)")
+      .def_readonly("client_id", &protocol::Event::client_id, "the client concerned (claimer, owner, requester), 0 if none")
+      .def_readonly("sim_time_s", &protocol::Event::sim_time_s, "[s] simulated time")
+      .def_readonly("stamp_ns", &protocol::Event::stamp_ns, "[ns] the writer's clock (DDS time)")
+      .def_readonly("text", &protocol::Event::text, "the text (an annotation, a refusal's reason), at most 1024 bytes")
+      .def_readonly("tick", &protocol::Event::tick, "the physics tick it belongs to")
+      .def_readonly("scene", &protocol::Event::scene, "scene_loaded: the scene loaded");
   py::class_<protocol::TelemetryReport>(m, "Telemetry", "The server's health report (about one a second).")
-      .def_readonly("steps", &protocol::TelemetryReport::steps)
-      .def_readonly("physics_rate_hz", &protocol::TelemetryReport::physics_rate_hz)
-      .def_readonly("step_p99_us", &protocol::TelemetryReport::step_p99_us)
-      .def_readonly("late_ticks", &protocol::TelemetryReport::late_ticks)
-      .def_readonly("missed_slots", &protocol::TelemetryReport::missed_slots)
-      .def_readonly("rejected_messages", &protocol::TelemetryReport::rejected_messages);
+      .def_readonly("steps", &protocol::TelemetryReport::steps, "physics ticks run so far")
+      .def_readonly("physics_rate_hz", &protocol::TelemetryReport::physics_rate_hz, "[Hz] the physics rate")
+      .def_readonly("step_p99_us", &protocol::TelemetryReport::step_p99_us, "[us] 99th percentile of the tick's duration")
+      .def_readonly("late_ticks", &protocol::TelemetryReport::late_ticks, "ticks that ended after their slot")
+      .def_readonly("missed_slots", &protocol::TelemetryReport::missed_slots, "slots of the fixed-rate grid that passed with no tick")
+      .def_readonly("rejected_messages", &protocol::TelemetryReport::rejected_messages, "messages dropped: failed verification or ownership");
   py::class_<protocol::SurfaceTopology, std::shared_ptr<protocol::SurfaceTopology>>(m, "SurfaceTopology", "The organ's boundary surface.")
-      .def_readonly("mesh_id", &protocol::SurfaceTopology::mesh_id)
-      .def_readonly("organ_name", &protocol::SurfaceTopology::organ_name)
-      .def_readonly("vertex_count", &protocol::SurfaceTopology::vertex_count)
-      .def_property_readonly("triangles",
-                             [](py::object self) {
-                               const auto& t = self.cast<const protocol::SurfaceTopology&>().triangles;
-                               return view_array<std::uint32_t>(t.data(), {static_cast<py::ssize_t>(t.size() / 3), 3}, {12, 4}, self);
-                             })
-      .def_property_readonly("rest_positions", [](py::object self) {
-        const auto& p = self.cast<const protocol::SurfaceTopology&>().rest_positions;
-        return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
-      });
+      .def_readonly("mesh_id", &protocol::SurfaceTopology::mesh_id, "the organ mesh (SurfaceTopology.mesh_id; +1 per scene loaded)")
+      .def_readonly("organ_name", &protocol::SurfaceTopology::organ_name, "the organ's name")
+      .def_readonly("vertex_count", &protocol::SurfaceTopology::vertex_count, "vertices of the surface")
+      .def_property_readonly(
+          "triangles",
+          [](py::object self) {
+            const auto& t = self.cast<const protocol::SurfaceTopology&>().triangles;
+            return view_array<std::uint32_t>(t.data(), {static_cast<py::ssize_t>(t.size() / 3), 3}, {12, 4}, self);
+          },
+          "(triangles, 3) vertex indices, outward by the right-hand rule; a read-only view")
+      .def_property_readonly(
+          "rest_positions",
+          [](py::object self) {
+            const auto& p = self.cast<const protocol::SurfaceTopology&>().rest_positions;
+            return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
+          },
+          "(vertices, 3) float32 [m] rest positions; a read-only view");
   py::class_<protocol::MeshFrame, std::shared_ptr<protocol::MeshFrame>>(m, "MeshFrame", "The deformed surface at one instant.")
-      .def_readonly("mesh_id", &protocol::MeshFrame::mesh_id)
-      .def_readonly("frame", &protocol::MeshFrame::frame)
-      .def_readonly("sim_time_s", &protocol::MeshFrame::sim_time_s)
-      .def_readonly("tick", &protocol::MeshFrame::tick)
+      .def_readonly("mesh_id", &protocol::MeshFrame::mesh_id, "the organ mesh (SurfaceTopology.mesh_id; +1 per scene loaded)")
+      .def_readonly("frame", &protocol::MeshFrame::frame, "1, 2, ... per mesh")
+      .def_readonly("sim_time_s", &protocol::MeshFrame::sim_time_s, "[s] simulated time")
+      .def_readonly("tick", &protocol::MeshFrame::tick, "the physics tick it belongs to")
       .def_property_readonly(
           "positions",
           [](py::object self) {
@@ -121,15 +132,15 @@ void bind_session(py::module_& m) {
             return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
           },
           "(vertices, 3) float32 [m]: a read-only view of the received frame, no copy; it keeps the frame alive");
-  py::class_<client::ClaimResult>(m, "ClaimResult")
-      .def_readonly("claimed", &client::ClaimResult::claimed)
-      .def_readonly("why", &client::ClaimResult::why)
+  py::class_<client::ClaimResult>(m, "ClaimResult", "What became of a claim (truthy when claimed).")
+      .def_readonly("claimed", &client::ClaimResult::claimed, "whether the instrument is this client's now")
+      .def_readonly("why", &client::ClaimResult::why, "when not claimed: the server's reason, or the timeout")
       .def("__bool__", [](const client::ClaimResult& c) { return c.claimed; });
   py::class_<client::LatencyStats>(m, "LatencyStats", "Command-to-force round trips [us].")
-      .def_readonly("samples", &client::LatencyStats::samples)
-      .def_readonly("p50_us", &client::LatencyStats::p50_us)
-      .def_readonly("p99_us", &client::LatencyStats::p99_us)
-      .def_readonly("max_us", &client::LatencyStats::max_us);
+      .def_readonly("samples", &client::LatencyStats::samples, "round trips measured")
+      .def_readonly("p50_us", &client::LatencyStats::p50_us, "[us] median round trip")
+      .def_readonly("p99_us", &client::LatencyStats::p99_us, "[us] 99th percentile round trip")
+      .def_readonly("max_us", &client::LatencyStats::max_us, "[us] longest round trip");
 
   using Outcome = std::optional<protocol::RequestOutcome>;
   const auto unlocked = py::call_guard<py::gil_scoped_release>();
@@ -138,7 +149,7 @@ void bind_session(py::module_& m) {
                      "(send_tip may run on another thread than the requests).")
       .def(py::init<std::uint32_t, std::uint32_t, const std::string&>(), py::arg("domain_id"), py::arg("client_id"), py::arg("partition") = "",
            unlocked)
-      .def_property_readonly("client_id", &Client::id)
+      .def_property_readonly("client_id", &Client::id, "this client's id")
       .def(
           "wait_for_scene", [](Client& c, double timeout_s) { return c.wait_for_scene(ms(timeout_s)); }, py::arg("timeout_s"), unlocked,
           "Waits up to timeout_s [s] for the server's scene state; None if none came.")
@@ -222,13 +233,13 @@ void bind_session(py::module_& m) {
             return f ? std::make_shared<protocol::MeshFrame>(std::move(*f)) : nullptr;
           },
           "The newest surface frame since the last call, checked against the topology; None if none.")
-      .def_property_readonly("mesh_frames_received", &Client::mesh_frames_received)
+      .def_property_readonly("mesh_frames_received", &Client::mesh_frames_received, "surface frames received so far")
       .def("poll_events", &Client::poll_events, unlocked, "Events since the last call, in order (the first call subscribes).")
       .def("poll_telemetry", &Client::poll_telemetry, unlocked, "Health reports since the last call (the first call subscribes).")
       .def("annotate", &Client::annotate, py::arg("text"), unlocked, "Publishes an annotation (at most 1024 bytes) for recorders and consoles.")
-      .def_property_readonly("server_state", &Client::server_state)
+      .def_property_readonly("server_state", &Client::server_state, "whether the server is there (its DDS liveliness)")
       .def_property_readonly("rejected", &Client::rejected, "Payloads that failed verification and were dropped.")
-      .def_property_readonly("last_rejection", &Client::last_rejection);
+      .def_property_readonly("last_rejection", &Client::last_rejection, "why the newest rejected payload was (\"\" if none)");
   m.def("now_ns", &client::now_ns, "The protocol's clock [ns] (DDS time, the wall clock).");
 }
 

@@ -165,10 +165,14 @@ void bind_tissue(py::module_& m) {
            py::arg("poisson_ratio") = 0.45, py::arg("density_kg_m3") = 1060.0, py::arg("model") = "gps_energy", py::arg("volume_term") = 0.5,
            py::arg("fixed_nodes") = std::vector<std::int32_t>{}, py::arg("gravity_m_s2") = std::array<double, 3>{0, 0, -9.81},
            py::arg("damping_per_s") = 5.0, py::arg("integrator") = "explicit", py::arg("dt_s") = 0.01)
-      .def_property_readonly("node_count", [](const Organ& o) { return o.mesh_->node_count(); })
-      .def_property_readonly("tet_count", [](const Organ& o) { return o.mesh_->tet_count(); })
-      .def_property_readonly("model", [](const Organ& o) { return std::string(o.model_->name()); })
-      .def_property_readonly("material", [](const Organ& o) { return o.name_; })
+      .def_property_readonly(
+          "node_count", [](const Organ& o) { return o.mesh_->node_count(); }, "nodes of the mesh")
+      .def_property_readonly(
+          "tet_count", [](const Organ& o) { return o.mesh_->tet_count(); }, "tetrahedra of the mesh")
+      .def_property_readonly(
+          "model", [](const Organ& o) { return std::string(o.model_->name()); }, "the force model's name")
+      .def_property_readonly(
+          "material", [](const Organ& o) { return o.name_; }, "the material's name")
       .def_property_readonly(
           "time_s", [](const Organ& o) { return o.state_.time_s; }, "[s] simulated time")
       .def_property_readonly(

@@ -60,6 +60,7 @@ class Recording:
 
     @property
     def path(self) -> str:
+        """The recording's file."""
         return self._r.path
 
     @property
