@@ -21,9 +21,11 @@ py::array_t<T> read_only(py::array_t<T> a) {
 /// The vector's elements as an array of that shape (C order), owning the vector: no copy.
 template <class T>
 py::array_t<T> owning_array(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
-  auto* held = new std::vector<T>(std::move(v));
-  py::capsule owner(held, [](void* p) { delete static_cast<std::vector<T>*>(p); });
-  return read_only(py::array_t<T>(std::move(shape), held->data(), owner));
+  auto held = std::make_unique<std::vector<T>>(std::move(v));
+  const T* data = held->data();
+  py::capsule owner(held.get(), [](void* p) { std::unique_ptr<std::vector<T>>(static_cast<std::vector<T>*>(p)).reset(); });
+  static_cast<void>(held.release());  // the capsule owns it now
+  return read_only(py::array_t<T>(std::move(shape), data, owner));
 }
 template <class T>
 py::array_t<T> owning_array(std::vector<T>&& v) {

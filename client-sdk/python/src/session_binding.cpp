@@ -108,14 +108,14 @@ void bind_session(py::module_& m) {
       .def_readonly("vertex_count", &protocol::SurfaceTopology::vertex_count, "vertices of the surface")
       .def_property_readonly(
           "triangles",
-          [](py::object self) {
+          [](const py::object& self) {
             const auto& t = self.cast<const protocol::SurfaceTopology&>().triangles;
             return view_array<std::uint32_t>(t.data(), {static_cast<py::ssize_t>(t.size() / 3), 3}, {12, 4}, self);
           },
           "(triangles, 3) vertex indices, outward by the right-hand rule; a read-only view")
       .def_property_readonly(
           "rest_positions",
-          [](py::object self) {
+          [](const py::object& self) {
             const auto& p = self.cast<const protocol::SurfaceTopology&>().rest_positions;
             return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
           },
@@ -127,7 +127,7 @@ void bind_session(py::module_& m) {
       .def_readonly("tick", &protocol::MeshFrame::tick, "the physics tick it belongs to")
       .def_property_readonly(
           "positions",
-          [](py::object self) {
+          [](const py::object& self) {
             const auto& p = self.cast<const protocol::MeshFrame&>().positions;
             return view_array<float>(p.data(), {static_cast<py::ssize_t>(p.size() / 3), 3}, {12, 4}, self);
           },

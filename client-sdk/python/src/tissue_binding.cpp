@@ -178,15 +178,15 @@ void bind_tissue(py::module_& m) {
       .def_property_readonly(
           "dt_s", [](const Organ& o) { return o.explicit_ ? o.explicit_->dt_s() : o.implicit_dt_s_; }, "[s] the step")
       .def_property_readonly(
-          "rest_positions", [](py::object self) { return vec3_view(self.cast<const Organ&>().mesh_->nodes, self); }, "(nodes, 3) [m], a view")
+          "rest_positions", [](const py::object& self) { return vec3_view(self.cast<const Organ&>().mesh_->nodes, self); }, "(nodes, 3) [m], a view")
       .def_property_readonly(
-          "positions", [](py::object self) { return vec3_view(self.cast<const Organ&>().state_.x, self); },
+          "positions", [](const py::object& self) { return vec3_view(self.cast<const Organ&>().state_.x, self); },
           "(nodes, 3) [m], a read-only view of the state (valid while the organ lives; it changes as the organ steps)")
       .def_property_readonly(
-          "velocities", [](py::object self) { return vec3_view(self.cast<const Organ&>().state_.v, self); }, "(nodes, 3) [m/s], a view")
+          "velocities", [](const py::object& self) { return vec3_view(self.cast<const Organ&>().state_.v, self); }, "(nodes, 3) [m/s], a view")
       .def_property_readonly(
           "tets",
-          [](py::object self) {
+          [](const py::object& self) {
             const auto& t = self.cast<const Organ&>().mesh_->tets;
             return view_array<std::int32_t>(t.data()->data(), {static_cast<py::ssize_t>(t.size()), 4}, {sizeof(t[0]), sizeof(std::int32_t)}, self);
           },
