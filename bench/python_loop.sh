@@ -17,7 +17,7 @@ sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$root/data/mes
   "$root/data/scenes/liver.json" > "$tmp/scene.json"
 "$root/build/server/runtime/viscera-server" --scene "$tmp/scene.json" > "$tmp/server.log" 2>&1 &
 for _ in $(seq 300); do grep -q "Hz physics" "$tmp/server.log" && break; sleep 0.1; done
-python="$(sed -n 's/^Python3_EXECUTABLE:FILEPATH=//p' "$root/build/CMakeCache.txt")"
+python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$root/build/CMakeCache.txt")"
 for rep in $(seq "${REPEAT:-1}"); do
   echo "python_loop.sh: run $rep: the C++ haptic-client, $seconds s at 1 kHz ..."
   "$root/build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 11 --instrument 1 --duration "$seconds" --depth 0.01 \

@@ -79,7 +79,7 @@ echo "[demo] the session re-run on a fresh server in lockstep, compared bit for 
 "$bin/tools/viscera-replay/viscera-replay" resimulate "$recording" --report "$root/out/demo-resimulation.json" --domain "$domain" 2>&1 \
   | sed -u 's/^/[replay] /' || echo "[demo] the re-simulation did not reproduce the session: see the first divergence above"
 echo "[demo] the same recording in Python (numpy, pandas, matplotlib): examples/python/analyse_session.py"
-python="$(sed -n 's/^Python3_EXECUTABLE:FILEPATH=//p' "$bin/CMakeCache.txt")"
+python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$bin/CMakeCache.txt")"
 PYTHONPATH="$bin/python" "${python:-python3}" "$root/examples/python/analyse_session.py" "$recording" --plot "$root/out/demo-session.png" 2>&1 \
   | sed -u 's/^/[python] /' || true
 echo "[demo] the Python package (docs/PYTHON.md): PYTHONPATH=$bin/python ${python:-python3} -c 'import viscera'"

@@ -52,10 +52,14 @@ def main() -> int:
     radius = next((i.tip_radius_m for i in scene.instruments if i.instrument_id == a.instrument), 0.0)
     above = radius + 0.003  # the tip starts 3 mm above the surface
 
+    # The loop as the C++ device loop runs it: each command waits for its answer until shortly
+    # before the next period, and the periods keep a fixed phase after the server's ticks
+    # (TickPhase, 100 us after a tick's end) when the loop runs at the physics rate.
     period = 1.0 / a.rate
+    phase = viscera.session.TickPhase(period, 100e-6) if abs(scene.physics_rate_hz - a.rate) <= 0.01 * a.rate else None
     start = time.monotonic()
     last = start
-    deadline = start
+    next_t = start
     periods = late = 0
     worst = 0.0
     peak = 0.0
@@ -63,10 +67,10 @@ def main() -> int:
     while (now := time.monotonic()) - start < a.duration:
         if a.report:
             starts.append(now - start)
-        phase = (now - start) / a.duration
-        depth = (a.depth + above) * (1 - abs(2 * phase - 1)) - above  # of the tip's lowest point below the surface
+        progress = (now - start) / a.duration
+        depth = (a.depth + above) * (1 - abs(2 * progress - 1)) - above  # of the tip's lowest point below the surface
         client.send_tip(a.instrument, [top[0], top[1], top[2] + radius - depth])
-        force = client.wait_force(a.instrument, period / 2)
+        force = client.wait_force(a.instrument, max(0.0, next_t + period - 100e-6 - time.monotonic()))
         if force is not None:
             peak = max(peak, force.force_n[2])
         periods += 1
@@ -75,8 +79,12 @@ def main() -> int:
         if periods > 1:
             worst = max(worst, gap)
             late += gap > a.late_ms * 1e-3
-        deadline += period
-        pause = deadline - time.monotonic()
+        next_t += period
+        tick_end = client.last_tick_end_ns(a.instrument) if phase is not None else None
+        if phase is not None and tick_end is not None:
+            next_ns = viscera.session.now_ns() + int((next_t - time.monotonic()) * 1e9)
+            next_t += phase.correction_ns(next_ns, tick_end) * 1e-9
+        pause = next_t - time.monotonic()
         if pause > 0:
             time.sleep(pause)
     client.release(a.instrument)

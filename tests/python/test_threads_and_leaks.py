@@ -59,3 +59,13 @@ def test_ten_thousand_clients_and_readers_do_not_leak(domain: int, session: Sess
     grown = int(subprocess.run([sys.executable, "-c", LEAK_LOOP, str(domain), str(session.recording), "10000"], check=True, capture_output=True,
                                text=True, timeout=300).stdout)
     assert grown < 5 * 1024 * 1024, f"resident memory grew by {grown / 1e6:.1f} MB"
+
+
+def test_waits_shorter_than_a_millisecond_wait(domain: int) -> None:
+    # A 1 kHz loop waits for its answer a fraction of a millisecond; such a wait must not be cut to
+    # nothing (with no server on this domain, nothing answers, so each wait runs to its end).
+    client = viscera.session.Client(domain + 100 if domain < 130 else domain - 100, 42)
+    for timeout in (0.0003, 0.0008):
+        start = time.perf_counter()
+        assert client.wait_force(1, timeout) is None
+        assert time.perf_counter() - start >= 0.9 * timeout

@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include "viscera/client/client.hpp"
+#include "viscera/client/tick_phase.hpp"
 #include "viscera/common/command_line.hpp"
 
 #include "bindings.hpp"
@@ -17,10 +18,13 @@ namespace {
 using client::Client;
 namespace protocol = viscera::protocol;
 
-std::chrono::milliseconds ms(double seconds) {
+/// A timeout [s] as nanoseconds (a 1 kHz loop waits fractions of a millisecond).
+std::chrono::nanoseconds ns(double seconds) {
   if (!(seconds >= 0 && seconds <= 86400)) throw common::UsageError("timeout_s must lie in [0, 86400], not " + std::to_string(seconds));
-  return std::chrono::milliseconds(static_cast<long long>(seconds * 1e3));
+  return std::chrono::nanoseconds(static_cast<long long>(seconds * 1e9));
 }
+/// For the calls that take milliseconds: rounded up, so that a short wait still waits.
+std::chrono::milliseconds ms(double seconds) { return std::chrono::ceil<std::chrono::milliseconds>(ns(seconds)); }
 
 protocol::Vector3 vector3(const std::vector<double>& v, const char* what) {
   if (v.size() != 3) throw common::UsageError(std::string(what) + ": 3 coordinates [m], not " + std::to_string(v.size()));
@@ -211,6 +215,8 @@ void bind_session(py::module_& m) {
           py::arg("instrument_id"), py::arg("timeout_s") = 0.01, unlocked,
           "Waits up to timeout_s [s] for the force answering the newest command; returns the newest force seen either way.")
       .def("round_trip", &Client::round_trip, "Command-to-force round trips measured so far.")
+      .def("last_tick_end_ns", &Client::last_tick_end_ns, py::arg("instrument_id"),
+           "[ns] when the server ended the newest tick whose force for the instrument was taken (DDS time), for TickPhase; None before")
       .def(
           "surface",
           [](Client& c) -> std::shared_ptr<protocol::SurfaceTopology> {
@@ -240,6 +246,27 @@ void bind_session(py::module_& m) {
       .def_property_readonly("server_state", &Client::server_state, "whether the server is there (its DDS liveliness)")
       .def_property_readonly("rejected", &Client::rejected, "Payloads that failed verification and were dropped.")
       .def_property_readonly("last_rejection", &Client::last_rejection, "why the newest rejected payload was (\"\" if none)");
+  py::class_<client::TickPhase>(m, "TickPhase",
+                                "Keeps a periodic loop at a fixed phase after the server's physics ticks (the C++ device loop's "
+                                "scheduler): its commands arrive in the server's idle time, each tick takes a command of the same age.")
+      .def(py::init([](double period_s, double offset_s, double max_step_s) {
+             if (!(period_s > 0 && period_s <= 1)) throw common::UsageError("period_s must lie in (0, 1] s");
+             if (!(offset_s >= 0 && offset_s < period_s)) throw common::UsageError("offset_s must lie in [0, period_s)");
+             if (!(max_step_s > 0 && max_step_s <= period_s)) throw common::UsageError("max_step_s must lie in (0, period_s]");
+             const auto ns = [](double s) { return std::chrono::nanoseconds(static_cast<long long>(s * 1e9)); };
+             return client::TickPhase(ns(period_s), ns(offset_s), ns(max_step_s));
+           }),
+           py::arg("period_s"), py::arg("offset_s") = 100e-6, py::arg("max_step_s") = 20e-6,
+           "period_s: the loop's period [s] (the server's tick); offset_s: where to run after a tick's end [s]; max_step_s: the largest "
+           "correction per period [s].")
+      .def(
+          "error_ns",
+          [](const client::TickPhase& p, std::int64_t next_ns, std::int64_t tick_end_ns) { return p.error(next_ns, tick_end_ns).count(); },
+          py::arg("next_ns"), py::arg("tick_end_ns"), "[ns] signed distance of next_ns from the nearest target time (DDS time)")
+      .def(
+          "correction_ns",
+          [](const client::TickPhase& p, std::int64_t next_ns, std::int64_t tick_end_ns) { return p.correction(next_ns, tick_end_ns).count(); },
+          py::arg("next_ns"), py::arg("tick_end_ns"), "[ns] what to add to the loop's next time (an eighth of -error, at most max_step_s)");
   m.def("now_ns", &client::now_ns, "The protocol's clock [ns] (DDS time, the wall clock).");
 }
 

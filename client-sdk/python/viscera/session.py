@@ -26,6 +26,7 @@ from ._viscera.session import (
     ServerState,
     SurfaceTopology,
     Telemetry,
+    TickPhase,
     now_ns,
 )
 
@@ -43,5 +44,6 @@ __all__ = [
     "ServerState",
     "SurfaceTopology",
     "Telemetry",
+    "TickPhase",
     "now_ns",
 ]
