@@ -11,7 +11,7 @@ seconds="${1:-60}"
 mkdir -p "$root/bench/results"
 "$root/deploy/build.sh" "$root/build" >/dev/null
 export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
-tmp="$(mktemp -d)"; trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$tmp"' EXIT
+tmp="$(mktemp -d)"; trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$tmp"' EXIT
 domain=$(( (RANDOM % 200) + 1 ))
 sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$root/data/meshes/#; s#\"../materials/#\"$root/data/materials/#" \
   "$root/data/scenes/liver.json" > "$tmp/scene.json"

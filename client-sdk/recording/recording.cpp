@@ -1,6 +1,7 @@
 #include "viscera/recording/recording.hpp"
 
 #include <algorithm>
+#include <future>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/number_text.hpp"
@@ -103,18 +104,28 @@ mcap::Integrity Recording::integrity() { return mcap::check_integrity(reader_); 
 std::uint64_t Recording::start_ns() const { return summary_.statistics ? summary_.statistics->message_start_time : 0; }
 std::uint64_t Recording::end_ns() const { return summary_.statistics ? summary_.statistics->message_end_time : 0; }
 
-void Recording::for_each(const std::function<bool(const RecordedChannel&, const mcap::Message&)>& f, std::uint64_t from_ns, std::uint64_t to_ns) {
-  std::vector<mcap::ChunkIndex> chunks = summary_.chunks;
+void Recording::for_each(const std::function<bool(const RecordedChannel&, const mcap::Message&)>& f, std::uint64_t from_ns, std::uint64_t to_ns,
+                         bool read_ahead) {
+  std::vector<mcap::ChunkIndex> chunks;
+  for (const auto& c : summary_.chunks)
+    if (c.end_time >= from_ns && c.start_time <= to_ns) chunks.push_back(c);
   std::stable_sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.start_time < b.start_time; });
-  for (const auto& c : chunks) {
-    if (c.end_time < from_ns || c.start_time > to_ns) continue;
+  const auto load = [this](const mcap::ChunkIndex& c) {
     std::vector<mcap::Message> messages = reader_.read_chunk(c);
     std::stable_sort(messages.begin(), messages.end(), [](const auto& a, const auto& b) { return a.log_time < b.log_time; });
+    return messages;
+  };
+  // With read_ahead, the next chunk is read, decompressed and checked on a thread of its own while
+  // `f` takes this one's messages (f must not use this recording meanwhile).
+  std::future<std::vector<mcap::Message>> next;
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    std::vector<mcap::Message> messages = next.valid() ? next.get() : load(chunks[i]);
+    if (read_ahead && i + 1 < chunks.size()) next = std::async(std::launch::async, load, chunks[i + 1]);
     for (const auto& m : messages) {
       if (m.log_time < from_ns || m.log_time > to_ns) continue;
       const auto ch = channels_.find(m.channel_id);
       if (ch == channels_.end()) continue;
-      if (!f(ch->second, m)) return;
+      if (!f(ch->second, m)) return;  // a chunk still being read is waited for (std::future's destructor)
     }
   }
 }

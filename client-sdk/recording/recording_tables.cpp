@@ -317,27 +317,29 @@ RecordingTables read_tables(Recording& recording, const std::set<std::string>& s
     }
   }
   const std::uint64_t frames_expected = expected_messages(recording, Stream::mesh_frame);
-  recording.for_each([&](const RecordedChannel& ch, const mcap::Message& m) {
-    if (!wanted.count(ch.stream)) return true;
-    switch (ch.stream) {
-      case Stream::instrument_command: add_row(out, ch.stream, ch, m, protocol::decode_command, command); break;
-      case Stream::force_feedback: add_row(out, ch.stream, ch, m, protocol::decode_force, force); break;
-      case Stream::session_request: add_row(out, ch.stream, ch, m, protocol::decode_session_request, request); break;
-      case Stream::scene_state: add_row(out, ch.stream, ch, m, protocol::decode_scene, scene); break;
-      case Stream::telemetry: add_row(out, ch.stream, ch, m, protocol::decode_telemetry, telemetry); break;
-      case Stream::surface_topology:
-        if (const auto* t = add_row(out, ch.stream, ch, m, protocol::decode_surface_topology, topology)) add_topology(out, *t);
-        break;
-      case Stream::mesh_frame:
-        if (const auto* f = add_row(out, ch.stream, ch, m, protocol::decode_mesh_frame, frame); f && with_frames)
-          add_frame(out, m, *f, frames_expected);
-        break;
-      case Stream::event: add_row(out, ch.stream, ch, m, protocol::decode_event, event); break;
-      case Stream::scene_files: add_row(out, ch.stream, ch, m, protocol::decode_scene_files, files); break;
-      default: break;
-    }
-    return true;
-  });
+  recording.for_each(
+      [&](const RecordedChannel& ch, const mcap::Message& m) {
+        if (!wanted.count(ch.stream)) return true;
+        switch (ch.stream) {
+          case Stream::instrument_command: add_row(out, ch.stream, ch, m, protocol::decode_command, command); break;
+          case Stream::force_feedback: add_row(out, ch.stream, ch, m, protocol::decode_force, force); break;
+          case Stream::session_request: add_row(out, ch.stream, ch, m, protocol::decode_session_request, request); break;
+          case Stream::scene_state: add_row(out, ch.stream, ch, m, protocol::decode_scene, scene); break;
+          case Stream::telemetry: add_row(out, ch.stream, ch, m, protocol::decode_telemetry, telemetry); break;
+          case Stream::surface_topology:
+            if (const auto* t = add_row(out, ch.stream, ch, m, protocol::decode_surface_topology, topology)) add_topology(out, *t);
+            break;
+          case Stream::mesh_frame:
+            if (const auto* f = add_row(out, ch.stream, ch, m, protocol::decode_mesh_frame, frame); f && with_frames)
+              add_frame(out, m, *f, frames_expected);
+            break;
+          case Stream::event: add_row(out, ch.stream, ch, m, protocol::decode_event, event); break;
+          case Stream::scene_files: add_row(out, ch.stream, ch, m, protocol::decode_scene_files, files); break;
+          default: break;
+        }
+        return true;
+      },
+      0, ~std::uint64_t{0}, /*read_ahead=*/true);
   return out;
 }
 

@@ -40,8 +40,15 @@ def scene_file(tmp_path_factory: pytest.TempPathFactory, domain: int) -> Path:
     scene["domain_id"] = domain
     for key in ("mesh", "material"):
         scene["organ"][key] = str(SOURCE / "data" / scene["organ"][key].removeprefix("../"))
-    path = tmp_path_factory.mktemp("scene") / "liver.json"
+    folder = tmp_path_factory.mktemp("scene")
+    path = folder / "liver.json"
     path.write_text(json.dumps(scene))
+    # The finer liver beside it, in the server's scene directory: load_scene("liver-12k").
+    fine = json.loads((SOURCE / "data/scenes/liver-12k.json").read_text())
+    fine["domain_id"] = domain
+    for key in ("mesh", "material"):
+        fine["organ"][key] = str(SOURCE / "data" / fine["organ"][key].removeprefix("../"))
+    (folder / "liver-12k.json").write_text(json.dumps(fine))
     return path
 
 

@@ -64,8 +64,10 @@ class Recording {
 
   /// Each message with log time in [from_ns, to_ns], chunk by chunk in log-time order; `f` returns
   /// false to stop. Messages on channels of streams this build does not know are skipped.
+  /// `read_ahead`: the next chunk is read and decompressed on a second thread while `f` runs (then
+  /// `f` must not call this recording).
   void for_each(const std::function<bool(const RecordedChannel&, const mcap::Message&)>& f, std::uint64_t from_ns = 0,
-                std::uint64_t to_ns = ~std::uint64_t{0});
+                std::uint64_t to_ns = ~std::uint64_t{0}, bool read_ahead = false);
 
  private:
   mcap::McapReader reader_;
