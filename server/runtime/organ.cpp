@@ -52,11 +52,17 @@ Box fixed_slab(const SceneSpec& s, const Box& bounds) {
 void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const std::string& source, const std::string& field) {
   const SceneSpec& s = organ.scene;
   const Material& material = organ.material;
-  const GpsMaterial gps = gps_material(material, s.material);
+  Mat6 D = material.elasticity;
+  GpsMechanisms ve;
+  if (material.viscoelasticity) {
+    const ViscoelasticSetup setup = make_viscoelastic(material.elasticity, *material.viscoelasticity, s.material);
+    D = setup.unrelaxed_elasticity;
+    ve = setup.gps;
+  }
   // Each region's material, calibrated per element like the organ's. The relaxation is the
   // model's (one set of memory-variable weights), so a region relaxes as its organ: its own
   // material file may repeat the organ's viscoelasticity, not give another.
-  std::vector<Mat6> materials{gps.elasticity};
+  std::vector<Mat6> materials{D};
   std::vector<double> density(organ.mesh->tet_count(), material.density_kg_m3);
   for (std::size_t k = 0; k < organ.region_materials.size(); ++k) {
     const Material& rm = organ.region_materials[k];
@@ -69,7 +75,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   }
   for (std::size_t e = 0; e < organ.regions.material_of_tet.size(); ++e)
     if (const std::uint16_t m = organ.regions.material_of_tet[e]) density[e] = organ.region_materials[m - 1].density_kg_m3;
-  organ.model = make_force_model(s.model, organ.mesh, materials, s.volume_term, gps.mechanisms, organ.regions.material_of_tet);
+  organ.model = make_force_model(s.model, organ.mesh, materials, s.volume_term, ve, organ.regions.material_of_tet);
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
   bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, fixed_slab(s, organ.bounds));

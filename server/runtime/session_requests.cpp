@@ -121,10 +121,8 @@ bool SimulationServer::Impl::control(const proto::SessionRequest& req, const Sta
     conclude(req, true, text + tick_cost(organ->integrator->dt_s(), organ->substep_cost_s, scene.physics_rate_hz), status);
     return true;
   }
-  // A material file that does not read is refused at once, as the background build would; not
-  // read at all while something is being prepared (refused busy below): a client sending file
-  // after file costs the physics thread one parse per build, not one per request.
-  if (req.action == proto::Action::set_material && req.material.file_text && session.preparing().empty()) {
+  // A material file that does not read is refused at once, as the background build would.
+  if (req.action == proto::Action::set_material && req.material.file_text) {
     try {
       tissue::parse_material(*req.material.file_text, "set_material");
     } catch (const InputError& e) {

@@ -138,9 +138,15 @@ Organ build(const viscera::common::CommandLine& cl) {
   scale_mesh(*o.mesh, scale);
   o.material = material_of(cl);
   const double volume = cl.number_in("volume-term", 0.0, 0.999);
-  const GpsMaterial gps = gps_material(o.material, cl.has("material") ? cl.text("material") : o.material.name);
-  if (!gps.table.empty()) std::printf("viscoelasticity\n%s", gps.table.c_str());
-  o.model = make_force_model(cl.text("model"), o.mesh, {gps.elasticity}, volume, gps.mechanisms);
+  Mat6 elasticity = o.material.elasticity;
+  GpsMechanisms mechanisms;
+  if (o.material.viscoelasticity) {
+    const ViscoelasticSetup ve = make_viscoelastic(o.material.elasticity, *o.material.viscoelasticity, cl.text("material"));
+    std::printf("viscoelasticity\n%s", ve.table.c_str());
+    elasticity = ve.unrelaxed_elasticity;
+    mechanisms = ve.gps;
+  }
+  o.model = make_force_model(cl.text("model"), o.mesh, {elasticity}, volume, mechanisms);
   BoundaryConditions bc;
   const auto g = cl.numbers("gravity", 3);
   bc.gravity_m_s2 = Vec3(g[0], g[1], g[2]);

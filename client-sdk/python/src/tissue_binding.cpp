@@ -13,6 +13,7 @@
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
 #include "bindings.hpp"
 #include "numpy_views.hpp"
@@ -49,8 +50,14 @@ class Organ {
     }
     if (!(o.volume_term >= 0 && o.volume_term < 1)) throw UsageError("volume_term must lie in [0, 1)");
     if (!(o.damping_per_s >= 0)) throw UsageError("damping_per_s must be at least 0");
-    const GpsMaterial gps = gps_material(material, o.material);
-    model_ = make_force_model(o.model, mesh_, {gps.elasticity}, o.volume_term, gps.mechanisms);
+    Mat6 elasticity = material.elasticity;
+    GpsMechanisms mechanisms;
+    if (material.viscoelasticity) {
+      const ViscoelasticSetup ve = make_viscoelastic(material.elasticity, *material.viscoelasticity, o.material);
+      elasticity = ve.unrelaxed_elasticity;
+      mechanisms = ve.gps;
+    }
+    model_ = make_force_model(o.model, mesh_, {elasticity}, o.volume_term, mechanisms);
     BoundaryConditions bc;
     bc.gravity_m_s2 = o.gravity_m_s2;
     for (const auto i : o.fixed_nodes)

@@ -92,10 +92,4 @@ Material parse_material(const std::string& text, const std::string& source) {
 
 Material read_material_file(const std::string& path) { return parse_material(read_text_file(path, std::size_t{1} << 20), path); }
 
-GpsMaterial gps_material(const Material& m, const std::string& source) {
-  if (!m.viscoelasticity) return {m.elasticity, {}, {}};
-  ViscoelasticSetup ve = make_viscoelastic(m.elasticity, *m.viscoelasticity, source);
-  return {ve.unrelaxed_elasticity, std::move(ve.gps), std::move(ve.table)};
-}
-
 }  // namespace viscera::tissue

@@ -30,14 +30,4 @@ Material read_material_file(const std::string& path);
 /// Parses material JSON text (source names it in errors).
 Material parse_material(const std::string& json_text, const std::string& source);
 
-/// What a GPS is built with for a material: its elasticity; or, when it is viscoelastic, the
-/// unrelaxed elasticity and the mechanisms (memory variables, stiffening, ...), with the fitted
-/// mechanisms' table for people. `source` names the material in errors.
-struct GpsMaterial {
-  Mat6 elasticity;
-  GpsMechanisms mechanisms;
-  std::string table;  ///< empty when elastic
-};
-GpsMaterial gps_material(const Material& m, const std::string& source);
-
 }  // namespace viscera::tissue
