@@ -43,4 +43,17 @@ for n in force-drill ../../escaped .hidden 'a/b' "$(printf 'a\033b')" liver.json
 printf '\002{"model": "m", "fitted_to": "d", "units": "SI", "mechanisms": ["broadband_relaxation", "strain_stiffening"], "modulus_pa": 1000, "viscosity_pa_s": 10, "relaxation_time_s": [0.1, 10], "relaxation_modulus_pa": [100, 50], "stiffening_b": 3}' > "$seeds/2-model.json"
 "$out/readers_fuzz" -max_total_time="$seconds" -max_len=262144 -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
   "$out/corpus-readers" "$seeds" 2>&1 | tail -8
-echo "fuzz: decoders_fuzz and readers_fuzz: 2 passed, 0 failed"
+# Cutting: random sweeps (up to 32 per input) through a box, from seeds of 32 sweeps each; the
+# target counts the sweeps it applied, at least 10,000 are required (three times the others' time).
+seeds="$out/seeds-cutting"; rm -rf "$seeds"; mkdir -p "$seeds" "$out/corpus-cutting"
+python3 -c "
+import random, sys
+r = random.Random(35)
+for i in range(32):
+    open(sys.argv[1] + '/seed-%02d' % i, 'wb').write(bytes(r.randrange(256) for _ in range(1 + 32 * 10)))
+" "$seeds"
+"$out/cutting_fuzz" -max_total_time="$((3 * seconds))" -max_len=400 -timeout=10 -print_final_stats=1 "$out/corpus-cutting" "$seeds" 2>&1 \
+  | tail -8 | tee "$out/cutting.log"
+applied=$(sed -n 's/^cutting_fuzz: \([0-9]*\) sweeps applied$/\1/p' "$out/cutting.log" | tail -1)
+if [ "${applied:-0}" -lt 10000 ]; then echo "fuzz: cutting_fuzz applied ${applied:-0} sweeps in $((3 * seconds)) s, fewer than 10,000"; exit 1; fi
+echo "fuzz: decoders_fuzz, readers_fuzz and cutting_fuzz: 3 passed, 0 failed"

@@ -118,3 +118,17 @@ TEST(Refinement, ChildrenKeepTheirParentsElementSets) {
     }
   }
 }
+
+TEST(MeshValidation, AFaceSharedByThreeTetrahedraIsCountedOnce) {
+  // Three tetrahedra on one triangle (apexes above, below and beside it): one face too many;
+  // a box mesh and its refinement: none.
+  TetMesh m = make_box_mesh(Vec3(0, 0, 0), Vec3(0.03, 0.02, 0.02), 3, 2, 2);
+  EXPECT_EQ(overshared_faces(m), 0u);
+  EXPECT_EQ(overshared_faces(refine_uniform(m)), 0u);
+  TetMesh fan;
+  fan.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.2, 1), Vec3(0.2, 0.2, -1), Vec3(0.3, 0.3, 0.5)};
+  fan.tets = {{0, 1, 2, 3}, {0, 2, 1, 4}, {0, 1, 2, 5}};
+  EXPECT_EQ(overshared_faces(fan), 1u);
+  fan.tets.push_back({0, 1, 2, 3});  // and a fourth on the same face is still one face
+  EXPECT_EQ(overshared_faces(fan), 1u);
+}

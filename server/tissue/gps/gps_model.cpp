@@ -32,45 +32,56 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   options_.mechanisms.validate();
   const GpsViscous& viscous = options_.mechanisms.viscous;
   mechanisms_ = viscous.mechanisms();
-  const bool bulk_differs = viscous.bulk_differs();
-  std::vector<double> kappa(materials.size());
-  for (std::size_t m = 0; m < materials.size(); ++m) kappa[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials[m]);
-
+  materials_ = std::move(materials);
+  material_of_tet_ = std::move(material_of_tet);
+  kappa_.resize(materials_.size());
+  for (std::size_t m = 0; m < materials_.size(); ++m) kappa_[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials_[m]);
   const std::size_t n = element_count();
   blocks_.resize((n + L - 1) / L);
-  if (bulk_differs) bulk_.resize(blocks_.size());
-  for (std::size_t slot = 0; slot < blocks_.size() * L; ++slot) {
-    const bool padding = slot >= n;
-    const std::size_t e = padding ? (slot / L) * L : slot;  // padding copies the block's first element
-    Block& b = blocks_[slot / L];
-    const int j = static_cast<int>(slot % L);
-    const auto rest = gather(mesh_->nodes, e);
-    const std::size_t m = material_of_tet.empty() ? 0 : material_of_tet[e];
-    Mat6 H = gps_edge_hessian(rest, materials[m]);
-    const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
+  if (viscous.bulk_differs()) bulk_.resize(blocks_.size());
+  for (std::size_t slot = 0; slot < blocks_.size() * L; ++slot) write_lane(slot);
+}
+
+std::size_t GpsModel::material_of(std::size_t e) const { return material_of_tet_.empty() ? 0 : material_of_tet_[e]; }
+
+Mat6 GpsModel::calibrated_hessian(const std::array<Vec3, 4>& rest, std::size_t m) const {
+  Mat6 H = gps_edge_hessian(rest, materials_[m]);
+  if (with_volume_) {
+    // Remove the volume term's small-strain stiffness so that the sum still equals linear FE.
     const Vec6 hv = volume_in_elongations(rest);
-    if (with_volume_) {
-      // Remove the volume term's small-strain stiffness so that the sum still equals linear FE.
-      H -= (kappa[m] / V0) * hv * hv.transpose();
-    }
-    if (bulk_differs) {
-      // The volumetric part of H is rank one: (K_Reuss / V0) hv hv^T (hv: J^T hv = grad V).
-      BulkBlock& bb = bulk_[slot / L];
-      for (int k = 0; k < 6; ++k) bb.hv[k][slot % L] = hv(k);
-      bb.scale[slot % L] = padding ? 0.0 : (reuss_bulk_modulus(materials[m]) - (with_volume_ ? kappa[m] : 0.0)) / V0;
-    }
-    if (padding) H.setZero();
-    for (int k = 0; k < 4; ++k) b.v[k][j] = mesh_->tets[e][k];
-    for (int k = 0; k < 6; ++k) {
-      b.rest_length[k][j] = (rest[kTetEdges[k][1]] - rest[kTetEdges[k][0]]).norm();
-      b.inv_rest_length[k][j] = 1.0 / b.rest_length[k][j];
-    }
-    int k = 0;
-    for (int r = 0; r < 6; ++r)
-      for (int c = r; c < 6; ++c) b.H[k++][j] = H(r, c);
-    b.rest_volume[j] = V0;
-    b.kappa[j] = (with_volume_ && !padding) ? kappa[m] : 0.0;
+    H -= (kappa_[m] / signed_volume(rest[0], rest[1], rest[2], rest[3])) * hv * hv.transpose();
   }
+  return H;
+}
+
+void GpsModel::write_lane(std::size_t slot) {
+  const std::size_t n = element_count();
+  const bool padding = slot >= n;
+  const std::size_t e = padding ? (slot / L) * L : slot;  // padding copies the block's first element
+  Block& b = blocks_[slot / L];
+  const int j = static_cast<int>(slot % L);
+  const auto rest = gather(mesh_->nodes, e);
+  const std::size_t m = material_of(e);
+  Mat6 H = calibrated_hessian(rest, m);
+  const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
+  if (!bulk_.empty()) {
+    // The volumetric part of H is rank one: (K_Reuss / V0) hv hv^T (hv: J^T hv = grad V).
+    const Vec6 hv = volume_in_elongations(rest);
+    BulkBlock& bb = bulk_[slot / L];
+    for (int k = 0; k < 6; ++k) bb.hv[k][j] = hv(k);
+    bb.scale[j] = padding ? 0.0 : (reuss_bulk_modulus(materials_[m]) - (with_volume_ ? kappa_[m] : 0.0)) / V0;
+  }
+  if (padding) H.setZero();
+  for (int k = 0; k < 4; ++k) b.v[k][j] = mesh_->tets[e][k];
+  for (int k = 0; k < 6; ++k) {
+    b.rest_length[k][j] = (rest[kTetEdges[k][1]] - rest[kTetEdges[k][0]]).norm();
+    b.inv_rest_length[k][j] = 1.0 / b.rest_length[k][j];
+  }
+  int k = 0;
+  for (int r = 0; r < 6; ++r)
+    for (int c = r; c < 6; ++c) b.H[k++][j] = H(r, c);
+  b.rest_volume[j] = V0;
+  b.kappa[j] = (with_volume_ && !padding) ? kappa_[m] : 0.0;
 }
 
 std::string_view GpsModel::name() const {

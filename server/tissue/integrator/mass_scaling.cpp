@@ -57,4 +57,19 @@ MassScaling scale_small_element_masses(const ForceModel& model, std::span<const 
   return out;
 }
 
+double hold_element_steps(const ForceModel& model, std::span<double> density_kg_m3, std::span<const std::int32_t> elements, double min_step_s) {
+  if (density_kg_m3.size() != model.element_count()) throw std::invalid_argument("hold_element_steps: one density per element expected");
+  double added = 0.0;
+  const auto& rest = model.rest_mesh().nodes;
+  for (const std::int32_t element : elements) {
+    const auto e = static_cast<std::size_t>(element);
+    const double r = 0.5 * min_step_s * element_frequency(model, e, density_kg_m3[e]);
+    if (r <= 1.0) continue;
+    const auto x = model.gather(rest, e);
+    added += density_kg_m3[e] * (r * r - 1.0) * signed_volume(x[0], x[1], x[2], x[3]);
+    density_kg_m3[e] *= r * r;
+  }
+  return added;
+}
+
 }  // namespace viscera::tissue

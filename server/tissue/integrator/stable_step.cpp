@@ -9,18 +9,20 @@
 
 namespace viscera::tissue {
 
+double element_frequency(const ForceModel& model, std::size_t e, double density_kg_m3) {
+  const auto& rest = model.rest_mesh().nodes;
+  const auto x = model.gather(rest, e);
+  const double volume = signed_volume(x[0], x[1], x[2], x[3]);
+  const Mat12 K = model.element_tangent(rest, e);
+  const Mat12 Ks = 0.5 * (K + K.transpose());
+  const double lambda = Eigen::SelfAdjointEigenSolver<Mat12>(Ks, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  return std::sqrt(lambda / (0.25 * density_kg_m3 * volume));
+}
+
 std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3) {
   if (density_kg_m3.size() != model.element_count()) throw std::invalid_argument("element_frequencies: one density per element expected");
-  const auto& rest = model.rest_mesh().nodes;
   std::vector<double> omega(model.element_count());
-  for (std::size_t e = 0; e < model.element_count(); ++e) {
-    const auto x = model.gather(rest, e);
-    const double volume = signed_volume(x[0], x[1], x[2], x[3]);
-    const Mat12 K = model.element_tangent(rest, e);
-    const Mat12 Ks = 0.5 * (K + K.transpose());
-    const double lambda = Eigen::SelfAdjointEigenSolver<Mat12>(Ks, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
-    omega[e] = std::sqrt(lambda / (0.25 * density_kg_m3[e] * volume));
-  }
+  for (std::size_t e = 0; e < model.element_count(); ++e) omega[e] = element_frequency(model, e, density_kg_m3[e]);
   return omega;
 }
 

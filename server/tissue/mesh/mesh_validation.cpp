@@ -1,6 +1,7 @@
 #include "viscera/tissue/mesh/mesh_validation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -60,6 +61,24 @@ void validate_mesh(const TetMesh& mesh, const MeshOrigin* origin) {
   }
   for (std::size_t i = 0; i < used.size(); ++i)
     if (!used[i]) fail(node(i), "is used by no tetrahedron", node_line(i));
+}
+
+std::size_t overshared_faces(const TetMesh& mesh) {
+  std::vector<std::array<std::int32_t, 3>> faces;
+  faces.reserve(4 * mesh.tets.size());
+  for (const Tet& t : mesh.tets)
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<std::int32_t, 3> f{};
+      int k = 0;
+      for (int i = 0; i < 4; ++i)
+        if (i != skip) f[static_cast<std::size_t>(k++)] = t[static_cast<std::size_t>(i)];
+      std::sort(f.begin(), f.end());
+      faces.push_back(f);
+    }
+  std::sort(faces.begin(), faces.end());
+  std::size_t count = 0;
+  for (std::size_t i = 2; i < faces.size(); ++i) count += faces[i] == faces[i - 2] && (i < 3 || faces[i - 3] != faces[i]);
+  return count;
 }
 
 }  // namespace viscera::tissue

@@ -11,6 +11,7 @@
 // modulus): restores inverted elements, which the edge lengths alone cannot see. H is calibrated
 // with the term's small-strain stiffness removed, so the sum still equals linear FE there.
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "viscera/tissue/gps/gps_mechanisms.hpp"
@@ -47,6 +48,34 @@ class GpsModel final : public ForceModel {
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e) const override;
 
   const GpsOptions& options() const { return options_; }
+  /// Memory for this model's elements from the memory of `before` (a model of the same options on
+  /// the mesh this one's was cut from): element e starts in the state of element origin[e] of
+  /// `before`. Edge quantities go through the parent's small strain, which its six elongations
+  /// determine (dL_k = L0_k n_k' eps n_k), so a child carries its parent's viscoelastic state; a
+  /// child's first-load extremes are the largest of its parent's, in each sense.
+  std::vector<double> memory_from(const GpsModel& before, std::span<const double> memory, std::span<const std::int32_t> origin) const;
+
+  /// What changed in the mesh a model was built on, when it is edited in place (cutting): nodes
+  /// and elements appended, some elements given new vertices. Nodes never move.
+  struct MeshEdit {
+    std::size_t elements_before = 0;
+    /// Per element after the edit, the element before it that it comes from (itself if unchanged).
+    std::span<const std::int32_t> origin;
+    /// Every element before the edit whose vertices changed, with its vertices before.
+    std::span<const std::pair<std::int32_t, Tet>> replaced;
+  };
+  /// Follows an edit of the mesh this model holds (done by its owner, e.g. a MeshCutter on the
+  /// same TetMesh): the changed and the new elements are calibrated from their own rest shapes
+  /// with their parent's material, the others stay bit for bit. `memory` (State::memory) is
+  /// brought to the new layout in place, changed and new elements carrying their parent's state
+  /// as memory_from does. Cost: the changed elements (vectors grow geometrically).
+  void follow_edit(const MeshEdit& edit, std::vector<double>& memory);
+  /// Room for this many elements, so that following edits up to it never reallocates (a
+  /// reallocation copies every element: milliseconds at 12k). Reserve the memory alike with
+  /// memory_size_for().
+  void reserve_elements(std::size_t elements);
+  /// The memory a model of this many elements keeps (doubles).
+  std::size_t memory_size_for(std::size_t elements) const;
   /// The paper's 36 constants C = diag(1/L0) H of element e (the volume term excluded).
   Mat6 paper_constants(std::size_t e) const;
   /// H of element e (symmetric 6x6) as used by the model.
@@ -81,6 +110,15 @@ class GpsModel final : public ForceModel {
   std::size_t softening_offset() const { return (1 + mechanisms_) * 6 * kLanes; }
   std::size_t memory_stride() const { return (1 + mechanisms_ + (options_.mechanisms.softening.active() ? 2 : 0)) * 6 * kLanes; }
   Mat6 packed_hessian(std::size_t e) const;
+  /// H of a tet of material m with these rest positions, as the model uses it.
+  Mat6 calibrated_hessian(const std::array<Vec3, 4>& rest, std::size_t m) const;
+  std::size_t material_of(std::size_t e) const;
+  /// Writes block lane `slot` from the mesh (a padding lane past the last element: a copy of its
+  /// block's first element with H = 0).
+  void write_lane(std::size_t slot);
+  /// Element memory of a child (at `to`) from its parent's (at `in`): edge vectors through the
+  /// strain, extremes as the parent's largest. Strided by kLanes.
+  void carry_memory(const double* in, const std::array<Vec3, 4>& parent_rest, const Mat6& parent_h, double* to, std::size_t e) const;
   double edge_length(std::size_t e, int k) const;
 
   GpsOptions options_;
@@ -88,6 +126,9 @@ class GpsModel final : public ForceModel {
   std::vector<Block> blocks_;  ///< padding lanes have H = 0 and copy a real element
   std::vector<BulkBlock> bulk_;  ///< only when bulk and shear relax differently
   std::size_t mechanisms_ = 0;
+  std::vector<Mat6> materials_;
+  std::vector<std::uint16_t> material_of_tet_;  ///< empty: all material 0
+  std::vector<double> kappa_;  ///< signed-volume stiffness per material [Pa]
 };
 
 }  // namespace viscera::tissue

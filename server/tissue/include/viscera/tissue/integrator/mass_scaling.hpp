@@ -28,4 +28,10 @@ struct MassScaling {
 /// Deterministic. Throws std::invalid_argument for a fraction outside [0, 10].
 MassScaling scale_small_element_masses(const ForceModel& model, std::span<const double> density_kg_m3, double added_mass_fraction);
 
+/// Local mass scaling for the elements a cut made (docs/CUTTING.md): each of `elements` whose own
+/// critical step 2 / omega_e is below `min_step_s` gets the density that brings it there, so a
+/// cut never shortens the step the organ runs at. Returns the mass added [kg] (inertia only, as
+/// above).
+double hold_element_steps(const ForceModel& model, std::span<double> density_kg_m3, std::span<const std::int32_t> elements, double min_step_s);
+
 }  // namespace viscera::tissue

@@ -21,6 +21,8 @@ StableStep critical_time_step(const ForceModel& model, std::span<const double> d
 /// Each element's bound on its highest natural frequency [rad/s], sqrt(lambda_max(M_e^-1 K_e)) as
 /// in critical_time_step (whose undamped step is 2 / the largest of them).
 std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3);
+/// The same for one element of the given density.
+double element_frequency(const ForceModel& model, std::size_t e, double density_kg_m3);
 
 /// Estimate of the global critical step from the highest natural frequency of the free
 /// coordinates: power iteration on M^-1/2 K M^-1/2, K applied through central differences of the

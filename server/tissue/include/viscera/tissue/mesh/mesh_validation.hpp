@@ -25,4 +25,7 @@ struct MeshOrigin {
 /// by its number in the file and gives its line; without, its 0-based index in the mesh.
 void validate_mesh(const TetMesh& mesh, const MeshOrigin* origin = nullptr);
 
+/// Faces shared by more than two tetrahedra: 0 for a mesh of a solid (a cut mesh included).
+std::size_t overshared_faces(const TetMesh& mesh);
+
 }  // namespace viscera::tissue
