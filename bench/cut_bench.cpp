@@ -95,7 +95,7 @@ void BM_CutStroke(benchmark::State& state) {
       const CutChange c = cutter.cut(stroke.sweep(k), x, 0);
       const auto t1 = std::chrono::steady_clock::now();
       extend_nodal(c, x);
-      if (c.topology_changed()) model.follow_edit({c.tets_before, c.origin, c.replaced}, memory);
+      if (c.topology_changed()) model.follow_edit(c.edit(), memory);
       const auto t2 = std::chrono::steady_clock::now();
       topology.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
       total.push_back(std::chrono::duration<double, std::micro>(t2 - t0).count());

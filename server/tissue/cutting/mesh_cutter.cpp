@@ -13,9 +13,9 @@ namespace viscera::tissue {
 namespace {
 
 // The four faces of a tetrahedron, as vertex slots (orientation does not matter here).
-constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+constexpr int kTetFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
 
-bool holds(const Tet& t, std::int32_t n) { return t[0] == n || t[1] == n || t[2] == n || t[3] == n; }
+bool tet_holds(const Tet& t, std::int32_t n) { return t[0] == n || t[1] == n || t[2] == n || t[3] == n; }
 
 void replace_vertex(Tet& t, std::int32_t from, std::int32_t to) {
   for (auto& v : t)
@@ -88,7 +88,7 @@ std::vector<std::int32_t> MeshCutter::tets_with(std::span<const std::int32_t> no
   std::vector<std::int32_t> out;
   for (const std::int32_t e : node_tets_[static_cast<std::size_t>(nodes[0])]) {
     const Tet& t = mesh_.tets[static_cast<std::size_t>(e)];
-    if (std::all_of(nodes.begin() + 1, nodes.end(), [&](std::int32_t n) { return holds(t, n); })) out.push_back(e);
+    if (std::all_of(nodes.begin() + 1, nodes.end(), [&](std::int32_t n) { return tet_holds(t, n); })) out.push_back(e);
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -162,7 +162,7 @@ void MeshCutter::separate_faces(std::span<const std::int32_t> touched, std::int3
   std::vector<std::int32_t> check;  // tetrahedra on both sides of newly separated faces
   for (const std::int32_t e : tets) {
     const Tet& t = mesh_.tets[static_cast<std::size_t>(e)];
-    for (const auto& f : kFaces) {
+    for (const auto& f : kTetFaces) {
       const std::int32_t face[3] = {t[f[0]], t[f[1]], t[f[2]]};
       if (std::any_of(std::begin(face), std::end(face), [&](std::int32_t v) { return on_cut_[static_cast<std::size_t>(v)] != stroke; })) continue;
       // In the blade's surface, not across it: the two tetrahedra lie on opposite sides of the
@@ -188,7 +188,7 @@ void MeshCutter::separate_faces(std::span<const std::int32_t> touched, std::int3
     double nearest = std::numeric_limits<double>::infinity();
     FaceKey keep{};
     bool joined = false;
-    for (const auto& f : kFaces) {
+    for (const auto& f : kTetFaces) {
       const std::int32_t face[3] = {t[f[0]], t[f[1]], t[f[2]]};
       const std::vector<std::int32_t> pair = tets_with(face);
       if (pair.size() != 2) continue;  // the organ's surface
@@ -235,7 +235,7 @@ void MeshCutter::duplicate_if_apart(std::int32_t node, CutChange& change) {
       std::int32_t shared[4];
       int k = 0;
       for (const std::int32_t v : ti)
-        if (v != node && holds(tj, v)) shared[k++] = v;
+        if (v != node && tet_holds(tj, v)) shared[k++] = v;
       if (k != 2) continue;  // they share no face through the node
       if (separated_.count(face_key(node, shared[0], shared[1])) > 0) {
         separated_joints.push_back({i, j, shared[0], shared[1]});

@@ -11,7 +11,7 @@ namespace viscera::tissue {
 
 namespace {
 
-constexpr std::size_t L = GpsModel::kLanes;
+constexpr std::size_t kLane = GpsModel::kLanes;  // (L is gps_model.cpp's, in the same unity build)
 
 // dL = A eps (Voigt, engineering shear): row k is L0_k times n_k's quadratic form.
 Mat6 elongation_of_strain(const std::array<Vec3, 4>& rest) {
@@ -39,16 +39,16 @@ void GpsModel::carry_memory(const double* in, const std::array<Vec3, 4>& parent_
   }
   for (std::size_t v = 0; v < 1 + mechanisms_; ++v) {  // previous elongation (or tension), then zeta_l
     Vec6 q;
-    for (int k = 0; k < 6; ++k) q(k) = in[(v * 6 + static_cast<std::size_t>(k)) * L];
+    for (int k = 0; k < 6; ++k) q(k) = in[(v * 6 + static_cast<std::size_t>(k)) * kLane];
     const Vec6 r = map * q;
-    for (int k = 0; k < 6; ++k) to[(v * 6 + static_cast<std::size_t>(k)) * L] = r(k);
+    for (int k = 0; k < 6; ++k) to[(v * 6 + static_cast<std::size_t>(k)) * kLane] = r(k);
   }
   if (options_.mechanisms.softening.active())
     for (std::size_t sense = 0; sense < 2; ++sense) {
-      const std::size_t at = softening_offset() + sense * 6 * L;
+      const std::size_t at = softening_offset() + sense * 6 * kLane;
       double peak = 0.0;
-      for (std::size_t k = 0; k < 6; ++k) peak = std::max(peak, in[at + k * L]);
-      for (std::size_t k = 0; k < 6; ++k) to[at + k * L] = same ? in[at + k * L] : peak;
+      for (std::size_t k = 0; k < 6; ++k) peak = std::max(peak, in[at + k * kLane]);
+      for (std::size_t k = 0; k < 6; ++k) to[at + k * kLane] = same ? in[at + k * kLane] : peak;
     }
 }
 
@@ -62,24 +62,24 @@ std::vector<double> GpsModel::memory_from(const GpsModel& before, std::span<cons
   for (std::size_t e = 0; e < element_count(); ++e) {
     const auto p = static_cast<std::size_t>(origin[e]);
     if (p >= before.element_count()) throw std::invalid_argument("GpsModel::memory_from: origin names no element of the model before");
-    carry_memory(memory.data() + (p / L) * stride + p % L, before.gather(before.mesh_->nodes, p), before.packed_hessian(p),
-                 out.data() + (e / L) * stride + e % L, e);
+    carry_memory(memory.data() + (p / kLane) * stride + p % kLane, before.gather(before.mesh_->nodes, p), before.packed_hessian(p),
+                 out.data() + (e / kLane) * stride + e % kLane, e);
   }
   return out;
 }
 
 void GpsModel::reserve_elements(std::size_t elements) {
-  blocks_.reserve((elements + L - 1) / L);
-  if (!bulk_.empty()) bulk_.reserve((elements + L - 1) / L);
+  blocks_.reserve((elements + kLane - 1) / kLane);
+  if (!bulk_.empty()) bulk_.reserve((elements + kLane - 1) / kLane);
 }
 
 std::size_t GpsModel::memory_size_for(std::size_t elements) const {
-  return options_.mechanisms.has_memory() ? (elements + L - 1) / L * memory_stride() : 0;
+  return options_.mechanisms.has_memory() ? (elements + kLane - 1) / kLane * memory_stride() : 0;
 }
 
 void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
   const std::size_t n = element_count(), before = edit.elements_before;
-  if (edit.origin.size() != n || before > n || blocks_.size() != (before + L - 1) / L)
+  if (edit.origin.size() != n || before > n || blocks_.size() != (before + kLane - 1) / kLane)
     throw std::invalid_argument("GpsModel::follow_edit: the edit does not match the model and its mesh");
   const bool with_memory = options_.mechanisms.has_memory();
   if (with_memory && memory.size() != memory_size()) throw std::invalid_argument("GpsModel::follow_edit: memory of another layout");
@@ -102,7 +102,7 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
     parent_rest[i] = {X[tet[0]], X[tet[1]], X[tet[2]], X[tet[3]]};
     if (!with_memory) continue;
     parent_h[i] = calibrated_hessian(parent_rest[i], material_of(e));
-    for (std::size_t w = 0; w < stride / L; ++w) parent_memory[i * stride + w * L] = memory[(e / L) * stride + w * L + e % L];
+    for (std::size_t w = 0; w < stride / kLane; ++w) parent_memory[i * stride + w * kLane] = memory[(e / kLane) * stride + w * kLane + e % kLane];
   }
   std::vector<std::int32_t> changed;
   for (std::size_t e = 0; e < n; ++e) {
@@ -115,20 +115,20 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
   if (!material_of_tet_.empty())
     for (std::size_t e = before; e < n; ++e) material_of_tet_.push_back(material_of_tet_[static_cast<std::size_t>(edit.origin[e])]);
   // Grow the blocks, rewrite the changed lanes and the last block's padding.
-  blocks_.resize((n + L - 1) / L);
+  blocks_.resize((n + kLane - 1) / kLane);
   if (!bulk_.empty()) bulk_.resize(blocks_.size());
   for (const std::int32_t e : changed) write_lane(static_cast<std::size_t>(e));
-  for (std::size_t slot = n; slot < blocks_.size() * L; ++slot) write_lane(slot);
+  for (std::size_t slot = n; slot < blocks_.size() * kLane; ++slot) write_lane(slot);
   if (!with_memory) return;
   memory.resize(memory_size(), 0.0);
   for (const std::int32_t element : changed) {
     const auto e = static_cast<std::size_t>(element);
     const auto i = static_cast<std::size_t>(slot_of[static_cast<std::size_t>(edit.origin[e])]);
-    carry_memory(parent_memory.data() + i * stride, parent_rest[i], parent_h[i], memory.data() + (e / L) * stride + e % L, e);
+    carry_memory(parent_memory.data() + i * stride, parent_rest[i], parent_h[i], memory.data() + (e / kLane) * stride + e % kLane, e);
   }
   // Padding lanes: zero memory, as a new model's.
-  for (std::size_t slot = n; slot < blocks_.size() * L; ++slot)
-    for (std::size_t w = 0; w < stride / L; ++w) memory[(slot / L) * stride + w * L + slot % L] = 0.0;
+  for (std::size_t slot = n; slot < blocks_.size() * kLane; ++slot)
+    for (std::size_t w = 0; w < stride / kLane; ++w) memory[(slot / kLane) * stride + w * kLane + slot % kLane] = 0.0;
 }
 
 }  // namespace viscera::tissue

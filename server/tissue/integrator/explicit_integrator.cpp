@@ -16,22 +16,25 @@ ExplicitIntegrator::ExplicitIntegrator(const ForceModel& model, std::vector<doub
     : model_(model), bc_(std::move(bc)), options_(options) {
   if (!(options_.safety_factor > 0 && options_.safety_factor <= 1)) throw std::invalid_argument("ExplicitOptions.safety_factor must lie in (0, 1]");
   if (!(options_.mass_damping_per_s >= 0)) throw std::invalid_argument("ExplicitOptions.mass_damping_per_s must be >= 0");
-  const std::vector<double> weight = lumped_masses(model.rest_mesh(), density_kg_m3);
+  weight_ = lumped_masses(model.rest_mesh(), density_kg_m3);
+  density_ = density_kg_m3;
   if (options_.added_mass_fraction > 0) {
     scaling_ = scale_small_element_masses(model, density_kg_m3, options_.added_mass_fraction);
     mass_ = lumped_masses(model.rest_mesh(), scaling_.density_kg_m3);
   } else {
     scaling_.density_kg_m3 = std::move(density_kg_m3);
-    mass_ = weight;
+    mass_ = weight_;
   }
-  const auto mask = bc_.constrained_mask(mass_.size());
-  critical_ = options_.global_stable_step ? global_time_step(model, mass_, mask) : critical_time_step(model, scaling_.density_kg_m3);
+  constrained_ = bc_.constrained_mask(mass_.size());
+  critical_ = options_.global_stable_step ? global_time_step(model, mass_, constrained_) : critical_time_step(model, scaling_.density_kg_m3);
+  // With the global estimate the element bound is found when a first edit needs it (element_step_s).
+  if (!options_.global_stable_step) element_step_s_ = 2.0 / critical_.omega_max_rad_s;
   dt_ = options_.dt_s > 0 ? options_.dt_s : options_.safety_factor * critical_.dt_s;
   inv_mass_.resize(mass_.size());
   gravity_.resize(mass_.size());
   for (std::size_t i = 0; i < mass_.size(); ++i) {
-    for (int k = 0; k < 3; ++k) inv_mass_[i][k] = mask[3 * i + k] ? 0.0 : 1.0 / mass_[i];
-    gravity_[i] = weight[i] * bc_.gravity_m_s2;
+    for (int k = 0; k < 3; ++k) inv_mass_[i][k] = constrained_[3 * i + k] ? 0.0 : 1.0 / mass_[i];
+    gravity_[i] = weight_[i] * bc_.gravity_m_s2;
   }
   if (!bc_.nodal_forces.empty() && bc_.nodal_forces.size() != mass_.size())
     throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");
@@ -125,6 +128,99 @@ long ExplicitIntegrator::advance(State& state, double duration_s) {
     if (k < steps && interrupted_ && interrupted_()) return k;
   }
   return steps;
+}
+
+double ExplicitIntegrator::gravity_energy(std::span<const Vec3> x) const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < weight_.size(); ++i) e -= weight_[i] * bc_.gravity_m_s2.dot(x[i]);
+  return e;
+}
+
+double ExplicitIntegrator::follow_edit(const MeshEdit& edit, State& state) {
+  const std::size_t nodes = model_.node_count(), elements = model_.element_count();
+  if (edit.nodes_before != mass_.size() || edit.nodes_before + edit.new_nodes.size() != nodes || edit.elements_before != density_.size() ||
+      edit.origin.size() != elements || state.x.size() != edit.nodes_before || state.v.size() != edit.nodes_before)
+    throw std::invalid_argument("ExplicitIntegrator::follow_edit: the edit does not match the integrator, its model or the state");
+  const auto& X = model_.rest_mesh().nodes;
+  const auto& tets = model_.rest_mesh().tets;
+  if (!(element_step_s_ > 0.0)) {  // the organ's element bound, from the elements the edit left alone
+    std::vector<char> left_alone(edit.elements_before, 1);
+    for (const auto& replaced_element : edit.replaced) left_alone[static_cast<std::size_t>(replaced_element.first)] = 0;
+    double omega = 0.0;
+    for (std::size_t e = 0; e < edit.elements_before; ++e)
+      if (left_alone[e]) omega = std::max(omega, element_frequency(model_, e, scaling_.density_kg_m3[e]));
+    element_step_s_ = 2.0 / omega;
+  }
+  // New nodes: state, flags and empty masses.
+  mass_.resize(nodes, 0.0);
+  weight_.resize(nodes, 0.0);
+  constrained_.resize(3 * nodes, 0);
+  for (std::size_t k = 0; k < edit.new_nodes.size(); ++k) {
+    const MeshEdit::NewNode& n = edit.new_nodes[k];
+    const auto a = static_cast<std::size_t>(n.a), b = static_cast<std::size_t>(n.b), i = edit.nodes_before + k;
+    state.x.push_back((1.0 - n.t) * state.x[a] + n.t * state.x[b]);
+    state.v.push_back((1.0 - n.t) * state.v[a] + n.t * state.v[b]);
+    bool fixed = false;
+    for (int c = 0; c < 3; ++c) {
+      constrained_[3 * i + static_cast<std::size_t>(c)] =
+          constrained_[3 * a + static_cast<std::size_t>(c)] && constrained_[3 * b + static_cast<std::size_t>(c)];
+      fixed = fixed || constrained_[3 * i + static_cast<std::size_t>(c)] != 0;
+    }
+    if (fixed) bc_.fixed_nodes.push_back(static_cast<std::int32_t>(i));
+    if (!bc_.nodal_forces.empty()) bc_.nodal_forces.push_back(Vec3::Zero());
+  }
+  // Lumped masses: the replaced elements' shares off, the changed and new elements' on.
+  std::vector<double>& inertia = scaling_.density_kg_m3;
+  const auto share = [&](const Tet& t, double density) { return 0.25 * density * signed_volume(X[t[0]], X[t[1]], X[t[2]], X[t[3]]); };
+  std::vector<char> replaced(edit.elements_before, 0);
+  for (const auto& [e, t] : edit.replaced) {
+    replaced[static_cast<std::size_t>(e)] = 1;
+    const double w = share(t, density_[static_cast<std::size_t>(e)]), m = share(t, inertia[static_cast<std::size_t>(e)]);
+    for (const std::int32_t v : t) {
+      weight_[static_cast<std::size_t>(v)] -= w;
+      mass_[static_cast<std::size_t>(v)] -= m;
+    }
+  }
+  std::vector<std::int32_t> changed;
+  for (std::size_t e = 0; e < elements; ++e)
+    if (e >= edit.elements_before || replaced[e]) changed.push_back(static_cast<std::int32_t>(e));
+  for (std::size_t e = edit.elements_before; e < elements; ++e) {
+    const auto p = static_cast<std::size_t>(edit.origin[e]);
+    density_.push_back(density_[p]);
+    inertia.push_back(inertia[p]);
+  }
+  // Local mass scaling: every changed element's own step back to the organ's element step.
+  std::vector<double> unscaled(changed.size());
+  for (std::size_t k = 0; k < changed.size(); ++k) unscaled[k] = inertia[static_cast<std::size_t>(changed[k])];
+  const double added = hold_element_steps(model_, inertia, changed, element_step_s_);
+  std::vector<double> grown(nodes, 0.0);  // inertia added per node
+  for (std::size_t k = 0; k < changed.size(); ++k) {
+    const auto e = static_cast<std::size_t>(changed[k]);
+    const Tet& t = tets[e];
+    const double w = share(t, density_[e]), m = share(t, inertia[e]), m0 = share(t, unscaled[k]);
+    for (const std::int32_t v : t) {
+      weight_[static_cast<std::size_t>(v)] += w;
+      mass_[static_cast<std::size_t>(v)] += m;
+      grown[static_cast<std::size_t>(v)] += m - m0;
+    }
+  }
+  // Momentum kept where inertia was added; the touched nodes' gravity and inverse masses.
+  gravity_.resize(nodes);
+  inv_mass_.resize(nodes);
+  for (const std::int32_t element : changed)
+    for (const std::int32_t v : tets[static_cast<std::size_t>(element)]) {
+      const auto i = static_cast<std::size_t>(v);
+      gravity_[i] = weight_[i] * bc_.gravity_m_s2;
+      for (int c = 0; c < 3; ++c) inv_mass_[i][c] = constrained_[3 * i + static_cast<std::size_t>(c)] ? 0.0 : 1.0 / mass_[i];
+    }
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (grown[i] > 0.0) state.v[i] *= (mass_[i] - grown[i]) / mass_[i];
+  force_.resize(nodes);
+  field_stiffness_.resize(nodes);
+  field_damping_.resize(nodes);
+  x_prev_.clear();  // no roll-back across an edit
+  v_prev_.clear();
+  return added;
 }
 
 double ExplicitIntegrator::kinetic_energy(const State& state) const {

@@ -25,6 +25,7 @@
 
 #include "viscera/tissue/cutting/blade_sweep.hpp"
 #include "viscera/tissue/mesh/tet_mesh.hpp"
+#include "viscera/tissue/model/force_model.hpp"
 
 namespace viscera::tissue {
 
@@ -37,12 +38,8 @@ struct CutOptions {
 /// What one sweep changed, for the caller to bring positions, velocities, fixed nodes, masses and
 /// the force model along. The mesh's rest positions and tetrahedra are already changed.
 struct CutChange {
-  /// Node `first_new_node + i`: x = (1 - t) x[a] + t x[b] (t = 0 and a = b for a copy), in the
-  /// order given, so that a node may be made from one made before it in the same change.
-  struct NewNode {
-    std::int32_t a = 0, b = 0;
-    double t = 0.0;
-  };
+  /// Node `first_new_node + i`, in the order made (a node may be made from one before it).
+  using NewNode = MeshEdit::NewNode;
   std::size_t first_new_node = 0;
   std::vector<NewNode> new_nodes;
   /// For every tetrahedron of the mesh after the change, the one of the mesh before it comes from
@@ -58,6 +55,8 @@ struct CutChange {
   std::size_t kept_joined = 0;  ///< tetrahedra that every face would have cut free, kept joined by one
 
   bool topology_changed() const { return !new_nodes.empty() || origin.size() != tets_before || separated_faces > 0; }
+  /// The change as the force model and the integrator follow it (views into this change).
+  MeshEdit edit() const { return {first_new_node, tets_before, new_nodes, origin, replaced}; }
 };
 
 /// Per-node values at a change's new nodes, interpolated along their edge (positions,

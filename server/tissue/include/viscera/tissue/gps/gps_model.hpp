@@ -11,7 +11,6 @@
 // modulus): restores inverted elements, which the edge lengths alone cannot see. H is calibrated
 // with the term's small-strain stiffness removed, so the sum still equals linear FE there.
 #include <memory>
-#include <utility>
 #include <vector>
 
 #include "viscera/tissue/gps/gps_mechanisms.hpp"
@@ -55,15 +54,6 @@ class GpsModel final : public ForceModel {
   /// child's first-load extremes are the largest of its parent's, in each sense.
   std::vector<double> memory_from(const GpsModel& before, std::span<const double> memory, std::span<const std::int32_t> origin) const;
 
-  /// What changed in the mesh a model was built on, when it is edited in place (cutting): nodes
-  /// and elements appended, some elements given new vertices. Nodes never move.
-  struct MeshEdit {
-    std::size_t elements_before = 0;
-    /// Per element after the edit, the element before it that it comes from (itself if unchanged).
-    std::span<const std::int32_t> origin;
-    /// Every element before the edit whose vertices changed, with its vertices before.
-    std::span<const std::pair<std::int32_t, Tet>> replaced;
-  };
   /// Follows an edit of the mesh this model holds (done by its owner, e.g. a MeshCutter on the
   /// same TetMesh): the changed and the new elements are calibrated from their own rest shapes
   /// with their parent's material, the others stay bit for bit. `memory` (State::memory) is

@@ -61,6 +61,21 @@ class ExplicitIntegrator {
   BoundaryConditions& boundary_conditions() { return bc_; }
   /// Kinetic energy [J] of a state.
   double kinetic_energy(const State& state) const;
+  /// Potential energy of the weights [J] at positions x (zero at the origin), -sum m_i g.x_i.
+  double gravity_energy(std::span<const Vec3> x) const;
+
+  /// Follows an edit of the organ's mesh (a cut), after the model followed it
+  /// (GpsModel::follow_edit): `state` gains the new nodes, their positions and velocities
+  /// interpolated as the nodes were. New elements take their parent's density. A new node is
+  /// fixed when it lies between fixed nodes, or copies one. Each changed element whose own step
+  /// falls below the organ's element step gets the density that brings it back (local mass
+  /// scaling, docs/CUTTING.md), so dt_s() stays valid; a node whose inertia that raises keeps its
+  /// momentum, so the edit adds no kinetic energy. Lumped masses change only where elements did.
+  /// Returns the inertia added [kg]. Prescribed motions and nodal forces do not reach new nodes.
+  double follow_edit(const MeshEdit& edit, State& state);
+  /// Every element's own critical step is at least this [s] (kept so through edits). With the
+  /// global step estimate it is found at the first edit (0 before).
+  double element_step_s() const { return element_step_s_; }
 
  private:
   void step_with(State& state, double dt);
@@ -69,6 +84,9 @@ class ExplicitIntegrator {
   BoundaryConditions bc_;
   ExplicitOptions options_;
   std::vector<double> mass_;
+  std::vector<double> density_;  // per element, as given (the weight's)
+  std::vector<double> weight_;  // lumped mass of density_ per node (what gravity pulls)
+  std::vector<char> constrained_;  // per coordinate
   std::vector<Vec3> inv_mass_;  // per coordinate; 0 where constrained
   std::vector<Vec3> gravity_;  // m g per node
   ForceEvaluation evaluate_;
@@ -80,6 +98,7 @@ class ExplicitIntegrator {
   std::vector<double> field_stiffness_, field_damping_;
   double t_prev_ = 0.0;
   double max_edge_strain_ = 0.0;
+  double element_step_s_ = 0.0;
 };
 
 }  // namespace viscera::tissue

@@ -5,6 +5,7 @@
 #include <memory>
 #include <span>
 #include <string_view>
+#include <utility>
 
 #include "viscera/tissue/element/tet_geometry.hpp"
 #include "viscera/tissue/mesh/tet_mesh.hpp"
@@ -25,6 +26,23 @@ struct MemoryUpdate {
 /// (NaN if any was NaN). The explicit integrator uses it to detect instability cheaply.
 struct ForceStats {
   double max_edge_strain = 0.0;
+};
+
+/// A mesh edited in place (cutting, docs/CUTTING.md): nodes and elements appended, some elements
+/// given new vertices; no node moves. What a model and an integrator need to follow it.
+struct MeshEdit {
+  /// A new node at (1 - t) x[a] + t x[b] (t = 0 and a = b for a copy of a), possibly of a node
+  /// made before it in the same edit.
+  struct NewNode {
+    std::int32_t a = 0, b = 0;
+    double t = 0.0;
+  };
+  std::size_t nodes_before = 0, elements_before = 0;
+  std::span<const NewNode> new_nodes;  ///< nodes nodes_before, nodes_before + 1, ...
+  /// Per element after the edit, the element before it that it comes from (itself if unchanged).
+  std::span<const std::int32_t> origin;
+  /// Every element before the edit whose vertices changed, with its vertices before.
+  std::span<const std::pair<std::int32_t, Tet>> replaced;
 };
 
 /// Part `index` of `count` of a model's elements, for evaluating forces on several threads: the
