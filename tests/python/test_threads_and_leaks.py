@@ -32,7 +32,10 @@ def test_a_python_thread_runs_while_the_main_thread_waits(domain: int) -> None:
     worker.start()
     assert client.wait_for_scene(2.0) is None
     worker.join()
-    assert rates[0] >= 0.9 * solo, f"background thread at {rates[0] / solo:.0%} of its solo rate"
+    # Were the lock held while waiting, the worker would count nothing for the 1.5 s it runs (the
+    # wait lasts 2 s). Released, it runs at its solo rate less what the DDS client's own threads
+    # take of the two cores: 82% was seen on a busy CI machine, so half is the line.
+    assert rates[0] >= 0.5 * solo, f"background thread at {rates[0] / solo:.0%} of its solo rate"
 
 
 LEAK_LOOP = """
