@@ -21,10 +21,14 @@
 #include "viscera/tissue/mesh/box_mesh.hpp"
 #include "viscera/tissue/mesh/mesh_validation.hpp"
 
+#include "cutting_support.hpp"
 #include "test_support.hpp"
 
 using namespace viscera::tissue;
 namespace test = viscera::tissue::test;
+using test::expect_valid_conforming;
+using test::node_connected_components;
+using test::total;
 
 namespace {
 
@@ -45,37 +49,11 @@ std::vector<CutChange> draw_blade(MeshCutter& cutter, double xc, double y0, doub
   return changes;
 }
 
-// Groups of tetrahedra connected through shared nodes.
-std::vector<int> node_connected_components(const TetMesh& m, int* count) {
-  std::vector<int> parent(m.nodes.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&](int i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  for (const Tet& t : m.tets)
-    for (int k = 1; k < 4; ++k) parent[root(t[k])] = root(t[0]);
-  std::vector<int> comp(m.tets.size());
-  std::map<int, int> ids;
-  for (std::size_t e = 0; e < m.tets.size(); ++e) comp[e] = ids.emplace(root(m.tets[e][0]), static_cast<int>(ids.size())).first->second;
-  *count = static_cast<int>(ids.size());
-  return comp;
-}
-
-// Every face is shared by at most two tetrahedra, and the mesh is valid (positive volumes, no
-// unused node, no duplicate tetrahedron).
-void expect_valid_conforming(const TetMesh& m) {
-  ASSERT_NO_THROW(validate_mesh(m));
-  ASSERT_EQ(overshared_faces(m), 0u);
-}
-
 double surface_area(const TetMesh& m) {
   double a = 0.0;
   for (const Triangle& t : extract_boundary(m).triangles) a += 0.5 * (m.nodes[t[1]] - m.nodes[t[0]]).cross(m.nodes[t[2]] - m.nodes[t[0]]).norm();
   return a;
 }
-
-double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
 
 }  // namespace
 
@@ -417,121 +395,4 @@ TEST(Cutting, AnOrganCutWhileItSwingsKeepsItsMassAndMomentumAndGainsNoEnergy) {
   for (const Vec3& x : st.x) ASSERT_TRUE(x.allFinite());
   std::cout << "[ figure ] a swinging bar cut through in " << cuts << " sweeps: energy change at a cut at most " << worst_rise
             << " of its kinetic + elastic energy; inertia added to hold the step " << added * 1e3 << " g (the bar: 40 g)\n";
-}
-
-TEST(CuttingFuzz, RandomStrokesThroughTheLiverKeepEveryInvariant) {
-  // Strokes of random blades (position, orientation, length, direction, a curve out of the
-  // blade's plane) through the liver deformed by a random affine map: after every sweep the mesh
-  // is valid and conforming, volume and mass are those of the organ before, and every new
-  // element's quality and own stable step are measured against the organ's worst.
-  const auto liver = test::liver2();
-  const Box box = bounding_box(*liver);
-  const double size = (box.hi - box.lo).norm();
-  const Mat6 D = test::soft_tissue();
-  const double density = 1000.0;
-  const GpsModel original_model(liver, {D});
-  const std::vector<double> rho0(liver->tet_count(), density);
-  const double worst_step_before = critical_time_step(original_model, rho0).dt_s;
-  double worst_quality_before = 1.0;
-  for (const Tet& t : liver->tets)
-    worst_quality_before =
-        std::min(worst_quality_before, tet_quality(liver->nodes[t[0]], liver->nodes[t[1]], liver->nodes[t[2]], liver->nodes[t[3]]));
-  std::mt19937_64 rng(2026);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::normal_distribution<double> n;
-  const int organs = 12, strokes_per_organ = 4, sweeps_per_stroke = 40;
-  std::size_t sweeps = 0, splits = 0, copies = 0, snapped = 0, kept = 0;
-  double worst_quality = 1.0, worst_step = 1e9, worst_added = 0.0;
-  int max_pieces = 1, smallest_piece = 1 << 30;
-  for (int organ = 0; organ < organs; ++organ) {
-    TetMesh m = *liver;
-    const double volume0 = mesh_volume(m), mass0 = total(lumped_masses(m, density));
-    Mat3 F = Mat3::Identity();
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) F(i, j) += 0.1 * n(rng);
-    MeshCutter cutter(m);
-    for (int stroke = 0; stroke < strokes_per_organ; ++stroke) {
-      const Vec3 centre = box.lo + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(box.hi - box.lo);
-      const Vec3 axis = Vec3(n(rng), n(rng), n(rng)).normalized();
-      Vec3 travel = Vec3(n(rng), n(rng), n(rng));
-      travel = (travel - travel.dot(axis) * axis).normalized();  // in the blade's plane...
-      const Vec3 bend = axis.cross(travel) * 0.3 * n(rng);  // ...bent out of it along the stroke
-      const double length = size * (0.1 + 0.6 * u(rng)), reach = size * (0.2 + 0.6 * u(rng));
-      const auto blade = [&](double t) {
-        const Vec3 mid = centre + (t - 0.5) * reach * travel + (t - 0.5) * (t - 0.5) * reach * bend;
-        return std::pair<Vec3, Vec3>{mid - 0.5 * length * axis, mid + 0.5 * length * axis};
-      };
-      for (int k = 0; k < sweeps_per_stroke; ++k) {
-        const auto [a0, b0] = blade(static_cast<double>(k) / sweeps_per_stroke);
-        const auto [a1, b1] = blade(static_cast<double>(k + 1) / sweeps_per_stroke);
-        std::vector<Vec3> x = m.nodes;
-        for (auto& p : x) p = F * p;
-        const std::size_t tets_before = m.tets.size();
-        const CutChange c = cutter.cut({F * a0, F * b0, F * a1, F * b1}, x, stroke);
-        ++sweeps;
-        splits += c.split_edges;
-        copies += c.duplicated_nodes;
-        snapped += c.snapped_nodes;
-        kept += c.kept_joined;
-        ASSERT_EQ(c.origin.size(), m.tets.size());
-        ASSERT_EQ(c.first_new_node + c.new_nodes.size(), m.nodes.size());
-        extend_nodal(c, x);
-        for (std::size_t i = c.first_new_node; i < x.size(); ++i) {
-          ASSERT_TRUE(x[i].allFinite());
-          ASSERT_LT((x[i] - F * m.nodes[i]).norm(), 1e-12 * size) << "a new node's position is not its rest position mapped";
-        }
-        for (std::size_t e = 0; e < m.tets.size(); ++e) {
-          if (c.origin[e] == static_cast<std::int32_t>(e) && e < tets_before) continue;
-          const Tet& t = m.tets[e];
-          worst_quality = std::min(worst_quality, tet_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]));
-        }
-        if (!c.topology_changed()) continue;
-        expect_valid_conforming(m);
-        if (HasFatalFailure()) return;
-        ASSERT_NEAR(mesh_volume(m), volume0, 1e-9 * volume0);
-        ASSERT_NEAR(total(lumped_masses(m, density)), mass0, 1e-12 * mass0);
-      }
-    }
-    int pieces = 0;
-    const auto comp = node_connected_components(m, &pieces);
-    max_pieces = std::max(max_pieces, pieces);
-    std::vector<int> piece_tets(static_cast<std::size_t>(pieces), 0);
-    for (const int c : comp) ++piece_tets[static_cast<std::size_t>(c)];
-    for (const int k : piece_tets) smallest_piece = std::min(smallest_piece, k);
-    const auto mesh = std::make_shared<TetMesh>(m);
-    const GpsModel cut_model(mesh, {D});
-    std::vector<double> rho(m.tet_count(), density);
-    worst_step = std::min(worst_step, critical_time_step(cut_model, rho).dt_s);
-    // The rule that keeps the step: local mass scaling of the new elements to the organ's step.
-    std::vector<std::int32_t> made;
-    for (std::size_t e = 0; e < m.tet_count(); ++e)
-      if (e >= liver->tet_count() || m.tets[e] != liver->tets[e]) made.push_back(static_cast<std::int32_t>(e));
-    const double added = hold_element_steps(cut_model, rho, made, worst_step_before);
-    worst_added = std::max(worst_added, added / total(lumped_masses(m, density)));
-    EXPECT_GE(critical_time_step(cut_model, rho).dt_s, worst_step_before * (1 - 1e-12));
-    std::vector<Vec3> x = m.nodes, f(x.size(), Vec3::Zero());
-    for (auto& p : x) p = F * p;
-    cut_model.add_forces(x, f);
-    for (const Vec3& fi : f) ASSERT_TRUE(fi.allFinite());
-    // Both integrators run the cut organ hanging from its top under gravity (free pieces fall).
-    BoundaryConditions bc;
-    bc.gravity_m_s2 = Vec3(0, 0, -9.81);
-    bc.fixed_nodes = nodes_in_box(m, Box{Vec3(-1, -1, box.hi.z() - 0.02), Vec3(1, 1, 1)});
-    ExplicitIntegrator explicit_path(cut_model, rho, bc);
-    State st = State::at_rest(m);
-    for (int i = 0; i < 20; ++i) ASSERT_NO_THROW(explicit_path.step(st));
-    ImplicitOptions io;
-    io.dt_s = 1e-3;
-    ImplicitIntegrator implicit_path(cut_model, rho, bc, io);
-    for (int i = 0; i < 2; ++i) ASSERT_NO_THROW(implicit_path.step(st));
-    for (const Vec3& p : st.x) ASSERT_TRUE(p.allFinite());
-  }
-  EXPECT_GT(splits, 1000u);
-  EXPECT_GT(copies, 100u);
-  EXPECT_GT(max_pieces, 1);
-  std::cout << "[ figure ] fuzz: " << sweeps << " sweeps in " << organs * strokes_per_organ << " strokes, " << splits << " edges split, " << snapped
-            << " nodes snapped, " << copies << " copies, " << kept << " tetrahedra kept joined, up to " << max_pieces
-            << " pieces (smallest: " << smallest_piece << " tets); worst new element quality " << worst_quality << " (organ's worst "
-            << worst_quality_before << "), worst element step " << worst_step * 1e3 << " ms (organ's " << worst_step_before * 1e3
-            << " ms); held there by adding at most " << worst_added * 100 << "% of the organ's mass to new elements\n";
 }
