@@ -48,6 +48,8 @@ const char* event_name(EventKind k) {
     case EventKind::material_changed: return "material_changed";
     case EventKind::physics_rate_changed: return "physics_rate_changed";
     case EventKind::request_refused: return "request_refused";
+    case EventKind::cut_started: return "cut_started";
+    case EventKind::cut_ended: return "cut_ended";
   }
   return "unknown";
 }

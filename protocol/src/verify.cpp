@@ -86,8 +86,11 @@ std::vector<std::uint8_t> encode(const Scene& s) {
   flatbuffers::FlatBufferBuilder b(512);
   std::vector<flatbuffers::Offset<fb::InstrumentState>> inst;
   for (const auto& i : s.instruments)
-    inst.push_back(fb::CreateInstrumentState(b, i.instrument_id, i.grasper ? fb::InstrumentKind::grasper : fb::InstrumentKind::probe, i.tip_radius_m,
-                                             i.owner_client_id));
+    inst.push_back(fb::CreateInstrumentState(b, i.instrument_id,
+                                             i.scalpel   ? fb::InstrumentKind::scalpel
+                                             : i.grasper ? fb::InstrumentKind::grasper
+                                                         : fb::InstrumentKind::probe,
+                                             i.tip_radius_m, i.owner_client_id, i.blade_length_m));
   const auto name = b.CreateString(s.name);
   const auto list = b.CreateVector(inst);
   const fb::Vec3 lo = to_fb(s.bounds_min), hi = to_fb(s.bounds_max);
@@ -125,14 +128,15 @@ std::vector<std::uint8_t> encode(const SurfaceTopology& t) {
   const auto name = b.CreateString(t.organ_name);
   const auto tris = b.CreateVector(t.triangles);
   const auto rest = b.CreateVector(t.rest_positions);
-  b.Finish(fb::CreateSurfaceTopology(b, t.mesh_id, name, t.vertex_count, tris, rest), fb::SurfaceTopologyIdentifier());
+  b.Finish(fb::CreateSurfaceTopology(b, t.mesh_id, name, t.vertex_count, tris, rest, t.topology_generation), fb::SurfaceTopologyIdentifier());
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
 
 std::vector<std::uint8_t> encode(const MeshFrame& m) {
   flatbuffers::FlatBufferBuilder b(64 + 4 * m.positions.size());
   const auto positions = b.CreateVector(m.positions);
-  b.Finish(fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions, m.tick), fb::MeshFrameIdentifier());
+  b.Finish(fb::CreateMeshFrame(b, m.mesh_id, m.frame, m.sim_time_s, m.server_stamp_ns, positions, m.tick, m.topology_generation),
+           fb::MeshFrameIdentifier());
   return {b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize()};
 }
 
@@ -298,7 +302,8 @@ std::optional<Scene> decode_scene(std::span<const std::uint8_t> bytes, std::stri
   s.paused = m->paused();
   if (m->instruments())
     for (const auto* i : *m->instruments())
-      s.instruments.push_back({i->instrument_id(), i->kind() == fb::InstrumentKind::grasper, i->tip_radius_m(), i->owner_client_id()});
+      s.instruments.push_back({i->instrument_id(), i->kind() == fb::InstrumentKind::grasper, i->tip_radius_m(), i->owner_client_id(),
+                               i->kind() == fb::InstrumentKind::scalpel, i->blade_length_m()});
   s.bounds_min = from_fb(m->organ_bounds_min());
   s.bounds_max = from_fb(m->organ_bounds_max());
   s.generation = m->generation();
@@ -425,6 +430,7 @@ std::optional<SurfaceTopology> decode_surface_topology(std::span<const std::uint
     }
   t.triangles.assign(m->triangles()->begin(), m->triangles()->end());
   t.rest_positions.assign(m->rest_positions()->begin(), m->rest_positions()->end());
+  t.topology_generation = m->topology_generation();
   return t;
 }
 
@@ -436,7 +442,13 @@ std::optional<MeshFrame> decode_mesh_frame(std::span<const std::uint8_t> bytes, 
     *why = "sim_time_s not finite or negative";
     return std::nullopt;
   }
-  return MeshFrame{m->mesh_id(), m->frame(), m->sim_time_s(), m->server_stamp_ns(), {m->positions()->begin(), m->positions()->end()}, m->tick()};
+  return MeshFrame{m->mesh_id(),
+                   m->frame(),
+                   m->sim_time_s(),
+                   m->server_stamp_ns(),
+                   {m->positions()->begin(), m->positions()->end()},
+                   m->tick(),
+                   m->topology_generation()};
 }
 
 std::optional<Event> decode_event(std::span<const std::uint8_t> bytes, std::string* why) {

@@ -16,7 +16,7 @@ std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance&
   const double k_penalty = r.normal.dot(penalty * r.normal);
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
   for (int k = 0; k < 3; ++k) {
-    const auto block = wait ? std::optional<Eigen::Matrix3d>(compliance.wait_node(r.deepest_triangle[k])) : compliance.node(r.deepest_triangle[k]);
+    const auto block = wait ? compliance.wait_node(r.deepest_triangle[k]) : compliance.node(r.deepest_triangle[k]);
     if (!block) return r.stiffness;
     C += r.deepest_weights[k] * *block;
   }
@@ -46,10 +46,18 @@ protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, 
   return f;
 }
 
-void CommandResponder::set_instruments(const std::vector<InstrumentSpec>& instruments, const std::vector<tissue::Triangle>& surface,
-                                       std::span<const Vec3> rest, double contact_stiffness_n_per_m) {
+void CommandResponder::set_instruments(const std::vector<InstrumentSpec>& instruments, const std::shared_ptr<const ContactSurface>& surface,
+                                       double contact_stiffness_n_per_m) {
   queries_.clear();
-  for (const auto& s : instruments) queries_[s.id] = std::make_unique<ProbeContact>(surface, rest, s.tip_radius_m, contact_stiffness_n_per_m);
+  scalpels_.clear();
+  for (const auto& s : instruments) {
+    queries_[s.id] = std::make_unique<ProbeContact>(surface, s.tip_radius_m, contact_stiffness_n_per_m);
+    if (s.kind == InstrumentKind::scalpel) scalpels_.insert(s.id);
+  }
+}
+
+void CommandResponder::set_surface(const std::shared_ptr<const ContactSurface>& surface) {
+  for (auto& [id, q] : queries_) q->set_surface(surface);
 }
 
 void CommandResponder::publish(std::shared_ptr<const Snapshot> snapshot) {
@@ -67,6 +75,7 @@ ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protoc
   if (tick) *tick = snap->tick;
   if (max_edge_strain) *max_edge_strain = snap->max_edge_strain;
   const Vec3 tip(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
+  if (scalpels_.contains(instrument_id) && (c.buttons & kCutButton) != 0) return {};  // cutting: the blade passes through
   ContactResult result = queries_.at(instrument_id)->query(tip, snap->x);
   if (const auto g = snap->grasped.find(instrument_id); g != snap->grasped.end() && !g->second.empty()) {
     const Eigen::Quaterniond q = Eigen::Quaterniond(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]).normalized();

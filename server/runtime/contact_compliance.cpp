@@ -29,6 +29,7 @@ ContactCompliance::~ContactCompliance() {
 
 std::optional<Eigen::Matrix3d> ContactCompliance::node(std::int32_t n) {
   const auto i = static_cast<std::size_t>(n);
+  if (i >= blocks_.size()) return std::nullopt;  // a node a cut made: not in the factorised organ
   if (state_[i].load(std::memory_order_acquire) == 2) return blocks_[i];
   std::uint8_t unknown = 0;
   if (factorised_.load() >= 0 && state_[i].compare_exchange_strong(unknown, 1)) {
@@ -44,7 +45,13 @@ std::optional<Eigen::Matrix3d> ContactCompliance::node(std::int32_t n) {
   return std::nullopt;
 }
 
-Eigen::Matrix3d ContactCompliance::wait_node(std::int32_t n) {
+void ContactCompliance::wait_settled() {
+  std::unique_lock lock(mutex_);
+  done_cv_.wait(lock, [this] { return factorised_.load() != 0; });
+}
+
+std::optional<Eigen::Matrix3d> ContactCompliance::wait_node(std::int32_t n) {
+  if (static_cast<std::size_t>(n) >= blocks_.size()) return std::nullopt;  // as node() answers it
   for (;;) {
     if (auto b = node(n)) return *b;
     if (factorised_.load() < 0) throw std::runtime_error("the organ's rest stiffness could not be factorised");
@@ -68,7 +75,9 @@ void ContactCompliance::work(const ForceModel& model, std::vector<double> densit
   ImplicitIntegrator system(model, std::move(density), std::move(bc), ImplicitOptions{1e-3});
   {
     std::lock_guard blas(g_blas_mutex);
-    factorised_ = system.factorize_stiffness(rest) ? 1 : -1;
+    const int outcome = system.factorize_stiffness(rest) ? 1 : -1;
+    std::lock_guard lock(mutex_);  // wait_settled() must not miss the notification
+    factorised_ = outcome;
   }
   done_cv_.notify_all();
   if (factorised_ < 0) return;

@@ -132,7 +132,9 @@ std::optional<std::uint32_t> InstrumentTable::owner(std::uint32_t instrument_id)
 std::vector<protocol::InstrumentInfo> InstrumentTable::describe() const {
   std::lock_guard lock(mutex_);
   std::vector<protocol::InstrumentInfo> out;
-  for (const auto& s : specs_) out.push_back({s.id, s.kind == InstrumentKind::grasper, s.tip_radius_m, entries_.at(s.id).owner});
+  for (const auto& s : specs_)
+    out.push_back({s.id, s.kind == InstrumentKind::grasper, s.tip_radius_m, entries_.at(s.id).owner, s.kind == InstrumentKind::scalpel,
+                   s.kind == InstrumentKind::scalpel ? s.blade_length_m : 0.0});
   return out;
 }
 

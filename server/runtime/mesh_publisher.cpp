@@ -41,7 +41,9 @@ void MeshPublisher::offer(std::span<const tissue::Vec3> x, double sim_time_s, st
     return;
   }
   if (ready_) ++skipped_;  // the previous snapshot was never taken: the newer one replaces it
+  pending_.positions.resize(3 * nodes_.size());
   copy_surface(x, nodes_, pending_.positions.data());
+  pending_.topology_generation = topology_generation_;
   pending_.frame = ++offered_;
   pending_.tick = tick;
   pending_.sim_time_s = sim_time_s;
@@ -49,6 +51,19 @@ void MeshPublisher::offer(std::span<const tissue::Vec3> x, double sim_time_s, st
   ready_ = true;
   lock.unlock();
   ready_cv_.notify_one();
+}
+
+void MeshPublisher::change_topology(proto::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes) {
+  std::lock_guard lock(mutex_);  // the publisher holds it only to swap buffers
+  topology_generation_ = topology.topology_generation;
+  nodes_ = std::move(surface_nodes);
+  pending_topology_ = std::move(topology);
+  ready_ = false;  // a frame of the old surface not yet taken is dropped: it must not follow the new topology
+}
+
+std::uint64_t MeshPublisher::topologies_published() const {
+  std::lock_guard lock(mutex_);
+  return topologies_;
 }
 
 std::uint64_t MeshPublisher::frames_published() const {
@@ -61,14 +76,28 @@ void MeshPublisher::publish_loop() {
   frame.mesh_id = mesh_id_;
   frame.positions.resize(pending_.positions.size());
   for (;;) {
+    std::optional<proto::SurfaceTopology> topology;
     {
       std::unique_lock lock(mutex_);
       ready_cv_.wait(lock, [this] { return ready_ || stop_; });
       if (stop_) return;
       std::swap(frame, pending_);  // O(1): the physics thread fills the other buffer next time
       ready_ = false;
+      topology.swap(pending_topology_);
     }
     try {
+      if (topology) {
+        // Reliable: a topology that cannot be written is written again before the next frame.
+        try {
+          stream_->write_topology(mesh_id_, proto::encode(*topology));
+        } catch (const proto::DdsError&) {
+          std::lock_guard lock(mutex_);
+          if (!pending_topology_) pending_topology_ = std::move(topology);
+          continue;
+        }
+        std::lock_guard lock(mutex_);
+        ++topologies_;
+      }
       stream_->write_frame(mesh_id_, proto::encode(frame));
     } catch (const proto::DdsError&) {
       continue;  // a frame lost to the transport; the next one follows in 1/rate s

@@ -7,6 +7,7 @@
 
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/runtime/organ_cutting.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/mesh/refinement.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
@@ -90,7 +91,12 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   // The compliance predicts the simulated response, so it sees the same inertia.
   organ.substep_cost_s = time_substep(organ);
   check_tick_budget(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget, source, field);
+  enable_cutting(organ);  // before the compliance's worker reads the model
   organ.compliance = std::make_unique<ContactCompliance>(*organ.model, organ.integrator->mass_scaling().density_kg_m3, bc);
+  // The worker reads the model while it factorises the uncut organ: a cuttable organ is ready once
+  // it is done, so a scalpel cuts from the first tick, live and re-simulated alike.
+  if (organ.cutter) organ.compliance->wait_settled();
+  organ.contact_surface = make_contact_surface(organ.boundary.triangles, organ.mesh->nodes);
 }
 
 }  // namespace

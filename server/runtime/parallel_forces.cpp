@@ -68,6 +68,8 @@ void ParallelForces::helper() {
 ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
   x_ = x;
   memory_ = memory;
+  if (!buffers_.empty() && buffers_[0].size() != f.size())  // the organ was cut: more nodes
+    for (auto& b : buffers_) b.resize(f.size());
   finished_.store(0, std::memory_order_relaxed);
   const std::uint64_t g = ++generation_;
   next_.store(g << 32 | 1u, std::memory_order_release);

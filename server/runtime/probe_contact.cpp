@@ -34,17 +34,20 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return *w = Vec3(1 - v - u, v, u), a + v * ab + u * ac;
 }
 
-ProbeContact::ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
-                           double max_depth_m, double damping_s_per_m)
-    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m), damping_(damping_s_per_m) {
-  reach2_.reserve(surface_.size());
-  for (const auto& t : surface_) {
+std::shared_ptr<const ContactSurface> make_contact_surface(std::vector<tissue::Triangle> triangles, std::span<const Vec3> rest) {
+  auto s = std::make_shared<ContactSurface>();
+  s->longest_rest_edge_m.reserve(triangles.size());
+  for (const auto& t : triangles) {
     const Vec3 &a = rest[t[0]], &b = rest[t[1]], &c = rest[t[2]];
-    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    const double reach = radius_ + max_depth_ + 3.0 * longest;
-    reach2_.push_back(reach * reach);
+    s->longest_rest_edge_m.push_back(std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}));
   }
+  s->triangles = std::move(triangles);
+  return s;
 }
+
+ProbeContact::ProbeContact(std::shared_ptr<const ContactSurface> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m,
+                           double damping_s_per_m)
+    : surface_(std::move(surface)), radius_(tip_radius_m), stiffness_(stiffness_n_per_m), max_depth_(max_depth_m), damping_(damping_s_per_m) {}
 
 ContactResult ProbeContact::apply(const Vec3& centre, const Vec3& tool_velocity, const tissue::BoundaryConditions::FieldEvaluation& field) const {
   const auto x = field.x, v = field.v;
@@ -54,10 +57,13 @@ ContactResult ProbeContact::apply(const Vec3& centre, const Vec3& tool_velocity,
   // First pass: the triangles the tip sphere touches, with their depths.
   touching_.clear();
   double total = 0.0;
-  for (std::size_t k = 0; k < surface_.size(); ++k) {
-    const auto& t = surface_[k];
+  const auto& triangles = surface_->triangles;
+  const auto& longest = surface_->longest_rest_edge_m;
+  for (std::size_t k = 0; k < triangles.size(); ++k) {
+    const auto& t = triangles[k];
     const Vec3& a = x[t[0]];
-    if ((centre - a).squaredNorm() > reach2_[k]) continue;  // broad phase
+    const double reach = radius_ + max_depth_ + 3.0 * longest[k];
+    if ((centre - a).squaredNorm() > reach * reach) continue;  // broad phase
     const Vec3 &b = x[t[1]], &c = x[t[2]];
     Vec3 n = (b - a).cross(c - a);
     const double area2 = n.norm();
@@ -100,12 +106,12 @@ ContactResult ProbeContact::apply(const Vec3& centre, const Vec3& tool_velocity,
     const double share = c.depth / total;
     double normal_force = stiffness_ * r.depth_m * share;
     if (rate_gain > 0) {
-      const auto& t = surface_[c.triangle];
+      const auto& t = triangles[c.triangle];
       const Vec3 vq = c.weights[0] * v[t[0]] + c.weights[1] * v[t[1]] + c.weights[2] * v[t[2]];
       normal_force = std::max(0.0, normal_force + rate_gain * share * (vq - tool_velocity).dot(c.normal));
     }
     const Vec3 push = normal_force * c.normal;  // on the tool, out of the tissue
-    const auto& t = surface_[c.triangle];
+    const auto& t = triangles[c.triangle];
     if (!f.empty())
       for (int k = 0; k < 3; ++k) f[t[k]] -= c.weights[k] * push;
     if (!node_stiffness.empty())

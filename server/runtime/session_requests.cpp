@@ -121,6 +121,10 @@ bool SimulationServer::Impl::control(const proto::SessionRequest& req, const Sta
     conclude(req, true, text + tick_cost(organ->integrator->dt_s(), organ->substep_cost_s, scene.physics_rate_hz), status);
     return true;
   }
+  // The material is rebuilt on the organ's mesh in the background; a cut organ's mesh changes
+  // under the physics thread, and its model carries what the cuts made.
+  if (req.action == proto::Action::set_material && organ->cuts > 0)
+    return refuse("the organ has been cut: a material change applies to an uncut organ (load the scene again first)");
   // A material file that does not read is refused at once, as the background build would.
   if (req.action == proto::Action::set_material && req.material.file_text) {
     try {

@@ -56,10 +56,13 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
       tools.clear();
       for (const auto& spec : scene.instruments)
         tools.emplace(spec.id, Tool{SimulatedTool(spec),
-                                    std::make_unique<ProbeContact>(organ->boundary.triangles, organ->mesh->nodes, spec.tip_radius_m,
-                                                                   scene.contact_stiffness_n_per_m, 0.02, scene.contact_damping_s_per_m),
+                                    std::make_unique<ProbeContact>(organ->contact_surface, spec.tip_radius_m, scene.contact_stiffness_n_per_m, 0.02,
+                                                                   scene.contact_damping_s_per_m),
+                                    {},
                                     {}});
-      responder.set_instruments(scene.instruments, organ->boundary.triangles, organ->mesh->nodes, scene.contact_stiffness_n_per_m);
+      responder.set_instruments(scene.instruments, organ->contact_surface, scene.contact_stiffness_n_per_m);
+      strokes = 0;
+      topology_to_publish = false;
       state = State::at_rest(*organ->mesh);
       if (old) ++generation;
       loaded.first_tick = current_tick();
@@ -109,7 +112,7 @@ void SimulationServer::Impl::start_outside(Tool& t) const {
 /// contact of each active tool, and the springs holding grasped nodes to the jaws.
 void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEvaluation& e) {
   for (auto& [id, t] : tools) {
-    if (!t.tool.active()) {
+    if (!t.tool.active() || t.tool.cutting()) {  // a cutting blade passes through the tissue
       t.result = {};
       continue;
     }
@@ -122,6 +125,7 @@ void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEv
 proto::SurfaceTopology SimulationServer::Impl::surface_topology(const BoundarySurface& boundary) const {
   proto::SurfaceTopology t;
   t.mesh_id = generation;
+  t.topology_generation = organ->topology_generation;
   t.organ_name = scene.name;
   t.vertex_count = static_cast<std::uint32_t>(boundary.nodes.size());
   const auto& nodes = organ->mesh->nodes;
@@ -161,6 +165,7 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
     try {
       organ->integrator->advance(state, dt);
       sim_time_s += dt;
+      cut_with_scalpels();
     } catch (const SimulationError& e) {
       // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
       // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.
@@ -173,7 +178,14 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
   const auto step_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
   publish_snapshot(current_tick());
   publish_forces(step_ns);
-  if (mesh_publisher) mesh_publisher->offer(state.x, sim_time_s, proto::now_ns(), current_tick());
+  if (mesh_publisher) {
+    const std::int64_t now = proto::now_ns();
+    if (topology_to_publish && mesh_publisher->due(now)) {  // at most one topology per frame
+      mesh_publisher->change_topology(surface_topology(organ->boundary), organ->boundary.nodes);
+      topology_to_publish = false;
+    }
+    mesh_publisher->offer(state.x, sim_time_s, now, current_tick());
+  }
   ++ticks_run;
   ++stats.ticks;
   return step_ns;
@@ -187,6 +199,7 @@ std::vector<std::uint8_t> SimulationServer::Impl::surface_frame() const {
   f.sim_time_s = sim_time_s;
   f.server_stamp_ns = proto::now_ns();
   f.tick = ticks_run;
+  f.topology_generation = organ->topology_generation;
   f.positions.resize(3 * organ->boundary.nodes.size());
   copy_surface(state.x, organ->boundary.nodes, f.positions.data());
   return proto::encode(f);

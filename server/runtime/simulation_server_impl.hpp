@@ -65,12 +65,21 @@ struct SimulationServer::Impl {
   proto::LockstepResult* capture = nullptr;
 
   InstrumentTable instruments;  // both threads (thread-safe)
+  struct Stroke {  // a scalpel's cut in progress
+    std::int32_t id = -1;  // -1: not cutting
+    tissue::Vec3 blade_tip = tissue::Vec3::Zero(), blade_end = tissue::Vec3::Zero();  // the blade after the last tick
+    std::size_t sweeps = 0, tets_cut = 0, split_edges = 0, duplicated_nodes = 0;
+    double added_mass_kg = 0;
+  };
   struct Tool {  // physics thread only
     SimulatedTool tool;
     std::unique_ptr<ProbeContact> contact;
     ContactResult result;
+    Stroke stroke;
   };
   std::map<std::uint32_t, Tool> tools;
+  std::int32_t strokes = 0;  // physics thread: strokes begun on this organ (the next one's id)
+  bool topology_to_publish = false;  // physics thread: the surface changed since the mesh publisher last had it
   CommandResponder responder;
   SessionControl session;
   std::unique_ptr<MeshPublisher> mesh_publisher;  // its own thread
@@ -108,6 +117,13 @@ struct SimulationServer::Impl {
 
   /// The boundary surface with its vertices numbered in the order of boundary.nodes.
   proto::SurfaceTopology surface_topology(const tissue::BoundarySurface& boundary) const;
+
+  /// After the step: every scalpel whose owner holds its cut button cuts the organ with the surface
+  /// its blade swept during the tick, and strokes begin and end with events. The contacts see the
+  /// cut surface from the next tick on.
+  void cut_with_scalpels();
+  /// A scalpel's stroke ends (its cut_ended event says what it cut).
+  void end_stroke(std::uint32_t id, Tool& t);
 
   // --- What the server publishes
   void publish_scene();

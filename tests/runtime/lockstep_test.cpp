@@ -3,9 +3,12 @@
 // fail); and the steps do what they say: the claim, the press, the material change and the pause
 // take effect at the ticks named, with the recording's clock. The whole server in one process,
 // its endpoints in memory.
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <functional>
+#include <iostream>
 #include <map>
 #include <thread>
 
@@ -69,8 +72,10 @@ struct LockstepRun {
   proto::Scene scene;
 };
 
-/// One lockstep server on `threads` physics threads, through the steps of script().
-LockstepRun run(int threads, std::uint64_t nudge_at = 0) {
+using Script = std::function<std::vector<proto::LockstepStep>(const proto::Scene&)>;
+
+/// One lockstep server on `threads` physics threads, through the steps of `steps_for` (script()).
+LockstepRun run(int threads, std::uint64_t nudge_at = 0, const Script& steps_for = {}) {
   SceneSpec spec = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
   spec.physics_threads = threads;
   MemoryEndpoints endpoints;
@@ -80,7 +85,7 @@ LockstepRun run(int threads, std::uint64_t nudge_at = 0) {
   r.scene = endpoints.decoded<proto::Scene>(endpoints.scenes, proto::decode_scene).back();
   std::atomic<bool> stop{false};
   std::thread t([&] { server.run_lockstep(stop, link, {}); });
-  const auto steps = script(r.scene, nudge_at);
+  const auto steps = steps_for ? steps_for(r.scene) : script(r.scene, nudge_at);
   for (const auto& s : steps) link.push_step(s);
   r.results = link.wait_results(steps.size(), std::chrono::seconds(300));
   stop = true;
@@ -125,7 +130,8 @@ std::string first_difference(const LockstepRun& a, const LockstepRun& b) {
     if (x.frame.empty() != y.frame.empty()) return at + "frame presence";
     if (!x.frame.empty()) {
       const auto m = proto::decode_mesh_frame(x.frame, &why), n = proto::decode_mesh_frame(y.frame, &why);
-      if (!m || !n || m->tick != n->tick || !same_bits(m->sim_time_s, n->sim_time_s) || m->positions.size() != n->positions.size() ||
+      if (!m || !n || m->tick != n->tick || !same_bits(m->sim_time_s, n->sim_time_s) || m->topology_generation != n->topology_generation ||
+          m->positions.size() != n->positions.size() ||
           std::memcmp(m->positions.data(), n->positions.data(), m->positions.size() * sizeof(float)) != 0)
         return at + "frame";
     }
@@ -216,6 +222,74 @@ TEST(Lockstep, AStepForAnotherTickIsRefusedWithItsReason) {
   EXPECT_EQ(results[0].error, "");
   EXPECT_NE(results[1].error.find("expected tick 6"), std::string::npos) << results[1].error;
   EXPECT_EQ(results[2].error, "");
+}
+
+/// The scalpel (instrument 4) claimed, lowered into the organ's top with its button held, drawn
+/// 6 cm along x, lifted out and the button let go; a frame every 10 ticks.
+std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
+  const double cx = 0.5 * (scene.bounds_min[0] + scene.bounds_max[0]), cy = 0.5 * (scene.bounds_min[1] + scene.bounds_max[1]);
+  const double z0 = scene.bounds_max[2] + 0.002, depth = 0.02;  // the blade from 18 mm under the top to 2 mm over it
+  std::vector<proto::LockstepStep> steps;
+  proto::LockstepStep first;
+  first.tick = kFirstTick;
+  first.sim_time_s = kFirstSimTime;
+  first.requests.push_back(proto::encode(proto::SessionRequest{7, proto::Action::claim_instrument, 4}));
+  steps.push_back(first);
+  const int down = 100, along = 300, up = 100;
+  for (int k = 1; k <= down + along + up; ++k) {
+    proto::LockstepStep s;
+    s.tick = kFirstTick + static_cast<std::uint64_t>(k);
+    proto::Command c;
+    c.instrument_id = 4;
+    c.client_id = 7;
+    c.seq = static_cast<std::uint64_t>(k);
+    c.client_stamp_ns = 1000 * k;
+    const double a = std::clamp(static_cast<double>(k - down) / along, 0.0, 1.0);
+    const double z = k <= down           ? z0 - depth * k / down
+                     : k <= down + along ? z0 - depth
+                                         : z0 - depth * (1.0 - static_cast<double>(k - down - along) / up);
+    c.tip_position = {cx - 0.03 + 0.06 * a, cy, z};
+    c.buttons = k < down + along + up ? 1u : 0u;
+    s.commands.push_back(proto::encode(c));
+    s.answers.push_back(proto::encode(c));
+    s.want_frame = k % 10 == 0;
+    steps.push_back(s);
+  }
+  return steps;
+}
+
+TEST(Lockstep, AnIncisionOpensTheSurfaceTheSameWayOnEveryRunAndOnTwoThreads) {
+  const LockstepRun a = run(1, 0, incision), again = run(1, 0, incision), two = run(2, 0, incision);
+  ASSERT_EQ(a.results.size(), 501u);
+  EXPECT_EQ(first_difference(a, again), "");
+  EXPECT_EQ(first_difference(a, two), "");
+  std::string why;
+  std::vector<proto::Event> events;
+  std::vector<proto::MeshFrame> frames;
+  for (const auto& r : a.results) {
+    EXPECT_EQ(r.error, "") << r.tick;
+    for (const auto& p : r.events) events.push_back(*proto::decode_event(p, &why));
+    if (!r.frame.empty()) frames.push_back(*proto::decode_mesh_frame(r.frame, &why));
+  }
+  const auto count = [&](proto::EventKind k) {
+    return std::count_if(events.begin(), events.end(), [&](const proto::Event& e) { return e.kind == k; });
+  };
+  EXPECT_EQ(count(proto::EventKind::physics_reset), 0);
+  EXPECT_EQ(count(proto::EventKind::cut_started), 1);
+  ASSERT_EQ(count(proto::EventKind::cut_ended), 1);
+  const auto ended = std::find_if(events.begin(), events.end(), [](const proto::Event& e) { return e.kind == proto::EventKind::cut_ended; });
+  EXPECT_EQ(ended->instrument_id, 4u);
+  EXPECT_EQ(ended->tick, kFirstTick + 500);  // the button let go in the last step
+  std::cout << "[ figure ] " << ended->text << "\n";
+  // The surface changed many times, its generation only ever rising, and it gained vertices (the
+  // cut's two faces).
+  ASSERT_GE(frames.size(), 50u);
+  EXPECT_EQ(frames.front().topology_generation, 0u);
+  for (std::size_t k = 1; k < frames.size(); ++k) EXPECT_GE(frames[k].topology_generation, frames[k - 1].topology_generation);
+  EXPECT_GT(frames.back().topology_generation, 10u);
+  EXPECT_GT(frames.back().positions.size(), frames.front().positions.size());
+  std::cout << "[ figure ] incision: surface generation " << frames.back().topology_generation << ", surface vertices "
+            << frames.front().positions.size() / 3 << " -> " << frames.back().positions.size() / 3 << "\n";
 }
 
 }  // namespace

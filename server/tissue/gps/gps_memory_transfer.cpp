@@ -81,7 +81,8 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
   const std::size_t n = element_count(), before = edit.elements_before;
   if (edit.origin.size() != n || before > n || blocks_.size() != (before + kLane - 1) / kLane)
     throw std::invalid_argument("GpsModel::follow_edit: the edit does not match the model and its mesh");
-  const bool with_memory = options_.mechanisms.has_memory();
+  // Empty memory is a relaxed organ (State::at_rest): nothing to carry, and it stays empty.
+  const bool with_memory = options_.mechanisms.has_memory() && !memory.empty();
   if (with_memory && memory.size() != memory_size()) throw std::invalid_argument("GpsModel::follow_edit: memory of another layout");
   const std::size_t stride = memory_stride();
   // The parents' rest shapes, H and memory before anything is rewritten (nodes never move, so

@@ -86,6 +86,8 @@ struct InstrumentInfo {
   bool grasper = false;
   double tip_radius_m = 0;
   std::uint32_t owner_client_id = 0;
+  bool scalpel = false;  ///< schema 15
+  double blade_length_m = 0;  ///< schema 15: a scalpel's blade [m]
 };
 
 struct MaterialInfo {
@@ -160,6 +162,7 @@ struct SurfaceTopology {
   std::uint32_t vertex_count = 0;
   std::vector<std::uint32_t> triangles;  ///< 3 vertex indices per triangle
   std::vector<float> rest_positions;  ///< [m] 3 per vertex
+  std::uint32_t topology_generation = 0;  ///< schema 15: 0 as loaded, +1 per change (cuts)
 };
 
 /// The deformed surface at one instant.
@@ -170,6 +173,7 @@ struct MeshFrame {
   std::int64_t server_stamp_ns = 0;
   std::vector<float> positions;  ///< [m] 3 per vertex
   std::uint64_t tick = 0;  ///< schema 7: the tick after which it was taken
+  std::uint32_t topology_generation = 0;  ///< schema 15: the SurfaceTopology these vertices are of
 };
 
 enum class EventKind : std::int8_t {
@@ -187,7 +191,9 @@ enum class EventKind : std::int8_t {
   scene_loaded,
   material_changed,
   physics_rate_changed,
-  request_refused  // schema 3
+  request_refused,  // schema 3
+  cut_started,  // schema 15
+  cut_ended
 };
 /// The kind's name; "unknown" for kinds added by a newer server (decoders pass them through).
 const char* event_name(EventKind k);
@@ -247,7 +253,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 14;
+inline constexpr int kSchemaVersion = 15;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <vector>
 
 #include "viscera/protocol/messages.hpp"
@@ -43,9 +44,11 @@ protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, 
 class CommandResponder {
  public:
   /// The instruments of a new organ: one contact query each (it keeps scratch space), on the
-  /// organ's surface and rest positions.
-  void set_instruments(const std::vector<InstrumentSpec>& instruments, const std::vector<tissue::Triangle>& surface, std::span<const Vec3> rest,
+  /// organ's surface.
+  void set_instruments(const std::vector<InstrumentSpec>& instruments, const std::shared_ptr<const ContactSurface>& surface,
                        double contact_stiffness_n_per_m);
+  /// The organ's surface after a cut, for every query (the caller holds off the command thread).
+  void set_surface(const std::shared_ptr<const ContactSurface>& surface);
   /// Physics thread, after each tick.
   void publish(std::shared_ptr<const Snapshot> snapshot);
   std::shared_ptr<const Snapshot> latest() const;
@@ -56,6 +59,7 @@ class CommandResponder {
 
  private:
   std::map<std::uint32_t, std::unique_ptr<ProbeContact>> queries_;
+  std::set<std::uint32_t> scalpels_;
   mutable std::mutex mutex_;  // guards the snapshot pointer only
   std::shared_ptr<const Snapshot> snapshot_;
 };

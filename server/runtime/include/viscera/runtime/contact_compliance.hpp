@@ -37,10 +37,16 @@ class ContactCompliance {
   /// The 3x3 block of K_t^-1 at `node` [m/N] if known; otherwise asks the worker for it and
   /// returns nothing. Never blocks.
   std::optional<Eigen::Matrix3d> node(std::int32_t node);
-  /// Blocks until the block of `node` is known (tests and tools; not for the physics loop).
-  Eigen::Matrix3d wait_node(std::int32_t node);
+  /// Blocks until the block of `node` is known (tests, tools and lockstep; not for the live physics
+  /// loop); nothing for a node made after the compliance (a cut's), as node() answers.
+  std::optional<Eigen::Matrix3d> wait_node(std::int32_t node);
   /// False while the rest stiffness is being factorised or if it could not be.
   bool ready() const { return factorised_.load() == 1; }
+  /// True once the worker no longer reads the model (factorised, or failed): from then on the
+  /// model may change (a cut). Blocks of nodes made later are never known: the penalty's bound.
+  bool settled() const { return factorised_.load() != 0; }
+  /// Blocks until settled().
+  void wait_settled();
 
  private:
   void work(const tissue::ForceModel& model, std::vector<double> density, tissue::BoundaryConditions bc);

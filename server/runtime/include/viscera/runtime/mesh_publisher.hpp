@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <thread>
 #include <vector>
@@ -33,6 +34,14 @@ class MeshPublisher {
 
   /// Physics thread: hands over the state after `tick` if a frame is due at `now_ns`; never blocks.
   void offer(std::span<const tissue::Vec3> x, double sim_time_s, std::int64_t now_ns, std::uint64_t tick);
+  /// Physics thread: whether offer() at `now_ns` would take a frame.
+  bool due(std::int64_t now_ns) const { return now_ns >= next_due_ns_; }
+  /// Physics thread: the organ's surface changed (a cut). Frames offered from now on are of
+  /// `topology` (its topology_generation), which is written before the first of them; a change
+  /// not yet written is replaced by a newer one. Encoding and writing happen on the publisher's
+  /// thread.
+  void change_topology(protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes);
+  std::uint64_t topologies_published() const;
   std::uint64_t frames_published() const;
   /// Frames that were due while the publisher was still writing the previous one.
   std::uint64_t frames_skipped() const { return skipped_; }
@@ -43,14 +52,16 @@ class MeshPublisher {
   std::unique_ptr<MeshStream> stream_;
   std::vector<std::int32_t> nodes_;
   std::uint32_t mesh_id_;
+  std::uint32_t topology_generation_ = 0;  // physics thread: of the frames offered
   std::int64_t period_ns_, next_due_ns_ = 0;
   std::uint64_t offered_ = 0, skipped_ = 0;  // physics thread only
 
   mutable std::mutex mutex_;
   std::condition_variable ready_cv_;
   protocol::MeshFrame pending_;  // guarded by mutex_
+  std::optional<protocol::SurfaceTopology> pending_topology_;  // guarded by mutex_: to write before pending_
   bool ready_ = false, stop_ = false;
-  std::uint64_t published_ = 0;
+  std::uint64_t published_ = 0, topologies_ = 1;
   std::thread thread_;
 };
 

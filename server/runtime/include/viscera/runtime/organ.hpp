@@ -9,8 +9,10 @@
 #include "viscera/runtime/contact_compliance.hpp"
 #include "viscera/runtime/material_regions.hpp"
 #include "viscera/runtime/parallel_forces.hpp"
+#include "viscera/runtime/probe_contact.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/runtime/tick_budget.hpp"
+#include "viscera/tissue/cutting/mesh_cutter.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
@@ -27,6 +29,14 @@ struct Organ {
   std::shared_ptr<tissue::TetMesh> mesh;
   tissue::Box bounds;
   tissue::BoundarySurface boundary;
+  /// The boundary triangles as the contacts see them (shared by every instrument's contact).
+  std::shared_ptr<const ContactSurface> contact_surface;
+  /// Cuts the mesh in place (organ_cutting.hpp); null when the model cannot follow a cut.
+  std::unique_ptr<tissue::MeshCutter> cutter;
+  /// Changes of the boundary surface since the organ was built (SurfaceTopology's generation).
+  std::uint32_t topology_generation = 0;
+  /// Sweeps that changed the mesh since the organ was built.
+  std::uint64_t cuts = 0;
   std::unique_ptr<tissue::ForceModel> model;
   std::unique_ptr<ParallelForces> parallel_forces;  ///< on the scene's physics_threads, max(kForceChunks, threads) chunks; used by the integrator
   std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set

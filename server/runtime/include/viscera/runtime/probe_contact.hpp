@@ -17,6 +17,7 @@
 // far side of the organ does not pull). Each triangle's share acts on its vertices with
 // barycentric weights; the tool feels the opposite.
 #include <array>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -41,13 +42,29 @@ struct ContactResult {
   Vec3 deepest_weights = Vec3::Zero();  ///< its barycentric weights
 };
 
+/// The boundary triangles a contact looks at, with each one's longest rest edge for the broad
+/// phase; immutable once made, so the physics thread's contacts and the command thread's queries
+/// share one, and a cut organ swaps in a new one for all of them.
+struct ContactSurface {
+  std::vector<tissue::Triangle> triangles;
+  std::vector<double> longest_rest_edge_m;
+};
+std::shared_ptr<const ContactSurface> make_contact_surface(std::vector<tissue::Triangle> triangles, std::span<const Vec3> rest);
+
 class ProbeContact {
  public:
   /// rest: the mesh's rest positions, for the broad phase (a triangle is skipped when its first
   /// vertex is farther from the tip than the tip radius, the depth limit and three times its
   /// longest rest edge: an edge stretched beyond 3x fails the integration's strain check first).
   ProbeContact(std::vector<tissue::Triangle> surface, std::span<const Vec3> rest, double tip_radius_m, double stiffness_n_per_m,
-               double max_depth_m = 0.02, double damping_s_per_m = 0.0);
+               double max_depth_m = 0.02, double damping_s_per_m = 0.0)
+      : ProbeContact(make_contact_surface(std::move(surface), rest), tip_radius_m, stiffness_n_per_m, max_depth_m, damping_s_per_m) {}
+  ProbeContact(std::shared_ptr<const ContactSurface> surface, double tip_radius_m, double stiffness_n_per_m, double max_depth_m = 0.02,
+               double damping_s_per_m = 0.0);
+  /// Another surface of the same organ (after a cut); the nodes it names must exist in the
+  /// positions the contact is given from now on.
+  void set_surface(std::shared_ptr<const ContactSurface> surface) { surface_ = std::move(surface); }
+  const std::shared_ptr<const ContactSurface>& surface() const { return surface_; }
   /// The contact's forces on the organ during one explicit step (the integrator's force field,
   /// tissue::BoundaryConditions::FieldEvaluation): adds the penalty forces to field.f and to
   /// field.stiffness a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row
@@ -66,8 +83,7 @@ class ProbeContact {
     Vec3 normal, weights, point;
     double depth;
   };
-  std::vector<tissue::Triangle> surface_;
-  std::vector<double> reach2_;  // per triangle: squared broad-phase distance from its first vertex
+  std::shared_ptr<const ContactSurface> surface_;
   double radius_, stiffness_, max_depth_, damping_;
   mutable std::vector<Touch> touching_;
 };

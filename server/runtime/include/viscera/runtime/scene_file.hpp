@@ -10,14 +10,20 @@
 
 namespace viscera::runtime {
 
-enum class InstrumentKind { probe, grasper };
+enum class InstrumentKind { probe, grasper, scalpel };
 
 struct InstrumentSpec {
   std::uint32_t id = 0;
   InstrumentKind kind = InstrumentKind::probe;
   double tip_radius_m = 0.005;
   double grasp_radius_m = 0.01;  ///< grasper: surface nodes this close to the tip are grasped
+  /// scalpel: the blade, a segment from the tip along the tool's z axis (the shaft) [m]; it cuts
+  /// while the owner holds button 1 (blade_cuts()).
+  double blade_length_m = 0.02;
 };
+
+/// Button 1 (bit 0 of Command::buttons): a scalpel's blade cuts while it is held.
+inline constexpr std::uint32_t kCutButton = 1u;
 
 /// Part of the organ made of its own material (docs/SCENE.md, "Material regions"): the elements
 /// whose centroid lies inside a sphere or a box, in metres in the organ's frame (the mesh as

@@ -54,6 +54,8 @@ class SessionControl {
   void wait_ready() const;
   /// What is being built ("" when nothing).
   std::string preparing() const { return preparing_ ? preparing_->what : std::string(); }
+  /// Whether a material change is being built (from the running organ's mesh, which must not change meanwhile).
+  bool preparing_material() const { return preparing_ && preparing_->request.action == protocol::Action::set_material; }
 
   /// Keeps a request's outcome (the last kOutcomesKept, oldest first).
   void record(const protocol::SessionRequest& request, bool accepted, const std::string& message);

@@ -25,6 +25,11 @@ inline constexpr double kContactEndAfterS = 0.05;
 /// What changed in a tick, for the session's events.
 enum class ToolEvent { none, grasped, let_go, contact_started, contact_ended };
 
+/// Whether `command` makes the instrument cut: a scalpel with kCutButton held.
+inline bool blade_cuts(const InstrumentSpec& spec, const protocol::Command& command) {
+  return spec.kind == InstrumentKind::scalpel && (command.buttons & kCutButton) != 0;
+}
+
 class SimulatedTool {
  public:
   explicit SimulatedTool(const InstrumentSpec& spec) : spec_(spec) {}
@@ -37,6 +42,9 @@ class SimulatedTool {
   const Vec3& velocity() const { return velocity_; }
   Eigen::Quaterniond orientation() const;
   const GraspHold& held() const { return held_; }
+  /// A scalpel whose owner holds the cut button: its blade passes through the tissue, cutting,
+  /// and its tip does not push it (blade_cuts()).
+  bool cutting() const { return active_ && blade_cuts(spec_, command_); }
 
   /// The tick's command (the newest of its owner), or inactive: an instrument without an owner or
   /// command exerts nothing, and a grasper lets go. A tool that becomes active starts at its

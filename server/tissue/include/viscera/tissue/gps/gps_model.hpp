@@ -58,7 +58,8 @@ class GpsModel final : public ForceModel {
   /// same TetMesh): the changed and the new elements are calibrated from their own rest shapes
   /// with their parent's material, the others stay bit for bit. `memory` (State::memory) is
   /// brought to the new layout in place, changed and new elements carrying their parent's state
-  /// as memory_from does. Cost: the changed elements (vectors grow geometrically).
+  /// as memory_from does; empty memory (a relaxed organ) stays empty. Cost: the changed elements
+  /// (vectors grow geometrically).
   void follow_edit(const MeshEdit& edit, std::vector<double>& memory);
   /// Room for this many elements, so that following edits up to it never reallocates (a
   /// reallocation copies every element: milliseconds at 12k). Reserve the memory alike with

@@ -73,8 +73,11 @@ class ExplicitIntegrator {
   /// momentum, so the edit adds no kinetic energy. Lumped masses change only where elements did.
   /// Returns the inertia added [kg]. Prescribed motions and nodal forces do not reach new nodes.
   double follow_edit(const MeshEdit& edit, State& state);
-  /// Every element's own critical step is at least this [s] (kept so through edits). With the
-  /// global step estimate it is found at the first edit (0 before).
+  /// Every element an edit changes or makes has its own critical step at least this [s]: the
+  /// organ's element bound (every element's own step is at least this, kept so through edits),
+  /// or, with the global step estimate, the organ's critical step itself (its worst elements'
+  /// own steps lie 2-3x below it, and a new element held only to theirs made the cut liver
+  /// unstable: the changed elements must not raise the organ's highest frequency).
   double element_step_s() const { return element_step_s_; }
 
  private:

@@ -1,0 +1,38 @@
+#pragma once
+// A scalpel's cut through the running organ (docs/CUTTING.md, "In the server"): the blade's sweep
+// over one tick cuts the mesh in place (tissue::MeshCutter), and the force model, the explicit
+// integrator, the boundary surface and the contacts' surface follow it, all on the physics thread
+// between ticks. Deterministic: the same sweeps on the same state give the same organ, so a
+// recorded session with cuts re-simulates bit for bit.
+#include <cstdint>
+#include <string>
+
+#include "viscera/runtime/organ.hpp"
+#include "viscera/tissue/cutting/blade_sweep.hpp"
+#include "viscera/tissue/integrator/state.hpp"
+
+namespace viscera::runtime {
+
+/// What one sweep did to the organ.
+struct SweepOutcome {
+  bool topology_changed = false;  ///< the mesh changed (split, opened)
+  bool surface_changed = false;  ///< the boundary surface changed (topology_generation went up)
+  std::size_t tets_cut = 0;  ///< tetrahedra of the organ before the sweep that it changed
+  std::size_t split_edges = 0, duplicated_nodes = 0;
+  double added_mass_kg = 0;  ///< inertia added to keep the new elements' stable step
+};
+
+/// Makes `organ` cuttable when its scene has a scalpel: a MeshCutter on its mesh, and room
+/// reserved for the elements cuts make, so a cut rarely reallocates (before anything else reads the
+/// model on another thread: the contact compliance's worker). Only the GPS models follow a cut;
+/// a scene with a scalpel on another model is refused when it is read (read_scene_file).
+void enable_cutting(Organ& organ);
+
+/// Whether the organ may be cut (its scene has a scalpel and its model follows cuts).
+bool can_cut(const Organ& organ);
+
+/// One sweep of a blade through the organ in `state` (its positions now), as part of stroke
+/// `stroke`; the state gains the new nodes and memory. Requires can_cut(organ).
+SweepOutcome cut_organ(Organ& organ, const tissue::BladeSweep& sweep, tissue::State& state, std::int32_t stroke);
+
+}  // namespace viscera::runtime

@@ -1,0 +1,64 @@
+// The server's scalpels (docs/CUTTING.md, "In the server"): after each step, a scalpel that cuts
+// sweeps its blade from where the last tick left it to where this one does, and the organ follows
+// the cut (organ_cutting.hpp). Physics thread, between the step and the snapshot.
+#include <cstdio>
+
+#include "viscera/runtime/organ_cutting.hpp"
+
+#include "simulation_server_impl.hpp"
+
+namespace viscera::runtime {
+
+using namespace viscera::tissue;
+
+void SimulationServer::Impl::end_stroke(std::uint32_t id, Tool& t) {
+  Stroke& s = t.stroke;
+  char text[240];
+  std::snprintf(text, sizeof text, "stroke %d: %zu sweeps, %zu tetrahedra cut, %zu edges split, %zu nodes duplicated, %.3g g of inertia added", s.id,
+                s.sweeps, s.tets_cut, s.split_edges, s.duplicated_nodes, 1e3 * s.added_mass_kg);
+  event(proto::EventKind::cut_ended, id, t.tool.owner(), text);
+  s = Stroke{};
+}
+
+void SimulationServer::Impl::cut_with_scalpels() {
+  bool surface_changed = false;
+  for (auto& [id, t] : tools) {
+    const InstrumentSpec& spec = t.tool.spec();
+    if (spec.kind != InstrumentKind::scalpel) continue;
+    // A material change being built reads the mesh: the blade waits for it (a few hundred ms).
+    const bool cutting = t.tool.cutting() && can_cut(*organ) && !session.preparing_material();
+    Stroke& s = t.stroke;
+    if (!cutting) {
+      if (s.id >= 0) end_stroke(id, t);
+      continue;
+    }
+    const Vec3 tip = t.tool.position();
+    const Vec3 end = tip + spec.blade_length_m * (t.tool.orientation() * Vec3::UnitZ());
+    if (s.id < 0) {  // the stroke begins where the blade is; it sweeps from the next tick on
+      s.id = strokes++;
+      s.blade_tip = tip;
+      s.blade_end = end;
+      event(proto::EventKind::cut_started, id, t.tool.owner(), "stroke " + std::to_string(s.id));
+      continue;
+    }
+    const BladeSweep sweep{s.blade_tip, s.blade_end, tip, end};
+    s.blade_tip = tip;
+    s.blade_end = end;
+    const SweepOutcome o = cut_organ(*organ, sweep, state, s.id);
+    ++s.sweeps;
+    s.tets_cut += o.tets_cut;
+    s.split_edges += o.split_edges;
+    s.duplicated_nodes += o.duplicated_nodes;
+    s.added_mass_kg += o.added_mass_kg;
+    surface_changed = surface_changed || o.surface_changed;
+  }
+  if (!surface_changed) return;
+  {
+    std::lock_guard world(organ_mutex);  // the command thread's queries see the new surface whole
+    responder.set_surface(organ->contact_surface);
+  }
+  for (auto& [id, t] : tools) t.contact->set_surface(organ->contact_surface);
+  topology_to_publish = true;
+}
+
+}  // namespace viscera::runtime
