@@ -150,7 +150,8 @@ class PlanBuilder {
       return;
     }
     if (f.tick < plan_.first_tick) return;
-    plan_.frames[f.tick] = {f.sim_time_s, fnv1a(f.positions.data(), f.positions.size() * sizeof(float)), f.positions.size() / 3, log_time};
+    plan_.frames[f.tick] = {f.sim_time_s, fnv1a(f.positions.data(), f.positions.size() * sizeof(float)), f.positions.size() / 3, log_time,
+                            f.topology_generation};
     step_at(f.tick).want_frame = true;
     plan_.last_tick = std::max(plan_.last_tick, f.tick);
     ++plan_.recorded_frames;

@@ -137,6 +137,9 @@ void ResimulationCheck::check_frame(const proto::LockstepResult& r) {
   const ExpectedFrame& e = expected->second;
   if (!same_bits(e.sim_time_s, f->sim_time_s))
     return diverged({r.tick, "mesh_frame", "the surface", "sim_time_s", exact_number(e.sim_time_s), exact_number(f->sim_time_s)});
+  if (f->topology_generation != e.topology_generation)
+    return diverged({r.tick, "mesh_frame", "the surface", "topology generation (cuts)", std::to_string(e.topology_generation),
+                     std::to_string(f->topology_generation)});
   if (f->positions.size() != 3 * e.vertex_count)
     return diverged({r.tick, "mesh_frame", "the surface", "vertex count", std::to_string(e.vertex_count), std::to_string(f->positions.size() / 3)});
   if (fnv1a(f->positions.data(), f->positions.size() * sizeof(float)) == e.digest) {

@@ -110,7 +110,7 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
       if (it == s->instruments.end()) {
         std::string list;
         for (const auto& i : s->instruments)
-          list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.grasper ? " (grasper)" : " (probe)");
+          list += (list.empty() ? "" : ", ") + std::to_string(i.instrument_id) + (i.scalpel ? " (scalpel)" : i.grasper ? " (grasper)" : " (probe)");
         return {false, "scene " + s->name + " has no instrument " + std::to_string(instrument_id) + " (its instruments: " + list + ")"};
       }
       if (it->owner_client_id == client_id_ && !another_owner_seen) {
@@ -282,6 +282,9 @@ std::optional<proto::MeshFrame> Client::poll_mesh_frame() {
   impl_->frames->take(
       [&](proto::MeshFrame f, const proto::Received&) {
         if (!topology || f.mesh_id > topology->mesh_id) return;  // its topology (transient local) is still on its way
+        // A cut changes the surface: a frame of a later generation waits for its topology, one of
+        // an earlier generation is old news.
+        if (f.mesh_id == topology->mesh_id && f.topology_generation != topology->topology_generation) return;
         if (f.mesh_id != topology->mesh_id || f.positions.size() != 3ull * topology->vertex_count) {
           impl_->rejections.add("mesh_frame: " + std::to_string(f.positions.size() / 3) + " vertices for mesh " + std::to_string(f.mesh_id) +
                                 ", whose topology has " + std::to_string(topology->vertex_count) + " (mesh " + std::to_string(topology->mesh_id) +

@@ -73,10 +73,14 @@ ContactResult ProbeContact::apply(const Vec3& centre, const Vec3& tool_velocity,
     const Vec3 q = closest_point_on_triangle(centre, a, b, c, &w);
     const double s = (centre - q).dot(n);
     if (s >= radius_ || s < -max_depth_) continue;
-    // Off the triangle's interior, only a tip outside the surface touches its edge or corner.
+    // Off the triangle's interior, only a tip outside the surface touches its edge or corner, and
+    // it penetrates by what the sphere overlaps it there: at a sharp edge (the lip of a cut, whose
+    // face stands at right angles to the top) the distance along the normal is near 0 while the
+    // tip only grazes the edge, and taken as the depth it pushed the lip with the tip's whole radius.
     const bool interior = w.minCoeff() > 0;
-    if (!interior && (s < 0 || (centre - q).norm() >= radius_)) continue;
-    const double depth = radius_ - s;
+    const double distance = (centre - q).norm();
+    if (!interior && (s < 0 || distance >= radius_)) continue;
+    const double depth = interior ? radius_ - s : radius_ - distance;
     touching_.push_back({k, n, w, q, depth});
     total += depth;
     if (depth > r.depth_m) {

@@ -235,8 +235,10 @@ std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
   first.sim_time_s = kFirstSimTime;
   first.requests.push_back(proto::encode(proto::SessionRequest{7, proto::Action::claim_instrument, 4}));
   steps.push_back(first);
-  const int down = 100, along = 300, up = 100;
-  for (int k = 1; k <= down + along + up; ++k) {
+  const int down = 100, along = 300, up = 100, probe = 400;
+  first.requests.push_back(proto::encode(proto::SessionRequest{8, proto::Action::claim_instrument, 1}));
+  steps.back() = first;
+  for (int k = 1; k <= down + along + up + probe; ++k) {
     proto::LockstepStep s;
     s.tick = kFirstTick + static_cast<std::uint64_t>(k);
     proto::Command c;
@@ -250,8 +252,19 @@ std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
                                          : z0 - depth * (1.0 - static_cast<double>(k - down - along) / up);
     c.tip_position = {cx - 0.03 + 0.06 * a, cy, z};
     c.buttons = k < down + along + up ? 1u : 0u;
-    s.commands.push_back(proto::encode(c));
-    s.answers.push_back(proto::encode(c));
+    if (k <= down + along + up) {
+      s.commands.push_back(proto::encode(c));
+      s.answers.push_back(proto::encode(c));
+    } else {  // then a probe presses 1 cm into the cut's line
+      proto::Command p;
+      p.instrument_id = 1;
+      p.client_id = 8;
+      p.seq = static_cast<std::uint64_t>(k);
+      p.client_stamp_ns = 1000 * k;
+      p.tip_position = {cx, cy, z0 + 0.004 - 0.014 * static_cast<double>(k - down - along - up) / probe};
+      s.commands.push_back(proto::encode(p));
+      s.answers.push_back(proto::encode(p));
+    }
     s.want_frame = k % 10 == 0;
     steps.push_back(s);
   }
@@ -260,7 +273,7 @@ std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
 
 TEST(Lockstep, AnIncisionOpensTheSurfaceTheSameWayOnEveryRunAndOnTwoThreads) {
   const LockstepRun a = run(1, 0, incision), again = run(1, 0, incision), two = run(2, 0, incision);
-  ASSERT_EQ(a.results.size(), 501u);
+  ASSERT_EQ(a.results.size(), 901u);
   EXPECT_EQ(first_difference(a, again), "");
   EXPECT_EQ(first_difference(a, two), "");
   std::string why;

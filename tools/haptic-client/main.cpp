@@ -37,6 +37,7 @@ using viscera::protocol::Vector3;
 struct MeshWatch {
   std::vector<float> rest;
   std::uint32_t mesh_id = 0;  // the surface in use (a scene loaded at run time brings a new one)
+  std::uint32_t generation = 0;  // its topology generation (a cut brings a new one)
   std::size_t frames = 0;
   double first_t = -1, last_t = -1;
   bool record = false;  // keep every frame's sample (for --report)
@@ -44,9 +45,10 @@ struct MeshWatch {
   void take(viscera::client::Client& client, double t, const Vector3& tip) {
     const auto s = client.surface();
     if (!s) return;
-    if (s->mesh_id != mesh_id) {
+    if (s->mesh_id != mesh_id || s->topology_generation != generation) {
       rest = s->rest_positions;
       mesh_id = s->mesh_id;
+      generation = s->topology_generation;
     }
     const auto frame = client.poll_mesh_frame();
     if (!frame || frame->mesh_id != mesh_id || frame->positions.size() != rest.size()) return;
@@ -107,7 +109,7 @@ nlohmann::json to_json(const std::vector<ForceSample>& samples) {
 
 struct Options {
   std::uint32_t domain = 0, client_id = 1, instrument = 1;
-  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, hold_s = -1, force_n = 1.0, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100,
+  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, length_m = 0.04, hold_s = -1, force_n = 1.0, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100,
          duration_s = 4;
   viscera::client::FadePolicy fade;
   std::string station, script, frame, report;
@@ -126,6 +128,7 @@ Options parse(viscera::common::CommandLine& cl) {
   o.depth_m = cl.number_in("depth", 0, 0.2);
   o.max_force_n = cl.number_in("max-force", 0.1, 1000);
   o.pull_m = cl.number_in("pull", 0, 0.2);
+  o.length_m = cl.number_in("length", 0.001, 0.3);
   if (cl.has("hold")) o.hold_s = cl.number_in("hold", 0, 3600);
   o.force_n = cl.number_in("force", 0.01, 50);
   o.blend_s = cl.number_in("blend", 0, 0.1);
@@ -133,8 +136,8 @@ Options parse(viscera::common::CommandLine& cl) {
   o.fade.stale_after_s = cl.number_in("stale-after", 0.001, 5);
   o.script = cl.text("script");
   o.frame = cl.text("frame");
-  if (o.script != "press" && o.script != "grasp" && o.script != "hold" && o.script != "palpate")
-    throw viscera::common::UsageError("--script: '" + o.script + "' is not press, grasp, hold or palpate");
+  if (o.script != "press" && o.script != "grasp" && o.script != "hold" && o.script != "palpate" && o.script != "incise")
+    throw viscera::common::UsageError("--script: '" + o.script + "' is not press, grasp, hold, palpate or incise");
   if (o.frame != "scene" && o.frame != "organ-top") throw viscera::common::UsageError("--frame: '" + o.frame + "' is not scene or organ-top");
   if (cl.has("trajectory")) {  // before connecting: a bad file fails at once
     o.trajectory_file = cl.text("trajectory");
@@ -157,7 +160,7 @@ Options parse(viscera::common::CommandLine& cl) {
 std::unique_ptr<viscera::client::Device> make_device(const Options& o, const viscera::protocol::Scene& scene) {
   if (o.trajectory.empty() && o.script == "palpate") return std::make_unique<viscera::haptic::PalpatingDevice>(scene, o.depth_m, !o.quiet);
   if (o.trajectory.empty())
-    return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m, o.hold_s, o.force_n);
+    return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m, o.hold_s, o.force_n, o.length_m);
   const Vector3 origin = o.frame == "scene" ? Vector3{0, 0, 0}
                                             : Vector3{0.5 * (scene.bounds_min[0] + scene.bounds_max[0]),
                                                       0.5 * (scene.bounds_min[1] + scene.bounds_max[1]), scene.bounds_max[2]};
@@ -235,7 +238,12 @@ void write_report(const Options& o, const std::string& scene, const std::string&
                    {"faded_t_s", run.faded_t_s},
                    {"server_returns", run.server_returns},
                    {"samples", to_json(run.samples)}};
-  if (o.watch_mesh) r["mesh"] = {{"frames", run.mesh.frames}, {"rate_hz", run.mesh.rate_hz()}, {"samples", run.mesh.samples}};
+  if (o.watch_mesh)
+    r["mesh"] = {{"frames", run.mesh.frames},
+                 {"rate_hz", run.mesh.rate_hz()},
+                 {"topology_generation", run.mesh.generation},
+                 {"surface_vertices", run.mesh.rest.size() / 3},
+                 {"samples", run.mesh.samples}};
   std::ofstream(o.report) << r.dump(1) << "\n";
 }
 
@@ -250,6 +258,8 @@ int main(int argc, char** argv) {
       "Script 'grasp': the grasper moves down to contact (plus DEPTH), closes its jaws, pulls up PULL, opens\n"
       "(with --hold: pulls up at 1 cm/s, holds HOLD seconds, then opens).\n"
       "Script 'hold': the probe presses until the force it feels is FORCE and holds it there (a force drill).\n"
+      "Script 'incise': the scalpel (instrument 4 of the bundled liver scenes) moves down to contact LENGTH/2 before the top\n"
+      "centre, holds its cut button, sinks DEPTH into the tissue, draws the blade LENGTH along +x and rises out (docs/CUTTING.md).\n"
       "Script 'palpate': the probe palpates the organ's top on a grid, pressing DEPTH beyond contact and judging each point\n"
       "by the force held still half way (deeper, a thin lobe bends away), and marks the centre of the stiff area\n"
       "around the stiffest place with button 1 (a palpation exercise; it never reads where the nodule is).\n"
@@ -268,7 +278,8 @@ int main(int argc, char** argv) {
   cl.flag("duration", "S", "length of the run [s] (default: 4 for scripts, the trajectory's length for --trajectory)");
   cl.flag("rate", "HZ", "device rate [Hz]", "1000");
   cl.flag("depth", "M", "how far to press beyond the first contact [m]", "0.03");
-  cl.flag("script", "NAME", "press | grasp | hold | palpate (above)", "press");
+  cl.flag("script", "NAME", "press | grasp | hold | palpate | incise (above)", "press");
+  cl.flag("length", "M", "incise script: the incision's length along x [m]", "0.04");
   cl.flag("pull", "M", "grasp script: how far to pull up after grasping [m]", "0.02");
   cl.flag("hold", "S", "grasp script: hold the pull this long, then open [s] (default: open at 75% of the run)");
   cl.flag("force", "N", "hold script: the force to hold [N]", "1.0");
@@ -308,7 +319,9 @@ int main(int argc, char** argv) {
         "haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
         rtt.samples, rtt.p50_us, rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()),
         static_cast<unsigned long long>(run.clamps), o.max_force_n);
-    if (o.watch_mesh) std::printf("haptic-client: %zu surface frames at %.1f Hz\n", run.mesh.frames, run.mesh.rate_hz());
+    if (o.watch_mesh)
+      std::printf("haptic-client: %zu surface frames at %.1f Hz; surface generation %u, %zu vertices\n", run.mesh.frames, run.mesh.rate_hz(),
+                  run.mesh.generation, run.mesh.rest.size() / 3);
     if (run.phased > 0)
       std::printf("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us\n", o.tick_phase_us,
                   static_cast<unsigned long long>(run.phased), 100.0 * static_cast<double>(run.near_phase) / static_cast<double>(run.phased));

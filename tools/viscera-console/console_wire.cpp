@@ -20,6 +20,7 @@ std::string encode_topology(const protocol::SurfaceTopology& t) {
   put<std::uint32_t>(out, 4, t.mesh_id);
   put<std::uint32_t>(out, 8, t.vertex_count);
   put<std::uint32_t>(out, 12, static_cast<std::uint32_t>(ni / 3));
+  put<std::uint32_t>(out, 16, t.topology_generation);
   std::memcpy(out.data() + kTopologyHeaderBytes, t.rest_positions.data(), 4 * nv);
   std::memcpy(out.data() + kTopologyHeaderBytes + 4 * nv, t.triangles.data(), 4 * ni);
   return out;
@@ -30,6 +31,7 @@ std::string encode_frame(const protocol::MeshFrame& m, double server_wall_ms) {
   out[0] = static_cast<char>(BinaryKind::frame);
   put<std::uint32_t>(out, 4, m.mesh_id);
   put<std::uint32_t>(out, 8, static_cast<std::uint32_t>(m.positions.size() / 3));
+  put<std::uint32_t>(out, 12, m.topology_generation);
   put<double>(out, 16, static_cast<double>(m.frame));
   put<double>(out, 24, m.sim_time_s);
   put<double>(out, 32, server_wall_ms);
@@ -40,7 +42,12 @@ std::string encode_frame(const protocol::MeshFrame& m, double server_wall_ms) {
 nlohmann::json to_json(const protocol::Scene& s) {
   nlohmann::json instruments = nlohmann::json::array();
   for (const auto& i : s.instruments)
-    instruments.push_back({{"id", i.instrument_id}, {"grasper", i.grasper}, {"tip_radius_m", i.tip_radius_m}, {"owner", i.owner_client_id}});
+    instruments.push_back({{"id", i.instrument_id},
+                           {"grasper", i.grasper},
+                           {"kind", i.scalpel ? "scalpel" : i.grasper ? "grasper" : "probe"},
+                           {"tip_radius_m", i.tip_radius_m},
+                           {"blade_length_m", i.blade_length_m},
+                           {"owner", i.owner_client_id}});
   nlohmann::json outcomes = nlohmann::json::array();
   for (const auto& o : s.recent_requests)
     outcomes.push_back({{"client_id", o.client_id}, {"action", protocol::action_name(o.action)}, {"accepted", o.accepted}, {"message", o.message}});

@@ -54,7 +54,7 @@ void Station::stream_loop() {
   client::StreamTap tap(domain_, partition_, streams, 256);
   ForceDecimator forces(force_period_s_);
   std::map<std::uint32_t, proto::Vector3> tips;
-  std::uint32_t mesh_id = 0, vertex_count = 0;
+  std::uint32_t mesh_id = 0, vertex_count = 0, topology_generation = 0;
   const auto now_s = [] { return 1e-9 * static_cast<double>(client::now_ns()); };
   while (!stop_) {
     tap.wait(std::chrono::milliseconds(5));
@@ -107,6 +107,7 @@ void Station::stream_loop() {
           if (const auto t = proto::decode_surface_topology(s.payload, &why)) {
             mesh_id = t->mesh_id;
             vertex_count = t->vertex_count;
+            topology_generation = t->topology_generation;
             auto m = std::make_shared<const std::string>(encode_topology(*t));
             {
               const std::lock_guard lock(mutex_);
@@ -118,8 +119,10 @@ void Station::stream_loop() {
           break;
         case proto::Stream::mesh_frame:
           if (const auto f = proto::decode_mesh_frame(s.payload, &why)) {
-            // A frame of another mesh than the topology's (a scene being swapped) waits for its own.
-            if (f->mesh_id != mesh_id || f->positions.size() != 3 * std::size_t{vertex_count}) break;
+            // A frame of another surface than the topology's (a scene being swapped, a cut whose
+            // topology is still on its way) waits for its own.
+            if (f->mesh_id != mesh_id || f->topology_generation != topology_generation || f->positions.size() != 3 * std::size_t{vertex_count})
+              break;
             auto m = std::make_shared<const std::string>(encode_frame(*f, 1e-6 * static_cast<double>(f->server_stamp_ns)));
             {
               const std::lock_guard lock(mutex_);

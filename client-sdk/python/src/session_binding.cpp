@@ -40,7 +40,9 @@ void bind_session(py::module_& m) {
       .value("lost", client::ServerState::lost);
   py::class_<protocol::InstrumentInfo>(m, "Instrument", "An instrument of the scene.")
       .def_readonly("instrument_id", &protocol::InstrumentInfo::instrument_id, "the instrument (the scene file's id)")
-      .def_readonly("grasper", &protocol::InstrumentInfo::grasper, "True for a grasper (jaws), False for a probe")
+      .def_readonly("grasper", &protocol::InstrumentInfo::grasper, "True for a grasper (jaws)")
+      .def_readonly("scalpel", &protocol::InstrumentInfo::scalpel, "True for a scalpel (its blade cuts while button 1 is held)")
+      .def_readonly("blade_length_m", &protocol::InstrumentInfo::blade_length_m, "A scalpel's blade [m] (0 for other instruments)")
       .def_readonly("tip_radius_m", &protocol::InstrumentInfo::tip_radius_m, "[m] radius of the tip sphere")
       .def_readonly("owner_client_id", &protocol::InstrumentInfo::owner_client_id, "0: free");
   py::class_<protocol::MaterialInfo>(m, "Material", "The organ's material as the scene state shows it (SI).")

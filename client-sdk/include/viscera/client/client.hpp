@@ -100,11 +100,13 @@ class Client {
   /// stamp, DDS time [ns]), for keeping a loop in phase with the physics (tick_phase.hpp).
   std::optional<std::int64_t> last_tick_end_ns(std::uint32_t instrument_id) const;
 
-  /// The organ's boundary surface (triangles, rest positions), once it has arrived. The first
-  /// call subscribes this client to the mesh streams; clients that never call it receive none.
+  /// The organ's boundary surface (triangles, rest positions), once it has arrived: the newest,
+  /// which changes when the organ is cut (its topology_generation). The first call subscribes
+  /// this client to the mesh streams; clients that never call it receive none.
   std::optional<protocol::SurfaceTopology> surface();
   /// The newest surface frame that arrived since the last call, checked against the topology
-  /// (frames of another mesh_id or with another vertex count are dropped and counted).
+  /// (frames of another mesh_id or with another vertex count are dropped and counted; frames of
+  /// another topology generation, a cut on its way, are dropped silently).
   std::optional<protocol::MeshFrame> poll_mesh_frame();
   std::uint64_t mesh_frames_received() const { return mesh_frames_; }
 

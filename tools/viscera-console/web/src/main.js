@@ -9,7 +9,7 @@ import './style.css';
 
 const state = (window.viscera = {
   connected: false, stations: [], station: '', scene: null, telemetry: null, settings: { force_limit_n: 3 },
-  topologyVertices: 0, framesReceived: 0, frame: -1, maxDisplacementM: 0, latenciesMs: [],
+  topologyVertices: 0, topologyGeneration: 0, topologyTriangles: 0, meshId: -1, framesReceived: 0, frame: -1, maxDisplacementM: 0, latenciesMs: [],
   forcePeakN: 0, forceSummaries: 0, events: [], replies: [], errors: [], held: [], tips: {},
 });
 
@@ -59,9 +59,10 @@ function fitCamera(min, max) {
 
 function onTopology(buf) {
   const dv = new DataView(buf);
-  const nv = dv.getUint32(8, true), nt = dv.getUint32(12, true);
-  rest = new Float32Array(buf, 16, 3 * nv);
-  const index = new Uint32Array(buf, 16 + 12 * nv, 3 * nt);
+  const meshId = dv.getUint32(4, true), nv = dv.getUint32(8, true), nt = dv.getUint32(12, true);
+  const generation = dv.getUint32(16, true);
+  rest = new Float32Array(buf, 24, 3 * nv);
+  const index = new Uint32Array(buf, 24 + 12 * nv, 3 * nt);
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(rest), 3));
   geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(index), 1));
@@ -70,17 +71,23 @@ function onTopology(buf) {
   organ = new THREE.Mesh(geometry, organMaterial);
   scene3.add(organ);
   state.topologyVertices = nv;
+  state.topologyGeneration = generation;
+  state.topologyTriangles = nt;
   state.maxDisplacementM = 0;
-  geometry.computeBoundingBox();
-  const b = geometry.boundingBox;
-  fitCamera(b.min.toArray(), b.max.toArray());
+  // A cut (the same mesh, a later generation) keeps the view; another organ is framed anew.
+  if (meshId !== state.meshId) {
+    geometry.computeBoundingBox();
+    const b = geometry.boundingBox;
+    fitCamera(b.min.toArray(), b.max.toArray());
+  }
+  state.meshId = meshId;
 }
 
 function onFrame(buf) {
   if (!organ) return;
   const dv = new DataView(buf);
   const nv = dv.getUint32(8, true);
-  if (nv !== state.topologyVertices) return;
+  if (nv !== state.topologyVertices || dv.getUint32(12, true) !== state.topologyGeneration) return;
   const positions = new Float32Array(buf, 40, 3 * nv);
   organ.geometry.attributes.position.array.set(positions);
   organ.geometry.attributes.position.needsUpdate = true;
@@ -102,11 +109,11 @@ function onFrame(buf) {
   dirty = true;
 }
 
-function toolFor(id, radius, grasper) {
+function toolFor(id, radius, kind) {
   let t = tools.get(id);
   if (t) return t;
   const group = new THREE.Group();
-  const metal = new THREE.MeshStandardMaterial({ color: grasper ? 0x9fb7d0 : 0xd0d4da, metalness: 0.6, roughness: 0.35 });
+  const metal = new THREE.MeshStandardMaterial({ color: kind === 'grasper' ? 0x9fb7d0 : kind === 'scalpel' ? 0xe8c07a : 0xd0d4da, metalness: 0.6, roughness: 0.35 });
   const tip = new THREE.Mesh(new THREE.SphereGeometry(radius, 24, 16), metal);
   const shaft = new THREE.Mesh(new THREE.CylinderGeometry(radius * 0.45, radius * 0.45, 0.12, 16), metal);
   shaft.rotation.x = Math.PI / 2;
@@ -218,7 +225,7 @@ function renderInstruments() {
     const mine = i.owner === me && state.held.includes(i.id);
     const button = mine ? `<button data-hand-back="${i.id}" title="Give the instrument back to the trainee it was taken from">Hand back</button>`
       : `<button data-take-over="${i.id}" title="Take the instrument from its owner (no moment without one) and drive it from here">Take over</button>`;
-    return `<tr><td>${i.id}</td><td>${i.grasper ? 'grasper' : 'probe'}</td><td>${i.owner === me ? 'this console' : i.owner ? `client ${i.owner}` : '<span class="dim">free</span>'}</td>` +
+    return `<tr><td>${i.id}</td><td>${i.kind}</td><td>${i.owner === me ? 'this console' : i.owner ? `client ${i.owner}` : '<span class="dim">free</span>'}</td>` +
       `<td data-force="${i.id}"></td><td>${button}</td></tr>`;
   }).join('');
   if (html !== instrumentRows) { $('instruments').tBodies[0].innerHTML = html; instrumentRows = html; }
@@ -264,7 +271,7 @@ function onScene(s) {
   const badge = $('state');
   badge.textContent = s.paused ? 'paused' : 'live';
   badge.className = 'badge ' + (s.paused ? 'paused' : 'live');
-  for (const i of s.instruments) toolFor(i.id, i.tip_radius_m, i.grasper);
+  for (const i of s.instruments) toolFor(i.id, i.tip_radius_m, i.kind);
   // An instrument no longer this console's (its lease lost, a scene loaded) is no longer driven.
   state.held = state.held.filter((id) => s.instruments.some((i) => i.id === id && i.owner === state.settings.client_id));
   if (first) {

@@ -53,6 +53,7 @@ struct ExpectedFrame {
   std::uint64_t digest = 0;  ///< FNV-1a of the positions' bytes
   std::size_t vertex_count = 0;
   std::uint64_t log_time_ns = 0;
+  std::uint32_t topology_generation = 0;  ///< the surface's (cuts change it)
 };
 
 struct LockstepPlan {

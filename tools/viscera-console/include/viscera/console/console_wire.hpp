@@ -16,7 +16,10 @@ namespace viscera::console {
 /// Binary message kinds (the first byte).
 enum class BinaryKind : std::uint8_t { topology = 1, frame = 2 };
 /// Bytes before the arrays of a binary message (a multiple of 8, so the page's typed views align).
-inline constexpr std::size_t kTopologyHeaderBytes = 16;
+/// Topology: kind at 0, mesh_id at 4, vertex count at 8, triangle count at 12, topology
+/// generation at 16; frame: kind at 0, mesh_id at 4, vertex count at 8, topology generation at 12,
+/// frame number at 16, simulated time at 24, server wall time [ms] at 32 (doubles).
+inline constexpr std::size_t kTopologyHeaderBytes = 24;
 inline constexpr std::size_t kFrameHeaderBytes = 40;
 
 /// [u8 kind=1, 3 pad][u32 mesh_id][u32 vertex_count][u32 triangle_count]
