@@ -5,6 +5,10 @@
 //    memory carried); counters give the time per sweep (median, p99, max) and the most
 //    tetrahedra one sweep made.
 //  - BM_RebuildAfterCut: the alternative, the model built again for the whole cut organ.
+//  - BM_ServerSweep: the same stroke through the server's organ of the bundled scene (liver.json,
+//    liver-12k.json) as a scalpel cuts it between ticks (runtime::cut_organ): the topology, the
+//    model, the explicit integrator (masses, the step rule), the boundary surface and the
+//    contacts' surface, everything a tick pays for a sweep.
 // Run: build/bench/cut_bench (or bench/run.sh, which runs every benchmark).
 #include <algorithm>
 #include <chrono>
@@ -14,6 +18,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/organ_cutting.hpp"
 #include "viscera/tissue/cutting/mesh_cutter.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/boundary_conditions.hpp"
@@ -141,8 +147,44 @@ void BM_RebuildAfterCut(benchmark::State& state) {
   state.counters["tets"] = static_cast<double>(m.tets.size());
 }
 
+void BM_ServerSweep(benchmark::State& state) {
+  const std::string scene_file = state.range(0) == 0 ? "liver.json" : "liver-12k.json";
+  std::vector<double> t;
+  std::size_t tets_before = 0, tets_after = 0, generation = 0;
+  double added_kg = 0, organ_kg = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto organ = viscera::runtime::build_organ(viscera::runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_file));
+    State s = State::at_rest(*organ->mesh);
+    organ->integrator->step(s);  // the memory variables in use, as in a running server
+    viscera::runtime::reserve_for_cuts(*organ, s);
+    const Stroke stroke(*organ->mesh);
+    tets_before = organ->mesh->tet_count();
+    for (const double m : organ->integrator->masses()) organ_kg += m;
+    state.ResumeTiming();
+    for (int k = 0; k < stroke.ticks; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto out = viscera::runtime::cut_organ(*organ, stroke.sweep(k), s, 0);
+      t.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+      added_kg += out.added_mass_kg;
+    }
+    tets_after = organ->mesh->tet_count();
+    generation = organ->topology_generation;
+  }
+  std::sort(t.begin(), t.end());
+  state.counters["sweeps"] = static_cast<double>(t.size());
+  state.counters["sweep_p50_us"] = t[t.size() / 2];
+  state.counters["sweep_p99_us"] = t[static_cast<std::size_t>(0.99 * static_cast<double>(t.size() - 1))];
+  state.counters["sweep_max_us"] = t.back();
+  state.counters["tets_before"] = static_cast<double>(tets_before);
+  state.counters["tets_after"] = static_cast<double>(tets_after);
+  state.counters["surface_changes"] = static_cast<double>(generation);
+  state.counters["inertia_added_pct"] = 100.0 * added_kg / organ_kg;
+}
+
 }  // namespace
 
+BENCHMARK(BM_ServerSweep)->Arg(0)->Arg(1)->ArgName("scene_level")->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_CutStroke)->Arg(0)->Arg(1)->ArgName("liver_level")->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_RebuildAfterCut)->Arg(0)->Arg(1)->ArgName("liver_level")->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

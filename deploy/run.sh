@@ -9,7 +9,9 @@
 # receives; the console what the server did, and the server's health reports while the probe presses again.
 # Then the liver takes the tissue viscera-lab fitted to the bundled titin data, and the lab's linear
 # baseline for it, one after the other (viscera-control material --file); the probe presses each,
-# and viscera-plot draws both force curves in out/titin-vs-linear.svg.
+# and viscera-plot draws both force curves in out/titin-vs-linear.svg. Last, a scalpel cuts an
+# incision along the organ's top and a probe presses on it (the cut is on the console, and in the
+# recording, whose re-simulation reproduces it bit for bit).
 # viscera-record records the whole session to out/demo.mcap; at the end the demo prints the
 # recording's summary and re-runs the session on a fresh server in lockstep, bit for bit, and the
 # Python package reads it into DataFrames (examples/python/analyse_session.py, out/demo-session.png).
@@ -65,6 +67,12 @@ done
 "$bin/tools/viscera-plot/viscera-plot" "$root/out/press-titin-fitted.json=titin as fitted (spectrum, stiffening)" \
   "$root/out/press-titin-linear.json=its linear baseline (Kelvin-Voigt)" --svg "$root/out/titin-vs-linear.svg" \
   --title "The same 2 cm press on the liver's shape: titin as fitted against its linear baseline" 2>&1 | sed -u 's/^/[plot] /'
+echo "[demo] scalpel 4 cuts a 6 cm incision 1.5 cm deep along the top of the organ (4 s; the console shows it open), then probe 2"
+echo "[demo] presses 1 cm on the incision's line (3 s): the cut's lips part under it (docs/CUTTING.md)"
+"$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 3 --instrument 4 --script incise --depth 0.015 --length 0.06 \
+  --duration 4 --watch-mesh 2>&1 | sed -u 's/^/[haptic] /'
+"$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 4 --instrument 2 --script press --depth 0.01 --duration 3 \
+  --watch-mesh 2>&1 | sed -u 's/^/[haptic] /'
 if [ -n "${KEEP:-}" ]; then
   echo "[demo] done; the server and the console keep running (KEEP=1): open the console's address above; Ctrl-C ends them"
   wait "$server" || true

@@ -242,6 +242,15 @@ const Message* add_row(RecordingTables& out, Stream s, const RecordedChannel& ch
 void add_frame(RecordingTables& out, const mcap::Message& m, const protocol::MeshFrame& f, std::uint64_t expected) {
   FrameSeries& s = out.frames[f.mesh_id];
   s.mesh_id = f.mesh_id;
+  if (!s.generation_known) {
+    s.topology_generation = f.topology_generation;
+    s.generation_known = true;
+  }
+  s.last_topology_generation = std::max(s.last_topology_generation, f.topology_generation);
+  if (f.topology_generation != s.topology_generation) {  // the surface after a cut: another series
+    ++s.later_generation_frames;
+    return;
+  }
   const auto n = static_cast<std::uint32_t>(f.positions.size() / 3);
   if (s.frame.empty() && s.vertex_count == 0) s.vertex_count = n;
   if (s.frame.empty()) try {
@@ -262,6 +271,12 @@ void add_frame(RecordingTables& out, const mcap::Message& m, const protocol::Mes
 void add_topology(RecordingTables& out, const protocol::SurfaceTopology& t) {
   FrameSeries& s = out.frames[t.mesh_id];
   s.mesh_id = t.mesh_id;
+  if (!s.generation_known) {
+    s.topology_generation = t.topology_generation;
+    s.generation_known = true;
+  }
+  s.last_topology_generation = std::max(s.last_topology_generation, t.topology_generation);
+  if (t.topology_generation != s.topology_generation) return;
   if (s.frame.empty()) s.vertex_count = t.vertex_count;
   s.triangles = t.triangles;
   s.rest_positions = t.rest_positions;

@@ -28,6 +28,14 @@ void enable_cutting(Organ& organ) {
   organ.cutter = std::make_unique<MeshCutter>(*organ.mesh);
 }
 
+void reserve_for_cuts(const Organ& organ, State& state) {
+  if (!organ.cutter) return;
+  const std::size_t elements = organ.mesh->tets.capacity(), nodes = organ.mesh->nodes.capacity();
+  state.memory.reserve(gps_of(const_cast<Organ&>(organ))->memory_size_for(elements));
+  state.x.reserve(nodes);
+  state.v.reserve(nodes);
+}
+
 bool can_cut(const Organ& organ) { return organ.cutter != nullptr; }
 
 SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std::int32_t stroke) {

@@ -11,6 +11,7 @@
 
 #include <pthread.h>
 
+#include "viscera/runtime/organ_cutting.hpp"
 #include "viscera/runtime/tick_grid.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 
@@ -64,6 +65,7 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
       strokes = 0;
       topology_to_publish = false;
       state = State::at_rest(*organ->mesh);
+      reserve_for_cuts(*organ, state);
       if (old) ++generation;
       loaded.first_tick = current_tick();
       loaded.sim_time_s = sim_time_s;
@@ -93,6 +95,7 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
 /// The organ back at rest (memory variables relaxed); graspers let go.
 void SimulationServer::Impl::reset_organ() {
   state = State::at_rest(*organ->mesh);
+  reserve_for_cuts(*organ, state);
   for (auto& [id, t] : tools) {
     t.tool.let_go();
     if (t.tool.active()) start_outside(t);

@@ -38,6 +38,9 @@ py::dict frames_dict(recording::FrameSeries& s) {
   d["mesh_id"] = s.mesh_id;
   d["vertex_count"] = s.vertex_count;
   d["mismatched"] = s.mismatched;
+  d["topology_generation"] = s.topology_generation;
+  d["later_generation_frames"] = s.later_generation_frames;
+  d["last_topology_generation"] = s.last_topology_generation;
   d["positions"] = owning_array(std::move(s.positions), {n, v, 3});
   d["log_time_ns"] = owning_array(std::move(s.log_time_ns));
   d["frame"] = owning_array(std::move(s.frame));

@@ -33,7 +33,10 @@ class Frames:
     positions: (n_frames, n_vertices, 3) float32 [m]; log_time_ns, frame, tick, sim_time_s: one per
     frame; triangles: (n_triangles, 3) vertex indices; rest_positions: (n_vertices, 3) float32 [m]
     (both empty if the topology was not recorded); mismatched: frames dropped for another vertex
-    count. Arrays are read-only and own their memory.
+    count. A scalpel's cut changes the surface (docs/CUTTING.md): the frames are those of one
+    topology_generation, the first recorded; later_generation_frames counts the frames left out
+    (of a cut surface) and last_topology_generation is the newest seen. Arrays are read-only and
+    own their memory.
     """
 
     mesh_id: int
@@ -45,6 +48,9 @@ class Frames:
     triangles: npt.NDArray[np.uint32]
     rest_positions: npt.NDArray[np.float32]
     mismatched: int
+    topology_generation: int = 0
+    later_generation_frames: int = 0
+    last_topology_generation: int = 0
 
 
 class Recording:
@@ -121,6 +127,9 @@ class Recording:
                     triangles=f["triangles"],
                     rest_positions=f["rest_positions"],
                     mismatched=int(f["mismatched"]),
+                    topology_generation=int(f["topology_generation"]),
+                    later_generation_frames=int(f["later_generation_frames"]),
+                    last_topology_generation=int(f["last_topology_generation"]),
                 )
         return self._tables
 

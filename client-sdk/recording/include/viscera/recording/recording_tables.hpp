@@ -42,6 +42,12 @@ struct FrameSeries {
   std::vector<double> sim_time_s;
   std::vector<float> positions;  ///< [m] frame-major: frame k's vertex i at 3 * (k * vertex_count + i)
   std::uint64_t mismatched = 0;  ///< frames dropped: another vertex count than the series' first
+  /// The topology generation the series holds: the first seen of this mesh (0 as loaded); a cut
+  /// makes later ones (docs/CUTTING.md).
+  std::uint32_t topology_generation = 0;
+  std::uint64_t later_generation_frames = 0;  ///< frames left out: of a later topology generation (after a cut)
+  std::uint32_t last_topology_generation = 0;  ///< the newest generation seen
+  bool generation_known = false;
 };
 
 struct RecordingTables {

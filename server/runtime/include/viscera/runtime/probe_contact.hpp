@@ -1,7 +1,8 @@
 #pragma once
 // Contact of a sphere-tipped probe with the organ's boundary triangles (docs/HAPTICS.md, "Probe").
 // For every triangle, the closest point q to the tip centre c and the signed distance
-// s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r.
+// s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r
+// (at an edge or corner of the triangle, by r - |c - q|: what the sphere overlaps there).
 // The contact is one penalty spring k at the deepest penetration d, its force k d shared among
 // the touched triangles in proportion to their depths, so it does not depend on how finely the
 // surface is meshed. A normal dashpot (Hunt-Crossley: k d (1 + alpha rate)) adds, for each touched
