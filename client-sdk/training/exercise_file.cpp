@@ -1,3 +1,6 @@
+#include <cmath>
+#include <utility>
+
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/plain_name.hpp"
@@ -12,6 +15,7 @@ const char* kind_name(ExerciseKind k) {
     case ExerciseKind::palpation: return "palpation";
     case ExerciseKind::retraction: return "retraction";
     case ExerciseKind::force_drill: return "force_drill";
+    case ExerciseKind::incision: return "incision";
   }
   return "?";
 }
@@ -20,7 +24,8 @@ namespace {
 
 Exercise read(const nlohmann::json& j, const std::string& source) {
   const JsonObject top(j, source);
-  top.require_known({"name", "description", "kind", "scene", "instrument", "time_limit_s", "limits", "palpation", "retraction", "force_drill"});
+  top.require_known(
+      {"name", "description", "kind", "scene", "instrument", "time_limit_s", "limits", "palpation", "retraction", "force_drill", "incision"});
   Exercise e;
   e.source = source;
   e.name = top.text("name");
@@ -28,9 +33,12 @@ Exercise read(const nlohmann::json& j, const std::string& source) {
   if (!common::is_plain_name(e.name))
     top.fail("name", "'" + common::printable(e.name, 80) + "' is not a plain name (" + common::kPlainNameRule + ")");
   e.description = top.text("description", "");
-  const std::string kind = top.choice("kind", {"palpation", "retraction", "force_drill"}, "");
-  if (kind.empty()) top.fail("kind", "missing: one of palpation, retraction, force_drill");
-  e.kind = kind == "palpation" ? ExerciseKind::palpation : kind == "retraction" ? ExerciseKind::retraction : ExerciseKind::force_drill;
+  const std::string kind = top.choice("kind", {"palpation", "retraction", "force_drill", "incision"}, "");
+  if (kind.empty()) top.fail("kind", "missing: one of palpation, retraction, force_drill, incision");
+  e.kind = kind == "palpation"    ? ExerciseKind::palpation
+           : kind == "retraction" ? ExerciseKind::retraction
+           : kind == "incision"   ? ExerciseKind::incision
+                                  : ExerciseKind::force_drill;
   e.scene = top.text("scene");
   if (!common::is_plain_name(e.scene))
     top.fail("scene",
@@ -44,7 +52,7 @@ Exercise read(const nlohmann::json& j, const std::string& source) {
     e.edge_strain_limit = l.number("edge_strain", 0.001, 5, e.edge_strain_limit);
   }
   // The kind's own block, and no other kind's.
-  for (const char* other : {"palpation", "retraction", "force_drill"})
+  for (const char* other : {"palpation", "retraction", "force_drill", "incision"})
     if (kind != other && top.has(other)) top.fail(other, std::string("belongs to a ") + other + " exercise, not a " + kind + " one");
   if (e.kind == ExerciseKind::palpation && top.has("palpation")) {
     const JsonObject p = top.object("palpation");
@@ -73,7 +81,24 @@ Exercise read(const nlohmann::json& j, const std::string& source) {
         f.fail("force_n", "the band's top exceeds limits.peak_force_n (" + std::to_string(e.peak_force_limit_n) + " N): the drill could not pass");
     }
   }
-  if (e.hold_s >= e.time_limit_s) top.fail("time_limit_s", "must leave time for the hold of " + std::to_string(e.hold_s) + " s");
+  if (e.kind == ExerciseKind::incision && top.has("incision")) {
+    const JsonObject c = top.object("incision");
+    c.require_known({"from_m", "to_m", "depth_m", "depth_tolerance_m", "line_tolerance_m", "length_tolerance_m"});
+    for (const auto& [field, point] : {std::pair{"from_m", &e.incision_from}, std::pair{"to_m", &e.incision_to}}) {
+      if (!c.has(field)) continue;
+      const auto v = c.numbers(field, 2, -0.5, 0.5);
+      *point = {v[0], v[1]};
+    }
+    e.incision_depth_m = c.number("depth_m", 0.001, 0.1, e.incision_depth_m);
+    e.depth_tolerance_m = c.number("depth_tolerance_m", 1e-4, 0.05, e.depth_tolerance_m);
+    e.line_tolerance_m = c.number("line_tolerance_m", 1e-4, 0.05, e.line_tolerance_m);
+    e.length_tolerance_m = c.number("length_tolerance_m", 1e-4, 0.2, e.length_tolerance_m);
+    if (std::hypot(e.incision_to[0] - e.incision_from[0], e.incision_to[1] - e.incision_from[1]) < 0.005)
+      c.fail("to_m", "the line is shorter than 5 mm");
+    if (e.depth_tolerance_m >= e.incision_depth_m) c.fail("depth_tolerance_m", "must be smaller than depth_m");
+  }
+  if (e.kind != ExerciseKind::incision && e.hold_s >= e.time_limit_s)
+    top.fail("time_limit_s", "must leave time for the hold of " + std::to_string(e.hold_s) + " s");
   return e;
 }
 

@@ -75,6 +75,7 @@ void ExerciseScorer::take(proto::Stream stream, std::span<const std::uint8_t> pa
       if (const auto s = proto::decode_scene(payload, &why)) {
         if (s->name != exercise_.scene) return;
         rate_hz_ = s->physics_rate_hz;
+        top_ = proto::Vector3{0.5 * (s->bounds_min[0] + s->bounds_max[0]), 0.5 * (s->bounds_min[1] + s->bounds_max[1]), s->bounds_max[2]};
         for (const auto& g : s->regions)
           if (g.name == exercise_.target_region) target_ = g;
       } else {
@@ -161,7 +162,9 @@ void ExerciseScorer::process_force(const proto::Force& f, const std::optional<pr
   if (f.in_contact) {
     contact_force_sum_ += F;
     ++contact_samples_;
+    if (!in_contact_) touch_z_ = f.contact_point[2];  // where this contact began
   }
+  in_contact_ = f.in_contact;
   if (F > exercise_.peak_force_limit_n) {
     if (f.tick != last_above_tick_) r_.time_above_force_limit_s += seconds(0, 1);
     last_above_tick_ = f.tick;
@@ -180,7 +183,8 @@ void ExerciseScorer::process_force(const proto::Force& f, const std::optional<pr
   // The task's own progress.
   bool holding = false;
   switch (exercise_.kind) {
-    case ExerciseKind::palpation: break;
+    case ExerciseKind::palpation:
+    case ExerciseKind::incision: break;
     case ExerciseKind::force_drill: holding = std::abs(F - exercise_.target_force_n) <= exercise_.force_tolerance_n; break;
     case ExerciseKind::retraction:
       if (grasped_ && last_tip_) {
@@ -189,7 +193,7 @@ void ExerciseScorer::process_force(const proto::Force& f, const std::optional<pr
       }
       break;
   }
-  if (exercise_.kind == ExerciseKind::palpation) return;
+  if (exercise_.kind == ExerciseKind::palpation || exercise_.kind == ExerciseKind::incision) return;
   if (!holding) {
     hold_start_.reset();
     announced_hold_s_ = 0;
@@ -222,6 +226,11 @@ void ExerciseScorer::walk_commands(const proto::Command& c, const proto::Force& 
     walked_ = {client, k.seq};
     const bool pressed = (k.buttons & kMarkButton) && !(buttons & kMarkButton);
     buttons = k.buttons;
+    if (exercise_.kind == ExerciseKind::incision) {
+      walk_incision(k, f.tick);
+      if (ended_) return;
+      continue;
+    }
     if (pressed && exercise_.kind == ExerciseKind::palpation) {
       // The place marked is where the tool touches the tissue (the contact point of the force
       // being processed, a few milliseconds after the press at most), not the tip's centre,
@@ -237,6 +246,39 @@ void ExerciseScorer::walk_commands(const proto::Command& c, const proto::Force& 
       return;
     }
   }
+}
+
+void ExerciseScorer::walk_incision(const proto::Command& k, std::uint64_t tick) {
+  const bool held = (k.buttons & kMarkButton) != 0;
+  if (held && !cutting_) {
+    cutting_ = true;
+    // The surface is where the blade's last contact before cutting began (the tissue pressed
+    // since has moved down with it), or the top of the organ's box if it touched nothing.
+    if (!surface_z_) surface_z_ = touch_z_ ? touch_z_ : top_ ? std::optional<double>((*top_)[2]) : std::nullopt;
+    say(format("cutting at %.1f s", seconds(*start_tick_, tick)));
+  }
+  if (!held) {
+    if (cutting_ && cut_samples_ > 0) end(tick, true, "incision made");
+    cutting_ = false;
+    return;
+  }
+  if (!surface_z_ || !top_) return;
+  const double depth = *surface_z_ - k.tip_position[2];
+  if (depth <= 0) return;  // the blade's tip above the surface: not cutting yet
+  // The line in the horizontal plane: the tip's place along it and its distance across it.
+  const double ax = (*top_)[0] + exercise_.incision_from[0], ay = (*top_)[1] + exercise_.incision_from[1];
+  const double dx = exercise_.incision_to[0] - exercise_.incision_from[0], dy = exercise_.incision_to[1] - exercise_.incision_from[1];
+  const double length = std::hypot(dx, dy), ux = dx / length, uy = dy / length;
+  const double px = k.tip_position[0] - ax, py = k.tip_position[1] - ay;
+  const double along = px * ux + py * uy, across = std::abs(px * uy - py * ux);
+  along_min_ = cut_samples_ == 0 ? along : std::min(along_min_, along);
+  along_max_ = cut_samples_ == 0 ? along : std::max(along_max_, along);
+  ++cut_samples_;
+  depth_sum_ += depth;
+  r_.incision_length_m = along_max_ - along_min_;
+  r_.incision_deviation_m = std::max(r_.incision_deviation_m, across);
+  r_.incision_max_depth_m = std::max(r_.incision_max_depth_m, depth);
+  r_.incision_mean_depth_m = depth_sum_ / static_cast<double>(cut_samples_);
 }
 
 void ExerciseScorer::end(std::uint64_t tick, bool completed, const std::string& how) {
@@ -272,9 +314,25 @@ ScoreReport ExerciseScorer::report() const {
           format("the wrong place was marked: %.1f mm from the nodule (at most %.1f mm)", 1e3 * *r.mark_distance_m,
                  1e3 * exercise_.mark_tolerance_m));
   }
+  if (exercise_.kind == ExerciseKind::incision) {
+    const double target = std::hypot(exercise_.incision_to[0] - exercise_.incision_from[0], exercise_.incision_to[1] - exercise_.incision_from[1]);
+    if (!r.incision_length_m) {
+      add("incision", 0, 0, "", false, "no incision was made (the scalpel's cut button held with its tip below the surface)");
+    } else {
+      const double dl = std::abs(*r.incision_length_m - target), dd = std::abs(r.incision_mean_depth_m - exercise_.incision_depth_m);
+      add("line", r.incision_deviation_m, exercise_.line_tolerance_m, "m", r.incision_deviation_m <= exercise_.line_tolerance_m,
+          format("off the line: %.1f mm at the most (at most %.1f mm)", 1e3 * r.incision_deviation_m, 1e3 * exercise_.line_tolerance_m));
+      add("depth error", dd, exercise_.depth_tolerance_m, "m", dd <= exercise_.depth_tolerance_m,
+          format("%.1f mm deep on average, %.1f mm asked", 1e3 * r.incision_mean_depth_m, 1e3 * exercise_.incision_depth_m) +
+              format(" (within %.1f mm)", 1e3 * exercise_.depth_tolerance_m));
+      add("length error", dl, exercise_.length_tolerance_m, "m", dl <= exercise_.length_tolerance_m,
+          format("%.1f mm long, %.1f mm asked", 1e3 * *r.incision_length_m, 1e3 * target) +
+              format(" (within %.1f mm)", 1e3 * exercise_.length_tolerance_m));
+    }
+  }
   if (exercise_.kind == ExerciseKind::retraction)
     add("drops", r.drops, 0, "", r.drops == 0, "the lobe was dropped " + std::to_string(r.drops) + " time(s) before the hold was complete");
-  if (exercise_.kind != ExerciseKind::palpation)
+  if (exercise_.kind == ExerciseKind::retraction || exercise_.kind == ExerciseKind::force_drill)
     add("longest hold", r.longest_hold_s, exercise_.hold_s, "s", r.longest_hold_s >= exercise_.hold_s,
         exercise_.kind == ExerciseKind::force_drill ? format("the force was held in %.2f +- %.2f N for at most %.1f s", exercise_.target_force_n,
                                                              exercise_.force_tolerance_n, r.longest_hold_s) +

@@ -39,7 +39,11 @@ nlohmann::json to_json(const ScoreReport& r) {
             {"drops", r.drops},
             {"mark_m", point(r.mark_m)},
             {"target_m", point(r.target_m)},
-            {"mark_distance_m", r.mark_distance_m ? nlohmann::json(*r.mark_distance_m) : nlohmann::json()}}},
+            {"mark_distance_m", r.mark_distance_m ? nlohmann::json(*r.mark_distance_m) : nlohmann::json()},
+            {"incision_length_m", r.incision_length_m ? nlohmann::json(*r.incision_length_m) : nlohmann::json()},
+            {"incision_deviation_m", r.incision_deviation_m},
+            {"incision_mean_depth_m", r.incision_mean_depth_m},
+            {"incision_max_depth_m", r.incision_max_depth_m}}},
           {"criteria", criteria},
           {"failures", r.failures}};
 }
@@ -66,6 +70,11 @@ std::string to_markdown(const ScoreReport& r) {
                 "%.3f; longest hold %.1f s.\n",
                 r.path_length_m, r.peak_force_n, r.mean_contact_force_n, r.time_above_force_limit_s, r.max_edge_strain, r.longest_hold_s);
   s += b;
+  if (r.incision_length_m) {
+    std::snprintf(b, sizeof b, "Incision %.1f mm long, %.1f mm deep on average (%.1f mm at most), at most %.1f mm off the line.\n",
+                  1e3 * *r.incision_length_m, 1e3 * r.incision_mean_depth_m, 1e3 * r.incision_max_depth_m, 1e3 * r.incision_deviation_m);
+    s += b;
+  }
   if (r.mark_distance_m) {
     std::snprintf(b, sizeof b, "Mark %.1f mm from the target's surface.\n", 1e3 * *r.mark_distance_m);
     s += b;

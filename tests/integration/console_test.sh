@@ -57,7 +57,8 @@ sleep 1
 "$build/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script hold --force 1.2 --duration 150 --reconnect --quiet \
   > "$tmp/haptic.log" 2>&1 & pids+=($!)
 shots="${SHOTS:-$tmp}"; mkdir -p "$shots"
-node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
+HAPTIC_CLIENT="$build/tools/haptic-client/haptic-client" \
+  node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
 check "the page in Chromium (console_page.mjs)" '[ $rc_page -eq 0 ]'
 kill -INT "$recorder"; wait "$recorder"
 node "$node_dir/console_replay.mjs" "$url" session.mcap > "$tmp/replay.json"; rc_replay=$?

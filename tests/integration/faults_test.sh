@@ -165,7 +165,7 @@ t0=$(now)
 claim_s=$(python3 -c "print(round($(now) - $t0, 2))")
 cat "$tmp/claim.log"
 check "a claim of instrument 7 is refused at once ($claim_s s), listing the scene's instruments (rc $rc_claim)" \
-  "[ $rc_claim -eq 3 ] && grep -q 'scene liver has no instrument 7 (its instruments: 1 (probe), 2 (probe), 3 (grasper))' '$tmp/claim.log' && python3 -c 'import sys; sys.exit(not $claim_s < 2)'"
+  "[ $rc_claim -eq 3 ] && grep -q 'scene liver has no instrument 7 (its instruments: 1 (probe), 2 (probe), 3 (grasper), 4 (scalpel))' '$tmp/claim.log' && python3 -c 'import sys; sys.exit(not $claim_s < 2)'"
 lines_before=$(grep -c 'Hz physics' "$tmp/server-bad.log")
 sleep 1.2
 check "the server runs on (alive, still reporting)" "kill -0 $server && [ \$(grep -c 'Hz physics' '$tmp/server-bad.log') -gt $lines_before ]"

@@ -2,7 +2,7 @@
 # Integration, separate processes over a real DDS domain: each exercise (docs/TRAINING.md) run by
 # viscera-trainer on a live server, performed by a scripted haptic client once well and once
 # badly, and recorded by viscera-record. The good performance passes, the bad one fails for the
-# right named reason (too much force, the lobe dropped, the wrong place marked), and the score
+# right named reason (too much force, the lobe dropped, off the incision's line, the wrong place marked), and the score
 # computed afterwards from the recording equals the live one in every number. The good palpation
 # is performed by a client that searches by touch (the forces it feels), never by reading the
 # scene, and must mark the nodule.
@@ -28,7 +28,7 @@ done
 ex="$tmp/exercises"; mkdir -p "$ex"
 python3 - "$src/data/exercises" "$ex" <<'PY'
 import json, sys
-for name, limit in (("force-drill", 20), ("force-drill-titin", 20), ("retraction", 15), ("palpation", 90)):
+for name, limit in (("force-drill", 20), ("force-drill-titin", 20), ("retraction", 15), ("palpation", 90), ("incision", 20)):
     e = json.load(open(f"{sys.argv[1]}/{name}.json"))
     e["time_limit_s"] = limit
     json.dump(e, open(f"{sys.argv[2]}/{name}.json", "w"), indent=1)
@@ -60,6 +60,10 @@ perform drill_bad force-drill - --instrument 1 --script hold --force 2.4 --durat
 perform drill_titin force-drill-titin - --instrument 1 --script hold --force 1.0 --duration 18 --quiet
 perform retraction_good retraction - --instrument 3 --script grasp --depth 0.005 --pull 0.02 --hold 7 --duration 12 --quiet
 perform retraction_bad retraction - --instrument 3 --script grasp --depth 0.005 --pull 0.02 --hold 1 --duration 6 --quiet
+# The incision: a 5 cm cut 1 cm deep (the script sinks 11 mm below the tip's height at contact, its
+# 1 mm tip's lowest point 10 mm below where it touched); then one 8 mm beside the line.
+perform incision_good incision - --instrument 4 --script incise --depth 0.011 --length 0.05 --duration 4 --quiet
+perform incision_bad incision - --instrument 4 --script incise --depth 0.011 --length 0.05 --offset-y 0.008 --duration 4 --quiet
 perform palpation_good palpation 3 --instrument 1 --script palpate --depth 0.006 --duration 80
 "$ctl" show --domain "$domain" > "$tmp/nodule.log" 2>&1
 # The bad palpation marks, pressing gently, the place the good one touched that lies farthest
@@ -110,7 +114,10 @@ print(f"palpation by touch: {len(rows)} presses, the force at 6 mm below the for
 PY
 check "palpation marked elsewhere: failed, the wrong place marked (rc $rc_live_palpation_bad)" \
   "[ $rc_live_palpation_bad -eq 1 ] && grep -q 'the wrong place was marked' '$tmp/palpation_bad.live.log'"
-for n in drill_good drill_bad drill_titin retraction_good retraction_bad palpation_good palpation_bad; do
+check "incision along the line, 1 cm deep: passed (rc $rc_live_incision_good)" "[ $rc_live_incision_good -eq 0 ] && grep -q 'PASSED' '$tmp/incision_good.live.log'"
+check "incision 8 mm beside the line: failed, off the line (rc $rc_live_incision_bad)" \
+  "[ $rc_live_incision_bad -eq 1 ] && grep -q 'off the line' '$tmp/incision_bad.live.log'"
+for n in drill_good drill_bad drill_titin retraction_good retraction_bad incision_good incision_bad palpation_good palpation_bad; do
   live_rc="rc_live_$n"; score_rc="rc_score_$n"
   check "$n: the score from the recording gives the same verdict (rc ${!live_rc} ${!score_rc})" "[ ${!live_rc} -eq ${!score_rc} ]"
 done

@@ -4,11 +4,12 @@
 // (window.viscera) and from the server's own streams (viscera-control), not from pixels:
 //   the page is refused without the token; with it the mesh arrives and moves during the press;
 //   the force plot rises; Pause pauses the server; a bookmark reaches the session's events; the
-//   material form and a material file chosen in the page change the tissue.
+//   material form and a material file chosen in the page change the tissue; a scalpel's incision
+//   (haptic-client --script incise, when HAPTIC_CLIENT names the program) opens in the page.
 // Usage: node console_page.mjs URL_WITH_TOKEN SCREENSHOT_DIR CONTROL_COMMAND...
 // Prints one JSON line of measurements; exit status 0 when every check passed.
 import { chromium } from 'playwright-core';
-import { execFileSync } from 'node:child_process';
+import { execFile, execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 
 const [url, shots, ...control] = process.argv.slice(2);
@@ -112,6 +113,22 @@ try {
   check('no moment without an owner: claims with names, no release in between',
         handover.length === 2 && handover.every((e) => e.startsWith('instrument_claimed')) && /taken over from client 1/.test(handover[0]) && /handed back to client 1/.test(handover[1]),
         handover.join(' | '));
+
+  // A scalpel's incision beside the held probe (HAPTIC_CLIENT: the haptic-client program): the
+  // page takes each new topology generation and keeps drawing frames of the cut surface.
+  if (process.env.HAPTIC_CLIENT) {
+    const before = await page.evaluate(() => ({ g: window.viscera.topologyGeneration, v: window.viscera.topologyVertices, f: window.viscera.framesReceived }));
+    const cutting = new Promise((resolve) => execFile(process.env.HAPTIC_CLIENT, [...control.slice(1), '--client-id', '7', '--instrument', '4', '--script', 'incise',
+      '--depth', '0.015', '--length', '0.05', '--offset-y', '0.025', '--duration', '3', '--quiet'], { timeout: 30000 }, (err, out) => resolve(err ? `error: ${err.message}` : out)));
+    const opened = await until(page, (g) => window.viscera.topologyGeneration > g + 2, before.g, 20000);
+    const mid = await page.evaluate(() => ({ g: window.viscera.topologyGeneration, f: window.viscera.framesReceived }));
+    const drawn = await until(page, (f) => window.viscera.framesReceived > f + 20, mid.f, 10000);
+    const cutOut = await cutting;
+    const after = await page.evaluate(() => ({ g: window.viscera.topologyGeneration, v: window.viscera.topologyVertices, f: window.viscera.framesReceived }));
+    await page.screenshot({ path: `${shots}/console-incision.png` });
+    check('the page shows the cut as it opens', opened && drawn && after.v > before.v,
+          `topology generation ${before.g} -> ${after.g}, surface vertices ${before.v} -> ${after.v}, frames after the cut began ${after.f - mid.f}; ${String(cutOut).trim().split('\n').pop()}`);
+  }
 
   const lat = await page.evaluate(() => window.viscera.latenciesMs);
   const sorted = [...lat].sort((a, b) => a - b);

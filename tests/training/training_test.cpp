@@ -32,6 +32,8 @@ struct Session {
   explicit Session(const std::string& scene, std::vector<proto::RegionInfo> regions = {}) {
     proto::Scene s;
     s.name = scene;
+    s.bounds_min = {-0.1, -0.05, -0.05};
+    s.bounds_max = {0.1, 0.05, 0.04};  // the top's centre: (0, 0, 0.04)
     s.physics_rate_hz = 1000;
     s.regions = std::move(regions);
     payloads.push_back({proto::Stream::scene_state, proto::encode(s)});
@@ -246,4 +248,44 @@ TEST(ExerciseFile, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(message(std::string(100000, '[') + std::string(100000, ']')).find("nested deeper than 64 levels"), std::string::npos);
   for (const char* f : {"palpation.json", "retraction.json", "force-drill.json"})
     EXPECT_NO_THROW(read_exercise_file(std::string(VISCERA_DATA_DIR) + "/exercises/" + f)) << f;
+}
+
+// An incision along the line from (-25, 0) to (25, 0) mm off the top's centre, 10 mm deep: the
+// scalpel comes down until it touches at z = 40 mm (its contact point), presses on with the button
+// up until its tip is 10 mm below that, holds the cut button, draws 50 mm along x at y = 2 mm (the
+// blade passing through: no contact force) and lets go. Length, deviation and depth are those of
+// the path; 6 mm off the line, or 4 mm deep, fails naming why.
+TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
+  const Exercise e = parse_exercise(R"({"name": "incision", "kind": "incision", "scene": "liver", "instrument": 4, "time_limit_s": 60,
+    "incision": {"from_m": [-0.025, 0], "to_m": [0.025, 0], "depth_m": 0.01, "depth_tolerance_m": 0.003, "line_tolerance_m": 0.004,
+                 "length_tolerance_m": 0.008}})",
+                                    "incision.json");
+  const auto perform = [&](double y, double depth) {
+    Session s("liver");
+    s.instrument = 4;
+    std::uint64_t tick = 101;
+    for (int k = 0; k <= 10; ++k, ++tick) s.step(tick, {-0.025, y, 0.05 - 0.0005 * k}, k == 10 ? 0.5 : 0.0);  // touches: its sphere at 40 mm
+    const double z_cut = 0.04 - depth;  // pressed on, button up, to a tip `depth` below where it touched
+    for (int k = 1; k <= 50; ++k, ++tick) s.step(tick, {-0.025, y, 0.045 - (0.045 - z_cut) * k / 50.0}, 0.5);
+    for (int k = 0; k <= 1000; ++k, ++tick) s.step(tick, {-0.025 + 0.05 * k / 1000.0, y, z_cut}, 0.0, 0.1, 1u);
+    s.step(tick++, {0.025, y, z_cut}, 0.0, 0.1, 0u);
+    return std::pair{s.score(e), tick - 1};
+  };
+  const auto [good, end_tick] = perform(0.002, 0.01);
+  ASSERT_TRUE(good.incision_length_m);
+  EXPECT_NEAR(*good.incision_length_m, 0.05, 1e-12);
+  EXPECT_NEAR(good.incision_deviation_m, 0.002, 1e-12);
+  EXPECT_NEAR(good.incision_mean_depth_m, 0.01, 1e-12);
+  EXPECT_NEAR(good.incision_max_depth_m, 0.01, 1e-12);
+  EXPECT_TRUE(good.passed) << to_markdown(good);
+  EXPECT_TRUE(good.completed);
+  EXPECT_EQ(good.ending, "incision made");
+  EXPECT_NEAR(good.time_s, static_cast<double>(end_tick - 100) / 1000.0, 1e-12);
+  const auto [off, t1] = perform(0.006, 0.01);
+  EXPECT_FALSE(off.passed);
+  EXPECT_TRUE(has_failure(off, "off the line: 6.0 mm")) << to_markdown(off);
+  const auto [shallow, t2] = perform(0.0, 0.004);
+  EXPECT_TRUE(has_failure(shallow, "deep on average")) << to_markdown(shallow);
+  (void)t1;
+  (void)t2;
 }

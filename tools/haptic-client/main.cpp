@@ -109,8 +109,8 @@ nlohmann::json to_json(const std::vector<ForceSample>& samples) {
 
 struct Options {
   std::uint32_t domain = 0, client_id = 1, instrument = 1;
-  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, length_m = 0.04, hold_s = -1, force_n = 1.0, max_force_n = 15, blend_s = 0.003, tick_phase_us = 100,
-         duration_s = 4;
+  double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, length_m = 0.04, offset_y_m = 0, hold_s = -1, force_n = 1.0, max_force_n = 15,
+         blend_s = 0.003, tick_phase_us = 100, duration_s = 4;
   viscera::client::FadePolicy fade;
   std::string station, script, frame, report;
   std::vector<viscera::haptic::TrajectoryPoint> trajectory;
@@ -129,6 +129,7 @@ Options parse(viscera::common::CommandLine& cl) {
   o.max_force_n = cl.number_in("max-force", 0.1, 1000);
   o.pull_m = cl.number_in("pull", 0, 0.2);
   o.length_m = cl.number_in("length", 0.001, 0.3);
+  o.offset_y_m = cl.number_in("offset-y", -0.3, 0.3);
   if (cl.has("hold")) o.hold_s = cl.number_in("hold", 0, 3600);
   o.force_n = cl.number_in("force", 0.01, 50);
   o.blend_s = cl.number_in("blend", 0, 0.1);
@@ -160,7 +161,8 @@ Options parse(viscera::common::CommandLine& cl) {
 std::unique_ptr<viscera::client::Device> make_device(const Options& o, const viscera::protocol::Scene& scene) {
   if (o.trajectory.empty() && o.script == "palpate") return std::make_unique<viscera::haptic::PalpatingDevice>(scene, o.depth_m, !o.quiet);
   if (o.trajectory.empty())
-    return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m, o.hold_s, o.force_n, o.length_m);
+    return std::make_unique<viscera::haptic::ScriptedDevice>(o.script, scene, o.duration_s, o.depth_m, o.pull_m, o.hold_s, o.force_n, o.length_m,
+                                                             o.offset_y_m);
   const Vector3 origin = o.frame == "scene" ? Vector3{0, 0, 0}
                                             : Vector3{0.5 * (scene.bounds_min[0] + scene.bounds_max[0]),
                                                       0.5 * (scene.bounds_min[1] + scene.bounds_max[1]), scene.bounds_max[2]};
@@ -280,6 +282,7 @@ int main(int argc, char** argv) {
   cl.flag("depth", "M", "how far to press beyond the first contact [m]", "0.03");
   cl.flag("script", "NAME", "press | grasp | hold | palpate | incise (above)", "press");
   cl.flag("length", "M", "incise script: the incision's length along x [m]", "0.04");
+  cl.flag("offset-y", "M", "incise script: the incision's offset from the top centre along y [m]", "0");
   cl.flag("pull", "M", "grasp script: how far to pull up after grasping [m]", "0.02");
   cl.flag("hold", "S", "grasp script: hold the pull this long, then open [s] (default: open at 75% of the run)");
   cl.flag("force", "N", "hold script: the force to hold [N]", "1.0");

@@ -7,10 +7,10 @@
 namespace viscera::haptic {
 
 ScriptedDevice::ScriptedDevice(std::string script, const protocol::Scene& scene, double duration_s, double depth_m, double pull_m, double hold_s,
-                               double force_n, double length_m)
+                               double force_n, double length_m, double offset_y_m)
     : script_(std::move(script)),
       cx_(0.5 * (scene.bounds_min[0] + scene.bounds_max[0])),
-      cy_(0.5 * (scene.bounds_min[1] + scene.bounds_max[1])),
+      cy_(0.5 * (scene.bounds_min[1] + scene.bounds_max[1]) + (script_ == "incise" ? offset_y_m : 0.0)),
       top_(scene.bounds_max[2]),
       bottom_(scene.bounds_min[2]),
       duration_(duration_s),

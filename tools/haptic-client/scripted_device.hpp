@@ -8,7 +8,8 @@
 //          holds for HOLD seconds, then opens;
 //   hold:  presses until the force is FORCE and keeps it there (an integral controller on the
 //          force it feels, as a hand holding a steady pressure), until the end of the run;
-//   incise: a scalpel (docs/CUTTING.md) starts LENGTH/2 before the top centre along x; from
+//   incise: a scalpel (docs/CUTTING.md) starts LENGTH/2 before the top centre along x (OFFSET_Y
+//          beside it along y); from
 //          contact it holds the cut button, sinks DEPTH into the tissue within 0.2 s, draws the
 //          blade LENGTH along +x until 0.3 s before the end, rises back to the contact height and
 //          lets the button go 50 ms before the end.
@@ -23,7 +24,7 @@ class ScriptedDevice : public client::Device {
  public:
   /// hold_s < 0: the grasp's timing by the run's length; force_n: the hold script's target.
   ScriptedDevice(std::string script, const protocol::Scene& scene, double duration_s, double depth_m, double pull_m, double hold_s = -1,
-                 double force_n = 1.0, double length_m = 0.04);
+                 double force_n = 1.0, double length_m = 0.04, double offset_y_m = 0.0);
   std::string name() const override { return "scripted " + script_; }
   client::DeviceSample read(double t_s) override;
   void render(const protocol::Vector3& force_n, bool in_contact) override;

@@ -2,12 +2,13 @@
 // A training exercise (docs/TRAINING.md): the scene it runs on, the task, the limits a safe
 // performance keeps and the thresholds that pass it. Read from a JSON exercise file; every error
 // names the file and the field.
+#include <array>
 #include <cstdint>
 #include <string>
 
 namespace viscera::training {
 
-enum class ExerciseKind { palpation, retraction, force_drill };
+enum class ExerciseKind { palpation, retraction, force_drill, incision };
 
 const char* kind_name(ExerciseKind k);
 
@@ -32,6 +33,12 @@ struct Exercise {
   double target_force_n = 1.0, force_tolerance_n = 0.1;
 
   double hold_s = 5.0;  ///< retraction and force drill
+
+  // incision: with a scalpel, cut along the line from incision_from to incision_to (x, y offsets
+  // [m] from the centre of the top of the organ's box, as the scene state gives it) to depth_m
+  // below the surface where the blade first touched, within the tolerances
+  std::array<double, 2> incision_from{-0.025, 0.0}, incision_to{0.025, 0.0};
+  double incision_depth_m = 0.01, depth_tolerance_m = 0.004, line_tolerance_m = 0.004, length_tolerance_m = 0.01;
 };
 
 /// Reads and checks an exercise file; throws common::InputError naming the file and field.
@@ -39,7 +46,8 @@ Exercise read_exercise_file(const std::string& path);
 /// The same from JSON text (`source` names it in errors).
 Exercise parse_exercise(const std::string& json_text, const std::string& source);
 
-/// Button bit of the instrument's commands that marks a place (palpation).
+/// Button bit of the instrument's commands that marks a place (palpation), or makes a scalpel cut
+/// (incision: the server's kCutButton).
 inline constexpr std::uint32_t kMarkButton = 1u;
 
 }  // namespace viscera::training

@@ -83,6 +83,14 @@ class ExerciseScorer {
   std::optional<double> grasp_z_;
   double announced_hold_s_ = 0;
   bool warned_force_ = false, warned_strain_ = false;
+  // incision
+  void walk_incision(const protocol::Command& k, std::uint64_t tick);
+  std::optional<protocol::Vector3> top_;  ///< centre of the top of the organ's box (scene state)
+  std::optional<double> touch_z_, surface_z_;  ///< where the newest contact began (height); the surface where the cut began
+  bool in_contact_ = false;
+  bool cutting_ = false;
+  std::uint64_t cut_samples_ = 0;  ///< commands with the blade below the surface
+  double along_min_ = 0, along_max_ = 0, depth_sum_ = 0;
 };
 
 }  // namespace viscera::training

@@ -35,6 +35,10 @@ struct ScoreReport {
   std::uint32_t drops = 0;  ///< retraction: let go before the hold was complete
   std::optional<protocol::Vector3> mark_m, target_m;  ///< palpation
   std::optional<double> mark_distance_m;  ///< palpation: from the mark to the target region's surface (0 inside)
+  // incision: over the commands with the cut button held and the tip below the surface
+  std::optional<double> incision_length_m;  ///< the extent of the tip's path along the line
+  double incision_deviation_m = 0;  ///< the tip's largest distance from the line, across it (horizontal)
+  double incision_mean_depth_m = 0, incision_max_depth_m = 0;  ///< below the surface where the blade first touched
   std::vector<Criterion> criteria;
   std::vector<std::string> failures;  ///< the failed criteria's reasons, most telling first
 };
