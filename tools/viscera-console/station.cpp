@@ -121,8 +121,7 @@ void Station::stream_loop() {
           if (const auto f = proto::decode_mesh_frame(s.payload, &why)) {
             // A frame of another surface than the topology's (a scene being swapped, a cut whose
             // topology is still on its way) waits for its own.
-            if (f->mesh_id != mesh_id || f->topology_generation != topology_generation || f->positions.size() != 3 * std::size_t{vertex_count})
-              break;
+            if (f->mesh_id != mesh_id || f->topology_generation != topology_generation || f->positions.size() != 3 * std::size_t{vertex_count}) break;
             auto m = std::make_shared<const std::string>(encode_frame(*f, 1e-6 * static_cast<double>(f->server_stamp_ns)));
             {
               const std::lock_guard lock(mutex_);

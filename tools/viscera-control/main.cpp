@@ -204,7 +204,10 @@ int control(viscera::client::Client& client, const Request& r) {
 void print_scene(const viscera::protocol::Scene& scene) {
   std::printf("scene %s: %s, physics %.0f Hz, instruments:", shown(scene.name).c_str(), scene.paused ? "paused" : "running", scene.physics_rate_hz);
   for (const auto& i : scene.instruments)
-    std::printf(" %u (%s, %s)", i.instrument_id, i.scalpel ? "scalpel" : i.grasper ? "grasper" : "probe",
+    std::printf(" %u (%s, %s)", i.instrument_id,
+                i.scalpel   ? "scalpel"
+                : i.grasper ? "grasper"
+                            : "probe",
                 i.owner_client_id ? ("client " + std::to_string(i.owner_client_id)).c_str() : "free");
   const auto& m = scene.material;
   std::printf("\n  generation %u, material %s: E %.6g Pa, nu %.4g, density %.6g kg/m^3, shear Q %.4g, damping %.4g 1/s", scene.generation,
