@@ -44,7 +44,9 @@ nlohmann::json to_json(const protocol::Scene& s) {
   for (const auto& i : s.instruments)
     instruments.push_back({{"id", i.instrument_id},
                            {"grasper", i.grasper},
-                           {"kind", i.scalpel ? "scalpel" : i.grasper ? "grasper" : "probe"},
+                           {"kind", i.scalpel   ? "scalpel"
+                                    : i.grasper ? "grasper"
+                                                : "probe"},
                            {"tip_radius_m", i.tip_radius_m},
                            {"blade_length_m", i.blade_length_m},
                            {"owner", i.owner_client_id}});
