@@ -11,7 +11,7 @@ using namespace viscera::tissue;
 
 namespace {
 
-GpsModel* gps_of(Organ& organ) { return dynamic_cast<GpsModel*>(organ.model.get()); }
+GpsModel* gps_of(const Organ& organ) { return dynamic_cast<GpsModel*>(organ.model.get()); }
 
 }  // namespace
 
@@ -31,7 +31,7 @@ void enable_cutting(Organ& organ) {
 void reserve_for_cuts(const Organ& organ, State& state) {
   if (!organ.cutter) return;
   const std::size_t elements = organ.mesh->tets.capacity(), nodes = organ.mesh->nodes.capacity();
-  state.memory.reserve(gps_of(const_cast<Organ&>(organ))->memory_size_for(elements));
+  state.memory.reserve(gps_of(organ)->memory_size_for(elements));
   state.x.reserve(nodes);
   state.v.reserve(nodes);
 }
