@@ -45,6 +45,14 @@ struct Client::Impl {
   std::unique_ptr<proto::TypedReader<proto::Stream::telemetry>> telemetry;
   proto::Rejections rejections;  // payloads of every stream that failed their decoder
   std::unique_ptr<proto::Writer> annotations;
+  std::atomic<bool> sessions_settled{false};
+  // Before the first request: every reader of session requests (the server's, a recorder's) knows
+  // this writer, or the request is lost to the one that learns of it last (a recording that holds
+  // the server's answer to a request but not the request cannot re-run it). False if no reader.
+  bool session_readers_known(std::chrono::milliseconds timeout) {
+    if (!sessions_settled) sessions_settled = sessions.wait_for_settled_readers(std::chrono::milliseconds(100), timeout);
+    return sessions_settled;
+  }
   std::optional<proto::SurfaceTopology> surface;
   // The server's liveliness, as its scene-state writer's: set by a DDS listener thread.
   std::atomic<ServerState> server{ServerState::waiting};
@@ -143,7 +151,7 @@ void Client::release(std::uint32_t instrument_id) {
 
 bool Client::control(proto::Action action, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
-  impl_->sessions.wait_for_readers(timeout);  // the server's reader must know this writer
+  impl_->session_readers_known(timeout);
   do {
     impl_->sessions.write(client_id_, proto::encode(proto::SessionRequest{client_id_, action, 0}));
     // A reset shows in no state: it is done once the server acknowledged the request.
@@ -160,9 +168,8 @@ std::optional<proto::RequestOutcome> Client::request(proto::SessionRequest r, st
   if (request_seq_ == 0) request_seq_ = static_cast<std::uint64_t>(proto::now_ns());
   r.client_id = client_id_;
   r.request_seq = ++request_seq_;
-  // Sent once: a second copy would load the scene twice. The server's reader must know this
-  // writer first, or the sample is lost.
-  if (!impl_->sessions.wait_for_readers(timeout)) return std::nullopt;
+  // Sent once: a second copy would load the scene twice.
+  if (!impl_->session_readers_known(timeout)) return std::nullopt;
   impl_->sessions.write(client_id_, proto::encode(r));
   while (std::chrono::steady_clock::now() < end) {
     impl_->scene.wait(std::chrono::milliseconds(100));
@@ -321,7 +328,7 @@ void Client::annotate(const std::string& text) {
   if (!impl_->annotations) {
     impl_->annotations = std::make_unique<proto::Writer>(impl_->participant, proto::Stream::event);
     // A new writer's first sample reaches only the readers discovered by then.
-    impl_->annotations->wait_for_readers(std::chrono::seconds(1));
+    impl_->annotations->wait_for_settled_readers(std::chrono::milliseconds(100), std::chrono::seconds(1));
   }
   impl_->annotations->write(client_id_,
                             proto::encode(proto::Event{client_id_, proto::EventKind::annotation, 0, client_id_, 0, proto::now_ns(), text}));

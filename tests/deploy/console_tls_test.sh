@@ -72,5 +72,5 @@ print(f"console: tls {s['tls']}, {s['tls_handshakes_failed']} TLS handshakes ref
 sys.exit(0 if s["tls"] and s["tls_handshakes_failed"] >= 3 and s["plain_http_refused"] >= 1 else 1)
 PY
 check "the console still runs" 'kill -0 "${pids[1]}"'
-echo "passed $passed, failed $failures"
+echo "console_tls: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

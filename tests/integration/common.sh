@@ -12,6 +12,9 @@ failures=0; passed=0; failed_names=
 check() { if eval "$2"; then passed=$((passed+1)); else echo "FAIL $1"; failures=$((failures+1)); failed_names+=" [$1]"; fi; }
 # A check written in Python, read from standard input (a here-document): counts one pass or one failure.
 pycheck() { if python3 - "$@"; then passed=$((passed+1)); else echo "FAIL the Python check above"; failures=$((failures+1)); failed_names+=" [a Python check]"; fi; }
+# The FAIL lines a script wrote to FILE, joined on one line (at most 400 characters), for a check's
+# name: the script's own reasons reach the summary line.
+fails_in() { grep '^FAIL' "$1" 2>/dev/null | tr '\n' ' ' | cut -c1-400; }
 # Waits until PATTERN appears in FILE (at most TENTHS tenths of a second, default 100); says so if it never does.
 wait_for() {  # PATTERN FILE [TENTHS]
   for _ in $(seq "${3:-100}"); do grep -q "$1" "$2" && return 0; sleep 0.1; done

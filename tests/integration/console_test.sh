@@ -58,25 +58,25 @@ sleep 1
   > "$tmp/haptic.log" 2>&1 & pids+=($!)
 shots="${SHOTS:-$tmp}"; mkdir -p "$shots"
 HAPTIC_CLIENT="$build/tools/haptic-client/haptic-client" \
-  node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json"; rc_page=$?
-check "the page in Chromium (console_page.mjs)" '[ $rc_page -eq 0 ]'
+  node "$node_dir/console_page.mjs" "$url" "$shots" "$build/tools/viscera-control/viscera-control" --domain "$domain" > "$tmp/page.json" 2> "$tmp/page.err"; rc_page=$?; cat "$tmp/page.err" >&2
+check "the page in Chromium (console_page.mjs) $(fails_in "$tmp/page.err")" '[ $rc_page -eq 0 ]'
 kill -INT "$recorder"; wait "$recorder"
-node "$node_dir/console_replay.mjs" "$url" session.mcap > "$tmp/replay.json"; rc_replay=$?
-check "a recording opened for replay from the console (console_replay.mjs)" '[ $rc_replay -eq 0 ]'
-node "$node_dir/foxglove_client.mjs" "$url" > "$tmp/foxglove.json"; rc_foxglove=$?
-check "a Foxglove client on the live session (foxglove_client.mjs)" '[ $rc_foxglove -eq 0 ]'
+node "$node_dir/console_replay.mjs" "$url" session.mcap > "$tmp/replay.json" 2> "$tmp/replay.err"; rc_replay=$?; cat "$tmp/replay.err" >&2
+check "a recording opened for replay from the console (console_replay.mjs) $(fails_in "$tmp/replay.err")" '[ $rc_replay -eq 0 ]'
+node "$node_dir/foxglove_client.mjs" "$url" > "$tmp/foxglove.json" 2> "$tmp/foxglove.err"; rc_foxglove=$?; cat "$tmp/foxglove.err" >&2
+check "a Foxglove client on the live session (foxglove_client.mjs) $(fails_in "$tmp/foxglove.err")" '[ $rc_foxglove -eq 0 ]'
 # Recordings that cannot be replayed, and a link out of the folder; a link at the path where the
 # console once wrote its replays' logs in /tmp (it must not be written through).
 : > "$tmp/recordings/empty.mcap"
 ln -s /etc/passwd "$tmp/recordings/passwd.mcap"
 echo "mine" > "$tmp/victim"; old_log=/tmp/viscera-console-viscera-replay-2.log
 [ -e "$old_log" ] || [ -L "$old_log" ] || ln -s "$tmp/victim" "$old_log"
-node "$node_dir/console_faults.mjs" "$url" "$bridge" 2 > "$tmp/faults.json"; rc_faults=$?
-check "the console's faults of issue 31 (console_faults.mjs)" '[ $rc_faults -eq 0 ]'
+node "$node_dir/console_faults.mjs" "$url" "$bridge" 2 > "$tmp/faults.json" 2> "$tmp/faults.err"; rc_faults=$?; cat "$tmp/faults.err" >&2
+check "the console's faults of issue 31 (console_faults.mjs) $(fails_in "$tmp/faults.err")" '[ $rc_faults -eq 0 ]'
 check "nothing was written through a link in /tmp" '[ "$(cat "$tmp/victim")" = mine ]'
 [ "$(readlink "$old_log")" = "$tmp/victim" ] && rm -f "$old_log"
-node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json"; rc_robust=$?
-check "misbehaving browsers (console_robustness.mjs)" '[ $rc_robust -eq 0 ]'
+node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json" 2> "$tmp/robust.err"; rc_robust=$?; cat "$tmp/robust.err" >&2
+check "misbehaving browsers (console_robustness.mjs) $(fails_in "$tmp/robust.err")" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'
 # Another station's server appears on the domain (partition bay-2, at 200 Hz to spare the CPU): the
 # console (--discover) offers it as a station, once; the default station and the replay it opened
@@ -118,5 +118,5 @@ if [ "$failures" -gt 0 ]; then  # what the failing checks need to be understood
   echo "--- server (last 15 lines):"; tail -15 "$tmp/server.log"
   echo "--- console (last 15 lines):"; tail -15 "$tmp/console.log"
 fi
-echo "passed $passed, failed $failures"
+echo "console: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]
