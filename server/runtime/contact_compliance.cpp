@@ -8,14 +8,35 @@ namespace viscera::runtime {
 
 using namespace viscera::tissue;
 
-ContactCompliance::ContactCompliance(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc)
-    : blocks_(model.rest_mesh().node_count(), Eigen::Matrix3d::Zero()),
-      state_(std::make_unique<std::atomic<std::uint8_t>[]>(model.rest_mesh().node_count())) {
+ContactCompliance::ContactCompliance(std::size_t node_count)
+    : blocks_(node_count, Eigen::Matrix3d::Zero()), state_(std::make_unique<std::atomic<std::uint8_t>[]>(node_count)) {
   for (std::size_t i = 0; i < blocks_.size(); ++i) state_[i] = 0;
-  bc.force_field = nullptr;  // instruments are not part of the organ's own stiffness
-  bc.gravity_m_s2 = Vec3::Zero();
+}
+
+ContactCompliance::ContactCompliance(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc)
+    : ContactCompliance(model.rest_mesh().node_count()) {
   worker_ = std::thread(
       [this, &model, density = std::move(density_kg_m3), bc = std::move(bc)]() mutable { work(model, std::move(density), std::move(bc)); });
+}
+
+ContactCompliance::ContactCompliance(ModelMaker make_model, std::size_t node_count, std::vector<double> density_kg_m3, BoundaryConditions bc)
+    : ContactCompliance(node_count) {
+  worker_ = std::thread([this, make = std::move(make_model), density = std::move(density_kg_m3), bc = std::move(bc)]() mutable {
+    try {
+      own_model_ = make();
+    } catch (const std::exception&) {
+      own_model_.reset();
+    }
+    if (!own_model_ || own_model_->node_count() != blocks_.size()) {
+      {
+        std::lock_guard lock(mutex_);
+        factorised_ = -1;
+      }
+      done_cv_.notify_all();
+      return;
+    }
+    work(*own_model_, std::move(density), std::move(bc));
+  });
 }
 
 ContactCompliance::~ContactCompliance() {
@@ -70,6 +91,12 @@ std::mutex g_blas_mutex;
 
 void ContactCompliance::work(const ForceModel& model, std::vector<double> density, BoundaryConditions bc) {
   pthread_setname_np(pthread_self(), "compliance");
+  bc.force_field = nullptr;  // instruments are not part of the organ's own stiffness
+  bc.gravity_m_s2 = Vec3::Zero();
+  {
+    std::lock_guard lock(mutex_);
+    if (stop_) return;  // destroyed before it began: nothing waits for it
+  }
   const auto& rest = model.rest_mesh().nodes;
   // dt is irrelevant to the static stiffness; the integrator only needs a valid one.
   ImplicitIntegrator system(model, std::move(density), std::move(bc), ImplicitOptions{1e-3});

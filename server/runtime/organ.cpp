@@ -76,6 +76,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   }
   for (std::size_t e = 0; e < organ.regions.material_of_tet.size(); ++e)
     if (const std::uint16_t m = organ.regions.material_of_tet[e]) density[e] = organ.region_materials[m - 1].density_kg_m3;
+  organ.model_recipe = {s.model, materials, s.volume_term, ve};
   organ.model = make_force_model(s.model, organ.mesh, materials, s.volume_term, ve, organ.regions.material_of_tet);
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);

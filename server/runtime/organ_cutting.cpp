@@ -4,6 +4,7 @@
 
 #include "viscera/tissue/cutting/boundary_update.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/model/model_factory.hpp"
 
 namespace viscera::runtime {
 
@@ -56,6 +57,40 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
     organ.contact_surface = make_contact_surface(organ.boundary.triangles, organ.mesh->nodes);
   }
   return out;
+}
+
+
+namespace {
+
+/// Each element's material as the running model has it (a cut's children take their parent's).
+std::vector<std::uint16_t> element_materials(const Organ& organ) {
+  const GpsModel* gps = gps_of(organ);
+  std::vector<std::uint16_t> material_of(organ.mesh->tet_count());
+  for (std::size_t e = 0; e < material_of.size(); ++e) material_of[e] = static_cast<std::uint16_t>(gps->material_of(e));
+  return material_of;
+}
+
+std::unique_ptr<ForceModel> make_model(const Organ::ModelRecipe& r, std::shared_ptr<const TetMesh> mesh, std::vector<std::uint16_t> material_of) {
+  return make_force_model(r.name, std::move(mesh), r.materials, r.volume_fraction, r.mechanisms, std::move(material_of));
+}
+
+}  // namespace
+
+std::unique_ptr<ForceModel> remake_model(const Organ& organ) {
+  if (!can_cut(organ)) throw std::logic_error("remake_model: the organ cannot be cut");
+  return make_model(organ.model_recipe, std::make_shared<const TetMesh>(*organ.mesh), element_materials(organ));
+}
+
+std::unique_ptr<ContactCompliance> rebuild_compliance(const Organ& organ) {
+  if (!can_cut(organ)) throw std::logic_error("rebuild_compliance: the organ cannot be cut");
+  // Copied here, between ticks; calibrated and factorised on the compliance's worker.
+  auto mesh = std::make_shared<const TetMesh>(*organ.mesh);
+  const std::size_t nodes = mesh->node_count();
+  return std::make_unique<ContactCompliance>(
+      [recipe = organ.model_recipe, mesh = std::move(mesh), material_of = element_materials(organ)]() mutable {
+        return make_model(recipe, std::move(mesh), std::move(material_of));
+      },
+      nodes, organ.integrator->mass_scaling().density_kg_m3, organ.integrator->boundary_conditions());
 }
 
 }  // namespace viscera::runtime

@@ -20,7 +20,7 @@ void SimulationServer::Impl::end_stroke(std::uint32_t id, Tool& t) {
   s = Stroke{};
 }
 
-void SimulationServer::Impl::cut_with_scalpels() {
+void SimulationServer::Impl::cut_with_scalpels(const Status& status) {
   bool surface_changed = false;
   for (auto& [id, t] : tools) {
     const InstrumentSpec& spec = t.tool.spec();
@@ -52,6 +52,7 @@ void SimulationServer::Impl::cut_with_scalpels() {
     s.added_mass_kg += o.added_mass_kg;
     surface_changed = surface_changed || o.surface_changed;
   }
+  refresh_compliance(status);
   if (!surface_changed) return;
   {
     std::lock_guard world(organ_mutex);  // the command thread's queries see the new surface whole
@@ -59,6 +60,28 @@ void SimulationServer::Impl::cut_with_scalpels() {
   }
   for (auto& [id, t] : tools) t.contact->set_surface(organ->contact_surface);
   topology_to_publish = true;
+}
+
+void SimulationServer::Impl::refresh_compliance(const Status& status) {
+  Organ& o = *organ;
+  if (!can_cut(o)) return;
+  const bool stroke_open = std::any_of(tools.begin(), tools.end(), [](const auto& t) { return t.second.stroke.id >= 0; });
+  if (!o.next_compliance && !stroke_open && o.compliance_cuts != o.cuts) {
+    o.next_compliance = rebuild_compliance(o);
+    o.next_compliance_cuts = o.cuts;
+    // In lockstep it takes over at this tick on every run: the same stiffness, bit for bit.
+    if (lockstep) o.next_compliance->wait_settled();
+  }
+  if (o.next_compliance && o.next_compliance->settled()) {
+    std::unique_ptr<ContactCompliance> done = std::move(o.next_compliance);  // destroyed outside the lock
+    o.compliance_cuts = o.next_compliance_cuts;
+    if (done->ready()) {
+      std::lock_guard world(organ_mutex);  // the command thread's answers use it
+      std::swap(o.compliance, done);
+    } else if (status) {
+      status("the cut organ's contact compliance could not be factorised (a piece cut free?): the haptic local model keeps the previous one");
+    }
+  }
 }
 
 }  // namespace viscera::runtime

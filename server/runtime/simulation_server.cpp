@@ -168,7 +168,7 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
     try {
       organ->integrator->advance(state, dt);
       sim_time_s += dt;
-      cut_with_scalpels();
+      cut_with_scalpels(status);
     } catch (const SimulationError& e) {
       // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
       // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.

@@ -121,9 +121,13 @@ struct SimulationServer::Impl {
   /// After the step: every scalpel whose owner holds its cut button cuts the organ with the surface
   /// its blade swept during the tick, and strokes begin and end with events. The contacts see the
   /// cut surface from the next tick on.
-  void cut_with_scalpels();
+  void cut_with_scalpels(const Status& status);
   /// A scalpel's stroke ends (its cut_ended event says what it cut).
   void end_stroke(std::uint32_t id, Tool& t);
+  /// Between strokes, the haptic local model's contact compliance of the cut organ: built again in
+  /// the background once the organ's cuts are not the ones it has seen (rebuild_compliance), and
+  /// swapped in once ready. One that cannot be factorised (a piece cut free) leaves the one in use.
+  void refresh_compliance(const Status& status);
 
   // --- What the server publishes
   void publish_scene();

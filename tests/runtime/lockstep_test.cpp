@@ -303,6 +303,24 @@ TEST(Lockstep, AnIncisionOpensTheSurfaceTheSameWayOnEveryRunAndOnTwoThreads) {
   EXPECT_GT(frames.back().positions.size(), frames.front().positions.size());
   std::cout << "[ figure ] incision: surface generation " << frames.back().topology_generation << ", surface vertices "
             << frames.front().positions.size() / 3 << " -> " << frames.back().positions.size() / 3 << "\n";
+  // The probe on the cut's line feels the cut organ: its local model's stiffness is the tissue's
+  // in series with the contact penalty (1000 N/m), from the compliance rebuilt after the stroke,
+  // never the penalty's bound that a node the uncut compliance does not know would give.
+  int pressed = 0, softened = 0;
+  double k_min = 1e300, k_max = 0;
+  for (const auto& r : a.results)
+    for (const auto& p : r.forces) {
+      const auto f = proto::decode_force(p, &why);
+      if (!f || f->instrument_id != 1 || !f->in_contact || f->tick <= ended->tick) continue;
+      const double k = f->stiffness[0] + f->stiffness[4] + f->stiffness[8];  // k n n^T: its trace is k
+      ++pressed;
+      softened += k < 0.95 * 1000;
+      k_min = std::min(k_min, k);
+      k_max = std::max(k_max, k);
+    }
+  ASSERT_GT(pressed, 100);
+  EXPECT_EQ(softened, pressed);
+  std::cout << "[ figure ] the probe on the cut: " << pressed << " forces in contact, local stiffness " << k_min << " to " << k_max << " N/m\n";
 }
 
 }  // namespace

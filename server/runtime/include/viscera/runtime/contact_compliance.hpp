@@ -16,6 +16,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -30,6 +31,12 @@ namespace viscera::runtime {
 class ContactCompliance {
  public:
   ContactCompliance(const tissue::ForceModel& model, std::vector<double> density_kg_m3, tissue::BoundaryConditions bc);
+  /// A compliance of a model of its own, made by `make_model` on the worker (a cut organ's: its
+  /// mesh copied and calibrated again there, so the running organ may go on being cut meanwhile).
+  /// `node_count`: the nodes of the model it will make. A model that cannot be made is a failed
+  /// factorisation (settled, not ready).
+  using ModelMaker = std::function<std::unique_ptr<tissue::ForceModel>()>;
+  ContactCompliance(ModelMaker make_model, std::size_t node_count, std::vector<double> density_kg_m3, tissue::BoundaryConditions bc);
   ~ContactCompliance();
   ContactCompliance(const ContactCompliance&) = delete;
   ContactCompliance& operator=(const ContactCompliance&) = delete;
@@ -49,8 +56,10 @@ class ContactCompliance {
   void wait_settled();
 
  private:
+  explicit ContactCompliance(std::size_t node_count);
   void work(const tissue::ForceModel& model, std::vector<double> density, tissue::BoundaryConditions bc);
 
+  std::unique_ptr<tissue::ForceModel> own_model_;  // the second constructor's (made and read by the worker)
   std::vector<Eigen::Matrix3d> blocks_;
   std::unique_ptr<std::atomic<std::uint8_t>[]> state_;  // per node: 0 unknown, 1 requested, 2 known
   std::atomic<int> factorised_{0};  // 0 pending, 1 done, -1 failed

@@ -13,6 +13,7 @@
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/runtime/tick_budget.hpp"
 #include "viscera/tissue/cutting/mesh_cutter.hpp"
+#include "viscera/tissue/gps/gps_mechanisms.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
@@ -38,8 +39,19 @@ struct Organ {
   /// Sweeps that changed the mesh since the organ was built.
   std::uint64_t cuts = 0;
   std::unique_ptr<tissue::ForceModel> model;
+  /// What the model was made of, to make it again on a copy of the cut mesh (the compliance below).
+  struct ModelRecipe {
+    std::string name;  ///< the scene's model
+    std::vector<tissue::Mat6> materials;  ///< the organ's (unrelaxed) elasticity, then each region's
+    double volume_fraction = 0;
+    tissue::GpsMechanisms mechanisms;
+  } model_recipe;
   std::unique_ptr<ParallelForces> parallel_forces;  ///< on the scene's physics_threads, max(kForceChunks, threads) chunks; used by the integrator
   std::unique_ptr<tissue::ExplicitIntegrator> integrator;  ///< its force field is the caller's to set
+  /// The compliance of the organ as cut by its first `next_compliance_cuts` cuts, being built on a
+  /// model of its own (organ_cutting.hpp, rebuild_compliance); it replaces `compliance` once ready.
+  std::unique_ptr<ContactCompliance> next_compliance;
+  std::uint64_t next_compliance_cuts = 0, compliance_cuts = 0;  ///< the cuts each compliance has seen
   std::unique_ptr<ContactCompliance> compliance;  ///< last: destroyed first (its worker uses *model)
   /// One explicit sub-step of this organ on this machine [s] (the median of five, timed when built).
   double substep_cost_s = 0;

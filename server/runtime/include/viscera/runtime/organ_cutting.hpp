@@ -39,4 +39,14 @@ bool can_cut(const Organ& organ);
 /// `stroke`; the state gains the new nodes and memory. Requires can_cut(organ).
 SweepOutcome cut_organ(Organ& organ, const tissue::BladeSweep& sweep, tissue::State& state, std::int32_t stroke);
 
+/// The organ's force model calibrated again from scratch on a copy of its (cut) mesh, each element
+/// with its material: what following the cuts must have given (tests; the compliance below).
+std::unique_ptr<tissue::ForceModel> remake_model(const Organ& organ);
+
+/// The contact compliance of the organ as cut now (docs/CUTTING.md, "The haptic local model"): the
+/// mesh, the elements' materials, the inertia and the boundary conditions copied on the calling
+/// thread (between ticks), the model made again and factorised on the compliance's worker, so the
+/// organ may go on being cut meanwhile. Requires can_cut(organ).
+std::unique_ptr<ContactCompliance> rebuild_compliance(const Organ& organ);
+
 }  // namespace viscera::runtime

@@ -71,6 +71,8 @@ class GpsModel final : public ForceModel {
   Mat6 paper_constants(std::size_t e) const;
   /// H of element e (symmetric 6x6) as used by the model.
   Mat6 edge_hessian(std::size_t e) const;
+  /// Element e's index into the materials (0 without per-element materials).
+  std::size_t material_of(std::size_t e) const;
 
   /// The hot loop's data: tetrahedra in blocks of kLanes, structure-of-arrays inside a block, so
   /// that one block streams contiguously and every arithmetic line vectorises across the lanes.
@@ -103,7 +105,6 @@ class GpsModel final : public ForceModel {
   Mat6 packed_hessian(std::size_t e) const;
   /// H of a tet of material m with these rest positions, as the model uses it.
   Mat6 calibrated_hessian(const std::array<Vec3, 4>& rest, std::size_t m) const;
-  std::size_t material_of(std::size_t e) const;
   /// Writes block lane `slot` from the mesh (a padding lane past the last element: a copy of its
   /// block's first element with H = 0).
   void write_lane(std::size_t slot);
