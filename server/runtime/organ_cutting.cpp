@@ -59,7 +59,6 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
   return out;
 }
 
-
 namespace {
 
 /// Each element's material as the running model has it (a cut's children take their parent's).

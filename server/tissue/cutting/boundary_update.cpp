@@ -47,10 +47,17 @@ BoundaryChange update_boundary(BoundarySurface& surface, const MeshCutter& cutte
   if (faces.empty()) return {};
 
   BoundaryChange out;
+  // A boundary triangle is held by its owner alone, so one whose face a changed tetrahedron held
+  // before is owned by that tetrahedron (new ones lie inside their parents, never on the other side
+  // of a boundary face): only the replaced tetrahedra's triangles are looked up (the whole surface
+  // in a hash set cost 0.15 ms a change on the 12k liver).
+  std::vector<char> replaced(change.tets_before, 0);
+  for (const auto& [e, before] : change.replaced) replaced[static_cast<std::size_t>(e)] = 1;
   std::vector<std::int32_t> left;  // nodes of removed triangles: still on the boundary?
   std::size_t kept = 0;
   for (std::size_t k = 0; k < surface.triangles.size(); ++k) {
-    if (faces.contains(sorted(surface.triangles[k]))) {
+    const auto owner = static_cast<std::size_t>(surface.owner_tet[k]);
+    if (owner < replaced.size() && replaced[owner] && faces.contains(sorted(surface.triangles[k]))) {
       left.insert(left.end(), surface.triangles[k].begin(), surface.triangles[k].end());
       ++out.removed_triangles;
       continue;

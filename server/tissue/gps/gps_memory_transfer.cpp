@@ -102,7 +102,7 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
     slot_of[e] = static_cast<std::int32_t>(i);
     parent_rest[i] = {X[tet[0]], X[tet[1]], X[tet[2]], X[tet[3]]};
     if (!with_memory) continue;
-    parent_h[i] = calibrated_hessian(parent_rest[i], material_of(e));
+    parent_h[i] = packed_hessian(e);  // as write_lane calibrated it (its lane is rewritten below)
     for (std::size_t w = 0; w < stride / kLane; ++w) parent_memory[i * stride + w * kLane] = memory[(e / kLane) * stride + w * kLane + e % kLane];
   }
   std::vector<std::int32_t> changed;

@@ -63,7 +63,9 @@ double hold_element_steps(const ForceModel& model, std::span<double> density_kg_
   const auto& rest = model.rest_mesh().nodes;
   for (const std::int32_t element : elements) {
     const auto e = static_cast<std::size_t>(element);
-    const double r = 0.5 * min_step_s * element_frequency(model, e, density_kg_m3[e]);
+    // Only the elements whose frequency exceeds 2 / min_step_s are scaled: the others are told
+    // from a bound, without their eigenvalues (a cut's children, at the physics thread's cost).
+    const double r = 0.5 * min_step_s * element_frequency_above(model, e, density_kg_m3[e], 2.0 / min_step_s);
     if (r <= 1.0) continue;
     const auto x = model.gather(rest, e);
     added += density_kg_m3[e] * (r * r - 1.0) * signed_volume(x[0], x[1], x[2], x[3]);

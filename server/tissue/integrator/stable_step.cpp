@@ -5,18 +5,60 @@
 #include <stdexcept>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 namespace viscera::tissue {
 
+namespace {
+
+/// Element e's rest positions, symmetrised tangent at rest and lumped mass per vertex [kg].
+struct RestElement {
+  std::array<Vec3, 4> x;
+  Mat12 K;
+  double mass = 0;
+};
+RestElement rest_element(const ForceModel& model, std::size_t e, double density_kg_m3) {
+  RestElement r{model.gather(model.rest_mesh().nodes, e), model.element_tangent(model.rest_mesh().nodes, e), 0.0};
+  r.K = 0.5 * (r.K + r.K.transpose());
+  r.mass = 0.25 * density_kg_m3 * signed_volume(r.x[0], r.x[1], r.x[2], r.x[3]);
+  return r;
+}
+
+/// The largest eigenvalue of K. At rest, stress free, a tetrahedron's tangent vanishes on its six
+/// rigid motions, which are the null space of its edge-elongation map J (6x12, rank 6): K = J^T M J
+/// with M = J+^T K J+, and its nonzero eigenvalues are those of L^-1 (J K J^T) L^-T, L L^T = J J^T,
+/// a 6x6 problem (a third of the 12x12 one's cost). A tetrahedron too flat for the Cholesky factor
+/// falls back on the 12x12 problem.
+double largest_eigenvalue(const RestElement& r) {
+  const Mat6x12 J = elongation_jacobian(r.x);
+  const Eigen::LLT<Mat6> llt(J * J.transpose());
+  if (llt.info() == Eigen::Success) {
+    Mat6 A = J * r.K * J.transpose();
+    llt.matrixL().solveInPlace(A);  // L^-1 P
+    const Mat6 B = A.transpose();
+    Mat6 C = B;
+    llt.matrixL().solveInPlace(C);  // L^-1 (L^-1 P)^T = L^-1 P^T L^-T = L^-1 P L^-T (P symmetric)
+    const Mat6 S = 0.5 * (C + C.transpose());
+    return Eigen::SelfAdjointEigenSolver<Mat6>(S, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  }
+  return Eigen::SelfAdjointEigenSolver<Mat12>(r.K, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+}
+
+}  // namespace
+
 double element_frequency(const ForceModel& model, std::size_t e, double density_kg_m3) {
-  const auto& rest = model.rest_mesh().nodes;
-  const auto x = model.gather(rest, e);
-  const double volume = signed_volume(x[0], x[1], x[2], x[3]);
-  const Mat12 K = model.element_tangent(rest, e);
-  const Mat12 Ks = 0.5 * (K + K.transpose());
-  const double lambda = Eigen::SelfAdjointEigenSolver<Mat12>(Ks, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
-  return std::sqrt(lambda / (0.25 * density_kg_m3 * volume));
+  const RestElement r = rest_element(model, e, density_kg_m3);
+  return std::sqrt(largest_eigenvalue(r) / r.mass);
+}
+
+double element_frequency_above(const ForceModel& model, std::size_t e, double density_kg_m3, double omega_rad_s) {
+  const RestElement r = rest_element(model, e, density_kg_m3);
+  // K is positive semi-definite at rest: its largest eigenvalue is at most its trace and at most
+  // its largest absolute row sum (Gershgorin).
+  const double bound = std::min(r.K.trace(), r.K.cwiseAbs().rowwise().sum().maxCoeff());
+  if (bound <= omega_rad_s * omega_rad_s * r.mass) return std::sqrt(bound / r.mass);
+  return std::sqrt(largest_eigenvalue(r) / r.mass);
 }
 
 std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3) {

@@ -23,6 +23,10 @@ StableStep critical_time_step(const ForceModel& model, std::span<const double> d
 std::vector<double> element_frequencies(const ForceModel& model, std::span<const double> density_kg_m3);
 /// The same for one element of the given density.
 double element_frequency(const ForceModel& model, std::size_t e, double density_kg_m3);
+/// The same where it may exceed `omega_rad_s`; elsewhere an upper bound of it that does not
+/// (from the tangent's trace and its largest absolute row sum, a tenth of the cost of the 12x12
+/// eigenvalues): for a rule that acts only on the elements above a frequency.
+double element_frequency_above(const ForceModel& model, std::size_t e, double density_kg_m3, double omega_rad_s);
 
 /// Estimate of the global critical step from the highest natural frequency of the free
 /// coordinates: power iteration on M^-1/2 K M^-1/2, K applied through central differences of the
