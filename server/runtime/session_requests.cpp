@@ -125,7 +125,9 @@ bool SimulationServer::Impl::control(const proto::SessionRequest& req, const Sta
   // under the physics thread, and its model carries what the cuts made.
   if (req.action == proto::Action::set_material && organ->cuts > 0)
     return refuse("the organ has been cut: a material change applies to an uncut organ (load the scene again first)");
-  // A material file that does not read is refused at once, as the background build would.
+  // A material file that does not read is refused at once, as the background build would; busy
+  // first, so that a flood of files costs the physics thread no parse while one is being built.
+  if (!session.preparing().empty()) return refuse("busy: still preparing " + session.preparing());
   if (req.action == proto::Action::set_material && req.material.file_text) {
     try {
       tissue::parse_material(*req.material.file_text, "set_material");
