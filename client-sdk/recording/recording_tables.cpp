@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
 #include <span>
 #include <type_traits>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/protocol/messages.hpp"
+#include "viscera/protocol/surface_assembler.hpp"
 
 namespace viscera::recording {
 
@@ -149,7 +151,10 @@ void row_of(Row& r, const protocol::SurfaceTopology& t) {
   r.put("mesh_id", t.mesh_id);
   r.put("organ_name", t.organ_name);
   r.put("vertex_count", t.vertex_count);
-  r.put("triangle_count", t.triangles.size() / 3);
+  r.put("triangle_count", t.triangles.size() / 3);  // a patch's: those it adds
+  r.put("topology_generation", t.topology_generation);
+  r.put("patch", t.patch);
+  r.put("base_generation", t.base_generation);
 }
 
 void row_of(Row& r, const protocol::MeshFrame& m) {
@@ -268,7 +273,10 @@ void add_frame(RecordingTables& out, const mcap::Message& m, const protocol::Mes
   s.positions.insert(s.positions.end(), f.positions.begin(), f.positions.end());
 }
 
-void add_topology(RecordingTables& out, const protocol::SurfaceTopology& t) {
+/// `message`: whole or a patch; `assembler`: the mesh's whole surfaces so far.
+void add_topology(RecordingTables& out, const protocol::SurfaceTopology& message, protocol::SurfaceAssembler& assembler) {
+  if (!assembler.take(message)) return;  // a patch of a surface the recording does not hold
+  const protocol::SurfaceTopology& t = *assembler.surface();
   FrameSeries& s = out.frames[t.mesh_id];
   s.mesh_id = t.mesh_id;
   if (!s.generation_known) {
@@ -313,6 +321,7 @@ RecordingTables read_tables(Recording& recording, const std::set<std::string>& s
   std::optional<protocol::Scene> scene;
   std::optional<protocol::TelemetryReport> telemetry;
   std::optional<protocol::SurfaceTopology> topology;
+  std::map<std::uint32_t, protocol::SurfaceAssembler> surfaces;  // per mesh
   std::optional<protocol::MeshFrame> frame;
   std::optional<protocol::Event> event;
   std::optional<protocol::SceneFiles> files;
@@ -342,7 +351,8 @@ RecordingTables read_tables(Recording& recording, const std::set<std::string>& s
           case Stream::scene_state: add_row(out, ch.stream, ch, m, protocol::decode_scene, scene); break;
           case Stream::telemetry: add_row(out, ch.stream, ch, m, protocol::decode_telemetry, telemetry); break;
           case Stream::surface_topology:
-            if (const auto* t = add_row(out, ch.stream, ch, m, protocol::decode_surface_topology, topology)) add_topology(out, *t);
+            if (const auto* t = add_row(out, ch.stream, ch, m, protocol::decode_surface_topology, topology))
+              add_topology(out, *t, surfaces[t->mesh_id]);
             break;
           case Stream::mesh_frame:
             if (const auto* f = add_row(out, ch.stream, ch, m, protocol::decode_mesh_frame, frame); f && with_frames)

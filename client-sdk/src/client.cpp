@@ -9,6 +9,7 @@
 
 #include "viscera/common/percentile.hpp"
 #include "viscera/protocol/dds.hpp"
+#include "viscera/protocol/surface_assembler.hpp"
 #include "viscera/protocol/typed_reader.hpp"
 
 namespace viscera::client {
@@ -53,7 +54,7 @@ struct Client::Impl {
     if (!sessions_settled) sessions_settled = sessions.wait_for_settled_readers(std::chrono::milliseconds(100), timeout);
     return sessions_settled;
   }
-  std::optional<proto::SurfaceTopology> surface;
+  proto::SurfaceAssembler surfaces;  // whole surfaces from whole ones and patches (schema 16)
   // The server's liveliness, as its scene-state writer's: set by a DDS listener thread.
   std::atomic<ServerState> server{ServerState::waiting};
   std::atomic<std::int64_t> lost_ns{0};
@@ -279,8 +280,8 @@ std::optional<proto::SurfaceTopology> Client::surface() {
     impl_->topology = std::make_unique<proto::TypedReader<proto::Stream::surface_topology>>(impl_->participant);
     impl_->frames = std::make_unique<proto::TypedReader<proto::Stream::mesh_frame>>(impl_->participant);
   }
-  impl_->topology->take([&](proto::SurfaceTopology t, const proto::Received&) { impl_->surface = std::move(t); }, impl_->rejections);
-  return impl_->surface;
+  impl_->topology->take([&](proto::SurfaceTopology t, const proto::Received&) { impl_->surfaces.take(t); }, impl_->rejections);
+  return impl_->surfaces.surface();
 }
 
 std::optional<proto::MeshFrame> Client::poll_mesh_frame() {

@@ -84,6 +84,10 @@ dds_qos_t* qos_for(Stream s, const std::string& partition, const std::string& ro
   else
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, info.depth);
   dds_qset_durability(q, info.durability == Durability::transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+  // What a late joiner gets: Cyclone keeps the durability service's history for it (default: the
+  // last sample), not the writer's: the surface's whole message and the patches after it.
+  if (info.durability == Durability::transient_local && info.depth > 0)
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, info.depth, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   // A client that dies or goes silent loses its liveliness within this lease.
   dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(kLivelinessLease.count()));
   return q;

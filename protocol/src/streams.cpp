@@ -20,7 +20,7 @@ constexpr std::array<StreamInfo, kStreamCount> kStreams{{
   {Stream::session_request,    "viscera_session_request",    "SessionRequest",     "session",            reliable,    16, volatile_only,   false, false, true,  verifies<Stream::session_request>},
   {Stream::scene_state,        "viscera_scene_state",        "SceneState",         "session",            reliable,    1,  transient_local, true,  false, true,  verifies<Stream::scene_state>},
   {Stream::telemetry,          "viscera_telemetry",          "Telemetry",          "telemetry",          best_effort, 1,  volatile_only,   false, true,  true,  verifies<Stream::telemetry>},
-  {Stream::surface_topology,   "viscera_surface_topology",   "SurfaceTopology",    "surface_mesh",       reliable,    1,  transient_local, true,  false, true,  verifies<Stream::surface_topology>},
+  {Stream::surface_topology,   "viscera_surface_topology",   "SurfaceTopology",    "surface_mesh",       reliable,    16, transient_local, true,  false, true,  verifies<Stream::surface_topology>},
   {Stream::mesh_frame,         "viscera_mesh_frame",         "MeshFrame",          "mesh_frame",         reliable,    1,  volatile_only,   false, true,  true,  verifies<Stream::mesh_frame>},
   {Stream::event,              "viscera_event",              "Event",              "event",              reliable,    64, volatile_only,   false, false, true,  verifies<Stream::event>},
   {Stream::scene_files,        "viscera_scene_files",        "SceneFiles",         "scene_files",        reliable,    1,  transient_local, true,  false, true,  verifies<Stream::scene_files>},

@@ -15,6 +15,7 @@ MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, const proto::Su
                              double rate_hz)
     : stream_(std::move(stream)), nodes_(std::move(surface_nodes)), mesh_id_(topology.mesh_id), period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
   stream_->write_topology(mesh_id_, proto::encode(topology));
+  sent_ = {topology.mesh_id, topology.topology_generation, nodes_, topology.triangles};
   pending_.mesh_id = mesh_id_;
   pending_.positions.resize(3 * nodes_.size());
   thread_ = std::thread([this] {
@@ -58,12 +59,23 @@ void MeshPublisher::change_topology(proto::SurfaceTopology topology, std::vector
   topology_generation_ = topology.topology_generation;
   nodes_ = std::move(surface_nodes);
   pending_topology_ = std::move(topology);
+  pending_topology_nodes_ = nodes_;
   ready_ = false;  // a frame of the old surface not yet taken is dropped: it must not follow the new topology
 }
 
 std::uint64_t MeshPublisher::topologies_published() const {
   std::lock_guard lock(mutex_);
   return topologies_;
+}
+
+std::uint64_t MeshPublisher::patches_published() const {
+  std::lock_guard lock(mutex_);
+  return patches_;
+}
+
+std::uint64_t MeshPublisher::topology_change_bytes() const {
+  std::lock_guard lock(mutex_);
+  return change_bytes_;
 }
 
 std::uint64_t MeshPublisher::frames_published() const {
@@ -77,6 +89,7 @@ void MeshPublisher::publish_loop() {
   frame.positions.resize(pending_.positions.size());
   for (;;) {
     std::optional<proto::SurfaceTopology> topology;
+    std::vector<std::int32_t> topology_nodes;
     {
       std::unique_lock lock(mutex_);
       ready_cv_.wait(lock, [this] { return ready_ || stop_; });
@@ -84,19 +97,31 @@ void MeshPublisher::publish_loop() {
       std::swap(frame, pending_);  // O(1): the physics thread fills the other buffer next time
       ready_ = false;
       topology.swap(pending_topology_);
+      topology_nodes.swap(pending_topology_nodes_);
     }
     try {
       if (topology) {
+        // A patch of what the readers hold where it is smaller; whole every kPatchesPerWhole.
+        std::optional<proto::SurfaceTopology> patch;
+        if (patches_since_whole_ < kPatchesPerWhole) patch = surface_patch(sent_, *topology, topology_nodes);
+        const proto::SurfaceTopology& message = patch ? *patch : *topology;
         // Reliable: a topology that cannot be written is written again before the next frame.
         try {
-          stream_->write_topology(mesh_id_, proto::encode(*topology));
+          stream_->write_topology(mesh_id_, proto::encode(message));
         } catch (const proto::DdsError&) {
           std::lock_guard lock(mutex_);
-          if (!pending_topology_) pending_topology_ = std::move(topology);
+          if (!pending_topology_) {
+            pending_topology_ = std::move(topology);
+            pending_topology_nodes_ = std::move(topology_nodes);
+          }
           continue;
         }
+        patches_since_whole_ = patch ? patches_since_whole_ + 1 : 0;
         std::lock_guard lock(mutex_);
         ++topologies_;
+        patches_ += patch ? 1 : 0;
+        change_bytes_ += surface_array_bytes(message);
+        sent_ = {topology->mesh_id, topology->topology_generation, std::move(topology_nodes), std::move(topology->triangles)};
       }
       stream_->write_frame(mesh_id_, proto::encode(frame));
     } catch (const proto::DdsError&) {

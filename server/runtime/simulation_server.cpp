@@ -126,20 +126,7 @@ void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEv
 
 /// The boundary surface with its vertices numbered in the order of boundary.nodes.
 proto::SurfaceTopology SimulationServer::Impl::surface_topology(const BoundarySurface& boundary) const {
-  proto::SurfaceTopology t;
-  t.mesh_id = generation;
-  t.topology_generation = organ->topology_generation;
-  t.organ_name = scene.name;
-  t.vertex_count = static_cast<std::uint32_t>(boundary.nodes.size());
-  const auto& nodes = organ->mesh->nodes;
-  std::vector<std::uint32_t> vertex_of(nodes.size(), 0);
-  for (std::size_t k = 0; k < boundary.nodes.size(); ++k) {
-    vertex_of[boundary.nodes[k]] = static_cast<std::uint32_t>(k);
-    for (int d = 0; d < 3; ++d) t.rest_positions.push_back(static_cast<float>(nodes[boundary.nodes[k]][d]));
-  }
-  for (const auto& tri : boundary.triangles)
-    for (const auto n : tri) t.triangles.push_back(vertex_of[n]);
-  return t;
+  return whole_surface(generation, organ->topology_generation, scene.name, *organ->mesh, boundary);
 }
 
 /// Session requests, a finished build, the lease; then the organ stepped by 1/rate with each

@@ -94,6 +94,15 @@ int main(int argc, char** argv) {
   t.triangles = {0, 1, 2, 0, 2, 3};
   t.rest_positions = {0, 0, 0, 0.01f, 0, 0, 0, 0.01f, 0, 0, 0, 0.01f};
   seed(dir, "surface-topology", t, decode_surface_topology);
+  SurfaceTopology patch = t;  // schema 16: a patch of it
+  patch.patch = true;
+  patch.topology_generation = 1;
+  patch.removed_vertices = {3};
+  patch.inserted_vertices = {1};
+  patch.rest_positions = {0.005f, 0, 0};
+  patch.removed_triangles = {1};
+  patch.triangles = {0, 1, 3};
+  seed(dir, "surface-patch", patch, decode_surface_topology);
 
   MeshFrame m;
   m.mesh_id = 2;

@@ -160,6 +160,47 @@ TEST(Messages, SurfaceTopologyAndFramesRoundTripAndBadOnesAreRejected) {
   EXPECT_FALSE(decode_surface_topology(std::span(bytes).first(bytes.size() / 2), &why));  // truncated
 }
 
+TEST(Messages, ASurfacePatchRoundTripsAndOneThatCannotApplyAnywhereIsRejected) {
+  SurfaceTopology p;
+  p.patch = true;
+  p.mesh_id = 1;
+  p.topology_generation = 3;
+  p.base_generation = 2;
+  p.vertex_count = 5;
+  p.removed_vertices = {0, 4};
+  p.inserted_vertices = {1, 3};
+  p.rest_positions = {0, 0, 0.2F, 0.1F, 0.1F, 0};
+  p.removed_triangles = {2};
+  p.triangles = {0, 1, 2};
+  std::string why;
+  const auto d = decode_surface_topology(encode(p), &why);
+  ASSERT_TRUE(d) << why;
+  EXPECT_TRUE(d->patch);
+  EXPECT_EQ(d->base_generation, 2u);
+  EXPECT_EQ(d->removed_vertices, p.removed_vertices);
+  EXPECT_EQ(d->inserted_vertices, p.inserted_vertices);
+  EXPECT_EQ(d->removed_triangles, p.removed_triangles);
+  EXPECT_EQ(d->rest_positions, p.rest_positions);
+  // A whole surface decodes without the patch's fields, as schema 15 wrote it.
+  EXPECT_FALSE(decode_surface_topology(encode(good_topology()), &why)->patch);
+  auto bad = p;
+  bad.inserted_vertices = {3, 1};  // not ascending
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  EXPECT_NE(why.find("inserted_vertices"), std::string::npos) << why;
+  bad = p;
+  bad.inserted_vertices = {1, 5};  // beyond the new vertex count
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  bad = p;
+  bad.removed_triangles = {2, 2};
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  bad = p;
+  bad.rest_positions.resize(3);  // positions for one of two inserted vertices
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+  bad = p;
+  bad.base_generation = 3;  // a patch of its own generation
+  EXPECT_FALSE(decode_surface_topology(encode(bad), &why));
+}
+
 TEST(Messages, EventsRoundTripAndBadOnesAreRejected) {
   std::string why;
   Event e{0, EventKind::grasped, 3, 12, 1.25, 77, ""};

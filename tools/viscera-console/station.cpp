@@ -10,6 +10,7 @@
 #include "viscera/console/force_decimator.hpp"
 #include "viscera/console/foxglove_protocol.hpp"
 #include "viscera/protocol/streams.hpp"
+#include "viscera/protocol/surface_assembler.hpp"
 
 namespace viscera::console {
 
@@ -55,14 +56,17 @@ void Station::stream_loop() {
   ForceDecimator forces(force_period_s_);
   std::map<std::uint32_t, proto::Vector3> tips;
   std::uint32_t mesh_id = 0, vertex_count = 0, topology_generation = 0;
+  proto::SurfaceAssembler surfaces;  // whole surfaces from the server's patches (schema 16)
   const auto now_s = [] { return 1e-9 * static_cast<double>(client::now_ns()); };
   while (!stop_) {
     tap.wait(std::chrono::milliseconds(5));
     const bool raw = sink_.wants_raw && sink_.wants_raw();
     tap.take([&](const client::TapSample& s) {
       // The state streams always (the bridge keeps their newest for Foxglove clients that come later).
+      // The surface goes on whole (below): a client that comes later gets the whole one.
       const bool state = proto::stream_info(s.stream).state;
-      if (raw || state) sink_.raw(s.stream, s.stamp_ns, std::make_shared<const std::vector<std::uint8_t>>(s.payload.begin(), s.payload.end()));
+      if ((raw || state) && s.stream != proto::Stream::surface_topology)
+        sink_.raw(s.stream, s.stamp_ns, std::make_shared<const std::vector<std::uint8_t>>(s.payload.begin(), s.payload.end()));
       std::string why;
       switch (s.stream) {
         case proto::Stream::instrument_command:
@@ -104,7 +108,9 @@ void Station::stream_loop() {
           }
           break;
         case proto::Stream::surface_topology:
-          if (const auto t = proto::decode_surface_topology(s.payload, &why)) {
+          if (const auto message = proto::decode_surface_topology(s.payload, &why); message && surfaces.take(*message)) {
+            const proto::SurfaceTopology* t = &*surfaces.surface();
+            sink_.raw(s.stream, s.stamp_ns, std::make_shared<const std::vector<std::uint8_t>>(proto::encode(*t)));
             mesh_id = t->mesh_id;
             vertex_count = t->vertex_count;
             topology_generation = t->topology_generation;

@@ -163,6 +163,12 @@ struct SurfaceTopology {
   std::vector<std::uint32_t> triangles;  ///< 3 vertex indices per triangle
   std::vector<float> rest_positions;  ///< [m] 3 per vertex
   std::uint32_t topology_generation = 0;  ///< schema 15: 0 as loaded, +1 per change (cuts)
+  /// Schema 16: a patch of the surface of base_generation (surface_mesh.fbs says how it applies;
+  /// surface_assembler.hpp applies it). Then rest_positions are the inserted vertices' only, and
+  /// triangles those added.
+  bool patch = false;
+  std::uint32_t base_generation = 0;
+  std::vector<std::uint32_t> removed_vertices, inserted_vertices, removed_triangles;
 };
 
 /// The deformed surface at one instant.
@@ -253,7 +259,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 15;
+inline constexpr int kSchemaVersion = 16;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -3,8 +3,10 @@
 // and writing 100 kB-1 MB frames never delays the physics loop (docs/PROTOCOL.md: never write from
 // the physics thread). The physics thread only offers its state: when a frame is due, it copies
 // the surface positions into a hand-over buffer, and if the publisher is still busy with that
-// buffer it skips the frame instead of waiting. The topology is published once, reliably and
-// transient local, so clients that join later still get it.
+// buffer it skips the frame instead of waiting. The topology is published reliably and transient
+// local, so clients that join later still get it; after a cut as a patch of the one before
+// (surface_message.hpp), whole again every kPatchesPerWhole patches, so that the stream's last 16
+// messages always hold a whole surface for a late joiner.
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -16,6 +18,7 @@
 
 #include "viscera/protocol/messages.hpp"
 #include "viscera/runtime/server_endpoints.hpp"
+#include "viscera/runtime/surface_message.hpp"
 #include "viscera/tissue/mesh/tet_mesh.hpp"
 
 namespace viscera::runtime {
@@ -42,6 +45,11 @@ class MeshPublisher {
   /// thread.
   void change_topology(protocol::SurfaceTopology topology, std::vector<std::int32_t> surface_nodes);
   std::uint64_t topologies_published() const;
+  /// Of them, the patches, and the bytes of the arrays written for topologies after the first.
+  std::uint64_t patches_published() const;
+  std::uint64_t topology_change_bytes() const;
+  /// A whole surface after at most this many patches (the stream keeps 16 messages).
+  static constexpr int kPatchesPerWhole = 12;
   std::uint64_t frames_published() const;
   /// Frames that were due while the publisher was still writing the previous one.
   std::uint64_t frames_skipped() const { return skipped_; }
@@ -60,8 +68,11 @@ class MeshPublisher {
   std::condition_variable ready_cv_;
   protocol::MeshFrame pending_;  // guarded by mutex_
   std::optional<protocol::SurfaceTopology> pending_topology_;  // guarded by mutex_: to write before pending_
+  std::vector<std::int32_t> pending_topology_nodes_;  // guarded by mutex_: its vertices' mesh nodes
   bool ready_ = false, stop_ = false;
-  std::uint64_t published_ = 0, topologies_ = 1;
+  std::uint64_t published_ = 0, topologies_ = 1, patches_ = 0, change_bytes_ = 0;  // guarded by mutex_
+  SentSurface sent_;  // publisher thread: what the stream's readers hold
+  int patches_since_whole_ = 0;  // publisher thread
   std::thread thread_;
 };
 
