@@ -280,7 +280,7 @@ std::optional<proto::SurfaceTopology> Client::surface() {
     impl_->topology = std::make_unique<proto::TypedReader<proto::Stream::surface_topology>>(impl_->participant);
     impl_->frames = std::make_unique<proto::TypedReader<proto::Stream::mesh_frame>>(impl_->participant);
   }
-  impl_->topology->take([&](proto::SurfaceTopology t, const proto::Received&) { impl_->surfaces.take(t); }, impl_->rejections);
+  impl_->topology->take([&](const proto::SurfaceTopology& t, const proto::Received&) { impl_->surfaces.take(t); }, impl_->rejections);
   return impl_->surfaces.surface();
 }
 
