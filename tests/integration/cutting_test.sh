@@ -50,5 +50,31 @@ r = json.load(open(sys.argv[1]))
 print("re-simulation:", json.dumps(r.get("frames")), json.dumps(r.get("events")))
 assert r["frames"]["compared"] > 100 and r["frames"]["identical"] == r["frames"]["recorded"], r["frames"]
 PY
+# The recording played back from its last half second, after the cut (schema 16: the newest
+# surface message before that point is a patch of the one before): a client of the replay's
+# station gets the whole surface as it stood there, the cutting client's, and frames of it.
+span=$("$build/tools/viscera-record/viscera-record" info "$tmp/cut.mcap" | grep -o "over [0-9.]* s" | grep -o "[0-9.]*")
+from=$(python3 -c "print(max(0.0, ${span:-0} - 0.5))")
+"$build/tools/viscera-replay/viscera-replay" play "$tmp/cut.mcap" --from "$from" --loop --station replay-cut --domain "$domain" --no-keys --quiet \
+  > "$tmp/play.log" 2>&1 & player=$!; pids+=($player)
+PYTHONPATH="$build/python" /usr/bin/python3 - "$tmp/incise.json" "$domain" <<'PY'; rc_replay=$?
+import json, sys, time
+from viscera.session import Client
+cut = json.load(open(sys.argv[1]))["mesh"]
+c = Client(int(sys.argv[2]), 31, "replay-cut")
+surface, frames, end = None, 0, time.time() + 15
+while time.time() < end and frames < 10:
+    surface = c.surface()
+    f = c.poll_mesh_frame()
+    if f is not None and surface is not None and f.topology_generation == surface.topology_generation:
+        frames += 1
+    time.sleep(0.01)
+got = (surface.topology_generation, surface.vertex_count) if surface else None
+print(f"replay from its last half second: surface {got}, {frames} frames; the cutting client's: "
+      f"generation {cut['topology_generation']}, {cut['surface_vertices']} vertices")
+sys.exit(0 if got == (cut["topology_generation"], cut["surface_vertices"]) and frames >= 10 else 1)
+PY
+kill -INT "$player" 2>/dev/null; wait "$player" 2>/dev/null
+check "a replay from after the cut gives a new client the cut surface whole, and its frames (rc $rc_replay)" "[ $rc_replay -eq 0 ]"
 echo "cutting: $passed passed, $failures failed${failed_names:+:$failed_names}"
 [ "$failures" -eq 0 ]

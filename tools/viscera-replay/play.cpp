@@ -15,6 +15,7 @@
 #include "viscera/common/input_error.hpp"
 #include "viscera/protocol/messages.hpp"
 #include "viscera/protocol/streams.hpp"
+#include "viscera/protocol/surface_assembler.hpp"
 #include "viscera/recording/playback_clock.hpp"
 #include "viscera/recording/recording.hpp"
 
@@ -153,16 +154,23 @@ class Player {
   }
 
   /// What a client joining at recording time `t` must have: the newest sample of each state
-  /// stream (scene state, surface topology, scene files) before it.
+  /// stream (scene state, scene files) before it, and the whole surface as it stood then (the
+  /// newest surface message may be a patch of the one before: schema 16).
   void prime(std::uint64_t t) {
     std::map<std::pair<proto::Stream, std::uint32_t>, std::vector<std::uint8_t>> last;
+    std::map<std::uint32_t, proto::SurfaceAssembler> surfaces;
+    std::string why;
     recording_.for_each(
         [&](const rec::RecordedChannel& ch, const mcap::Message& m) {
-          if (proto::stream_info(ch.stream).state) last[{ch.stream, ch.source_id}] = m.data;
+          if (ch.stream == proto::Stream::surface_topology) {
+            if (const auto message = proto::decode_surface_topology(m.data, &why); message && surfaces[ch.source_id].take(*message))
+              last[{ch.stream, ch.source_id}] = proto::encode(*surfaces[ch.source_id].surface());
+          } else if (proto::stream_info(ch.stream).state) {
+            last[{ch.stream, ch.source_id}] = m.data;
+          }
           return true;
         },
         t0_, t);
-    std::string why;
     for (const auto& [key, payload] : last) {
       if (key.first == proto::Stream::scene_state) {
         scene_ = proto::decode_scene(payload, &why);

@@ -112,6 +112,7 @@ void bind_session(py::module_& m) {
       .def_readonly("mesh_id", &protocol::SurfaceTopology::mesh_id, "the organ mesh (SurfaceTopology.mesh_id; +1 per scene loaded)")
       .def_readonly("organ_name", &protocol::SurfaceTopology::organ_name, "the organ's name")
       .def_readonly("vertex_count", &protocol::SurfaceTopology::vertex_count, "vertices of the surface")
+      .def_readonly("topology_generation", &protocol::SurfaceTopology::topology_generation, "0 as loaded, higher after each change a cut made")
       .def_property_readonly(
           "triangles",
           [](const py::object& self) {
@@ -131,6 +132,8 @@ void bind_session(py::module_& m) {
       .def_readonly("frame", &protocol::MeshFrame::frame, "1, 2, ... per mesh")
       .def_readonly("sim_time_s", &protocol::MeshFrame::sim_time_s, "[s] simulated time")
       .def_readonly("tick", &protocol::MeshFrame::tick, "the physics tick it belongs to")
+      .def_readonly("topology_generation", &protocol::MeshFrame::topology_generation,
+                    "the surface (SurfaceTopology.topology_generation) its vertices are of")
       .def_property_readonly(
           "positions",
           [](const py::object& self) {
