@@ -9,6 +9,9 @@
 
 namespace viscera::protocol::detail {
 
+/// The largest coordinate a received position may have [m]: a scene is metres across, not kilometres.
+inline constexpr double kMaxPositionM = 10.0;
+
 /// identifier: the schema's file identifier (4 characters), or nullptr for the schema-1 messages,
 /// which have none. max_tables bounds the work a hostile payload can cause.
 template <typename T>
