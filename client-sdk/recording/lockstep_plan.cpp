@@ -79,9 +79,19 @@ class PlanBuilder {
     plan_.sim_time_s = plan_.scene.sim_time_s;
     plan_.last_tick = plan_.first_tick;
     const auto& info = recording_.info();
-    if (const auto it = info.find("schema_version"); it != info.end() && it->second.size() == 1 && it->second < "8") {
+    const auto it = info.find("schema_version");
+    const std::string version = it == info.end() ? "" : it->second;
+    const int schema =
+        !version.empty() && version.size() <= 3 && std::all_of(version.begin(), version.end(), [](char c) { return c >= '0' && c <= '9'; })
+            ? std::stoi(version)
+            : proto::kSchemaVersion;
+    if (schema < 8) {
       plan_.strain_recorded = false;
-      plan_.notes.push_back("recorded with protocol schema " + it->second + ": its forces carry no edge strain, which is not compared");
+      plan_.notes.push_back("recorded with protocol schema " + version + ": its forces carry no edge strain, which is not compared");
+    }
+    if (schema < 17) {
+      plan_.cutting_recorded = false;
+      plan_.notes.push_back("recorded with protocol schema " + version + ": its forces do not say whether a blade cut, which is not compared");
     }
   }
 
@@ -242,7 +252,7 @@ class PlanBuilder {
       const bool stepped = f.step_time_ns > 0;
       const std::uint64_t result_tick = stepped ? f.tick : f.tick + 1;
       plan_.forces[result_tick].push_back({f.instrument_id, f.client_id, f.command_seq, stepped, f.in_contact, f.force, f.torque, f.contact_point,
-                                           f.contact_normal, f.penetration_m, f.max_edge_strain, f.stiffness, force_log_times_[i]});
+                                           f.contact_normal, f.penetration_m, f.max_edge_strain, f.stiffness, force_log_times_[i], f.cutting});
       ++plan_.recorded_forces;
       plan_.last_tick = std::max(plan_.last_tick, result_tick);
       if (stepped) {

@@ -94,6 +94,7 @@ void row_of(Row& r, const protocol::Force& f) {
   for (std::size_t i = 0; i < 9; ++i) r.put(k[i], f.stiffness[i]);
   r.put("penetration_m", f.penetration_m);
   r.put("max_edge_strain", f.max_edge_strain);
+  r.put("cutting", f.cutting);
 }
 
 void row_of(Row& r, const protocol::SessionRequest& q) {

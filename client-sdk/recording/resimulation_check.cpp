@@ -25,9 +25,10 @@ bool same_bits(const Range& a, const Range& b) {
 }
 
 /// The first field of two forces that differs, or nullopt: (name, recorded, recomputed).
-std::optional<std::tuple<std::string, std::string, std::string>> force_difference(const ExpectedForce& e, const proto::Force& f,
-                                                                                  bool compare_strain) {
+std::optional<std::tuple<std::string, std::string, std::string>> force_difference(const ExpectedForce& e, const proto::Force& f, bool compare_strain,
+                                                                                  bool compare_cutting) {
   if (e.in_contact != f.in_contact) return std::make_tuple("in_contact", e.in_contact ? "true" : "false", f.in_contact ? "true" : "false");
+  if (compare_cutting && e.cutting != f.cutting) return std::make_tuple("cutting", e.cutting ? "true" : "false", f.cutting ? "true" : "false");
   const char* axes = "xyz";
   const auto vec = [&](const char* name, const proto::Vector3& a,
                        const proto::Vector3& b) -> std::optional<std::tuple<std::string, std::string, std::string>> {
@@ -81,7 +82,7 @@ void ResimulationCheck::check_forces(const proto::LockstepResult& r) {
         continue;
       }
       ++matched;
-      if (const auto d = force_difference(e, it->second, plan_.strain_recorded)) {
+      if (const auto d = force_difference(e, it->second, plan_.strain_recorded, plan_.cutting_recorded)) {
         diverged({r.tick, "force_feedback", describe(e.instrument_id, e.command_seq, e.stepped), std::get<0>(*d), std::get<1>(*d), std::get<2>(*d)});
       } else {
         ++counts_.forces_identical;

@@ -227,7 +227,7 @@ void ExerciseScorer::walk_commands(const proto::Command& c, const proto::Force& 
     const bool pressed = (k.buttons & kMarkButton) && !(buttons & kMarkButton);
     buttons = k.buttons;
     if (exercise_.kind == ExerciseKind::incision) {
-      walk_incision(k, f.tick);
+      walk_incision(k, f);
       if (ended_) return;
       continue;
     }
@@ -248,8 +248,10 @@ void ExerciseScorer::walk_commands(const proto::Command& c, const proto::Force& 
   }
 }
 
-void ExerciseScorer::walk_incision(const proto::Command& k, std::uint64_t tick) {
-  const bool held = (k.buttons & kMarkButton) != 0;
+void ExerciseScorer::walk_incision(const proto::Command& k, const proto::Force& f) {
+  const std::uint64_t tick = f.tick;
+  // The cut button held, or the blade pressed through above the scene's cut force (schema 17).
+  const bool held = (k.buttons & kMarkButton) != 0 || f.cutting;
   if (held && !cutting_) {
     cutting_ = true;
     // The surface is where the blade's last contact before cutting began (the tissue pressed

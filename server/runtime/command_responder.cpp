@@ -43,6 +43,7 @@ protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, 
   f.contact_normal = {r.normal.x(), r.normal.y(), r.normal.z()};
   f.stiffness = stiffness;
   f.penetration_m = r.depth_m;
+  f.cutting = r.cutting;
   return f;
 }
 
@@ -75,7 +76,8 @@ ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protoc
   if (tick) *tick = snap->tick;
   if (max_edge_strain) *max_edge_strain = snap->max_edge_strain;
   const Vec3 tip(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
-  if (scalpels_.contains(instrument_id) && (c.buttons & kCutButton) != 0) return {};  // cutting: the blade passes through
+  if (scalpels_.contains(instrument_id) && ((c.buttons & kCutButton) != 0 || snap->pressed_through.contains(instrument_id)))
+    return ContactResult{.cutting = true};  // cutting: the blade passes through
   ContactResult result = queries_.at(instrument_id)->query(tip, snap->x);
   if (const auto g = snap->grasped.find(instrument_id); g != snap->grasped.end() && !g->second.empty()) {
     const Eigen::Quaterniond q = Eigen::Quaterniond(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]).normalized();

@@ -25,6 +25,7 @@ void SimulationServer::Impl::cut_with_scalpels(const Status& status) {
   for (auto& [id, t] : tools) {
     const InstrumentSpec& spec = t.tool.spec();
     if (spec.kind != InstrumentKind::scalpel) continue;
+    t.tool.update_press_through(t.result);  // the contact of the step just taken
     // A material change being built reads the mesh: the blade waits for it (a few hundred ms).
     const bool cutting = t.tool.cutting() && can_cut(*organ) && !session.preparing_material();
     Stroke& s = t.stroke;

@@ -137,17 +137,19 @@ SceneSpec read_scene_file(const std::string& path) {
   std::set<std::uint32_t> ids;
   for (std::size_t k = 0; k < instruments.size(); ++k) {
     const JsonObject i(instruments[k], path, "instruments[" + std::to_string(k) + "]");
-    i.require_known({"id", "kind", "tip_radius_m", "grasp_radius_m", "blade_length_m"});
+    i.require_known({"id", "kind", "tip_radius_m", "grasp_radius_m", "blade_length_m", "cut_force_n"});
     InstrumentSpec spec;
     spec.id = static_cast<std::uint32_t>(i.integer("id", 1, 1'000'000));
     if (!ids.insert(spec.id).second) i.fail("id", std::to_string(spec.id) + " is used twice");
     const std::string kind = i.choice("kind", {"probe", "grasper", "scalpel"}, "probe");
     spec.kind = kind == "grasper" ? InstrumentKind::grasper : kind == "scalpel" ? InstrumentKind::scalpel : InstrumentKind::probe;
     if (spec.kind != InstrumentKind::scalpel)
-      if (i.has("blade_length_m")) i.fail("blade_length_m", "is for a scalpel; this is a " + kind);
+      for (const char* key : {"blade_length_m", "cut_force_n"})
+        if (i.has(key)) i.fail(key, "is for a scalpel; this is a " + kind);
     spec.grasp_radius_m = i.number("grasp_radius_m", 1e-4, 0.05, 0.01);
     spec.tip_radius_m = i.number("tip_radius_m", 1e-4, 0.05, spec.kind == InstrumentKind::scalpel ? 0.001 : 0.005);
     spec.blade_length_m = i.number("blade_length_m", 1e-3, 0.1, 0.02);
+    spec.cut_force_n = i.number("cut_force_n", 0.01, 50.0, 0.0);
     if (spec.kind == InstrumentKind::scalpel && s.model != "gps" && s.model != "gps_energy")
       i.fail("kind", "scalpel: the organ's model '" + s.model + "' cannot follow a cut (gps and gps_energy can)");
     s.instruments.push_back(spec);

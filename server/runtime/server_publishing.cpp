@@ -67,8 +67,10 @@ void SimulationServer::Impl::publish_snapshot(std::uint64_t tick) {
   snap->tick = tick;
   snap->max_edge_strain = organ->integrator->max_edge_strain();
   snap->x = state.x;
-  for (const auto& [id, t] : tools)
+  for (const auto& [id, t] : tools) {
     if (!t.tool.held().empty()) snap->grasped[id] = t.tool.held();
+    if (t.tool.pressed_through()) snap->pressed_through.insert(id);
+  }
   responder.publish(std::move(snap));
 }
 

@@ -13,6 +13,7 @@ bool SimulatedTool::begin_tick(bool active, std::uint32_t owner, const protocol:
   owner_ = owner;
   if (!active_) {
     held_ = {};  // released, or its client silent: a grasper lets go
+    press_ = {};
     return false;
   }
   command_ = command;
@@ -43,6 +44,18 @@ ToolEvent SimulatedTool::update_grasp(std::span<const std::int32_t> surface, std
     return ToolEvent::let_go;
   }
   return ToolEvent::none;
+}
+
+void SimulatedTool::update_press_through(const ContactResult& contact) {
+  if (!active_ || spec_.kind != InstrumentKind::scalpel || !(spec_.cut_force_n > 0)) {
+    press_ = {};
+    return;
+  }
+  if (press_.through) {
+    if ((position_ - press_.entry_point).dot(press_.entry_normal) > spec_.tip_radius_m) press_ = {};
+    return;
+  }
+  if (contact.in_contact && contact.force_on_tool.norm() >= spec_.cut_force_n) press_ = {true, contact.point, contact.normal};
 }
 
 ToolEvent SimulatedTool::update_contact(bool touching, double sim_time_s) {

@@ -116,7 +116,7 @@ void SimulationServer::Impl::start_outside(Tool& t) const {
 void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEvaluation& e) {
   for (auto& [id, t] : tools) {
     if (!t.tool.active() || t.tool.cutting()) {  // a cutting blade passes through the tissue
-      t.result = {};
+      t.result = ContactResult{.cutting = t.tool.cutting()};
       continue;
     }
     t.result = t.contact->apply(t.tool.position(), t.tool.velocity(), e);

@@ -37,8 +37,10 @@ TEST(Messages, RoundTripsEveryMessage) {
   f.in_contact = true;
   f.stiffness[4] = 200;
   f.max_edge_strain = 0.137;
+  f.cutting = true;
   const auto fd = decode_force(encode(f), &why);
   ASSERT_TRUE(fd) << why;
+  EXPECT_TRUE(fd->cutting);
   EXPECT_EQ(fd->force[2], 3.0);
   EXPECT_TRUE(fd->in_contact);
   EXPECT_EQ(fd->stiffness[4], 200);

@@ -27,6 +27,7 @@ TEST(SchemaEvolution, OldReaderReadsNewForceFeedback) {
   f.penetration_m = 0.0021;  // fields schema 1 does not know: penetration (schema 2), tick (schema 7)
   f.tick = 987654321;
   f.max_edge_strain = 0.25;  // schema 8
+  f.cutting = true;  // schema 17
   const auto bytes = encode(f);
   flatbuffers::Verifier verifier(bytes.data(), bytes.size());
   ASSERT_TRUE(v1::VerifyForceFeedbackBuffer(verifier));
@@ -57,6 +58,7 @@ TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
   EXPECT_EQ(f->penetration_m, 0.0);  // absent: the schema's default
   EXPECT_EQ(f->tick, 0u);  // an older server stamps no tick: a recording of it cannot be re-simulated
   EXPECT_EQ(f->max_edge_strain, 0.0);  // nor the organ's strain (schema 8)
+  EXPECT_FALSE(f->cutting);  // nor a blade cutting (schema 17)
 
   flatbuffers::FlatBufferBuilder c;
   const v1::Vec3 tip(0.0, 0.01, 0.05);

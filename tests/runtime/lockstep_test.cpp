@@ -5,6 +5,7 @@
 // its endpoints in memory.
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -74,10 +75,12 @@ struct LockstepRun {
 
 using Script = std::function<std::vector<proto::LockstepStep>(const proto::Scene&)>;
 
-/// One lockstep server on `threads` physics threads, through the steps of `steps_for` (script()).
-LockstepRun run(int threads, std::uint64_t nudge_at = 0, const Script& steps_for = {}) {
+/// One lockstep server on `threads` physics threads, through the steps of `steps_for` (script()),
+/// on the bundled liver scene as `adjust` changes it.
+LockstepRun run(int threads, std::uint64_t nudge_at = 0, const Script& steps_for = {}, const std::function<void(SceneSpec&)>& adjust = {}) {
   SceneSpec spec = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
   spec.physics_threads = threads;
+  if (adjust) adjust(spec);
   MemoryEndpoints endpoints;
   MemoryLockstepLink link;
   SimulationServer server(spec, endpoints, {}, TickBudget{1e9}, true);  // lockstep: no real time to keep, as viscera-server --lockstep
@@ -116,9 +119,10 @@ std::string first_difference(const LockstepRun& a, const LockstepRun& b) {
       const auto f = proto::decode_force(x.forces[k], &why), g = proto::decode_force(y.forces[k], &why);
       if (!f || !g) return at + "undecodable force";
       if (f->instrument_id != g->instrument_id || f->command_seq != g->command_seq || f->tick != g->tick ||
-          (f->step_time_ns > 0) != (g->step_time_ns > 0) || f->in_contact != g->in_contact || !same_bits(f->force, g->force) ||
-          !same_bits(f->torque, g->torque) || !same_bits(f->contact_point, g->contact_point) || !same_bits(f->contact_normal, g->contact_normal) ||
-          !same_bits(f->stiffness, g->stiffness) || !same_bits(f->penetration_m, g->penetration_m))
+          (f->step_time_ns > 0) != (g->step_time_ns > 0) || f->in_contact != g->in_contact || f->cutting != g->cutting ||
+          !same_bits(f->force, g->force) || !same_bits(f->torque, g->torque) || !same_bits(f->contact_point, g->contact_point) ||
+          !same_bits(f->contact_normal, g->contact_normal) || !same_bits(f->stiffness, g->stiffness) ||
+          !same_bits(f->penetration_m, g->penetration_m))
         return at + "force " + std::to_string(k);
     }
     if (x.events.size() != y.events.size()) return at + "event counts";
@@ -224,9 +228,9 @@ TEST(Lockstep, AStepForAnotherTickIsRefusedWithItsReason) {
   EXPECT_EQ(results[2].error, "");
 }
 
-/// The scalpel (instrument 4) claimed, lowered into the organ's top with its button held, drawn
-/// 6 cm along x, lifted out and the button let go; a frame every 10 ticks.
-std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
+/// The scalpel (instrument 4) claimed, lowered into the organ's top with its button held (or
+/// not: `button`), drawn 6 cm along x, lifted out and the button let go; a frame every 10 ticks.
+std::vector<proto::LockstepStep> incision(const proto::Scene& scene, bool button = true) {
   const double cx = 0.5 * (scene.bounds_min[0] + scene.bounds_max[0]), cy = 0.5 * (scene.bounds_min[1] + scene.bounds_max[1]);
   const double z0 = scene.bounds_max[2] + 0.002, depth = 0.02;  // the blade from 18 mm under the top to 2 mm over it
   std::vector<proto::LockstepStep> steps;
@@ -251,7 +255,7 @@ std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
                      : k <= down + along ? z0 - depth
                                          : z0 - depth * (1.0 - static_cast<double>(k - down - along) / up);
     c.tip_position = {cx - 0.03 + 0.06 * a, cy, z};
-    c.buttons = k < down + along + up ? 1u : 0u;
+    c.buttons = button && k < down + along + up ? 1u : 0u;
     if (k <= down + along + up) {
       s.commands.push_back(proto::encode(c));
       s.answers.push_back(proto::encode(c));
@@ -272,7 +276,8 @@ std::vector<proto::LockstepStep> incision(const proto::Scene& scene) {
 }
 
 TEST(Lockstep, AnIncisionOpensTheSurfaceTheSameWayOnEveryRunAndOnTwoThreads) {
-  const LockstepRun a = run(1, 0, incision), again = run(1, 0, incision), two = run(2, 0, incision);
+  const Script held = [](const proto::Scene& scene) { return incision(scene, true); };
+  const LockstepRun a = run(1, 0, held), again = run(1, 0, held), two = run(2, 0, held);
   ASSERT_EQ(a.results.size(), 901u);
   EXPECT_EQ(first_difference(a, again), "");
   EXPECT_EQ(first_difference(a, two), "");
@@ -324,6 +329,74 @@ TEST(Lockstep, AnIncisionOpensTheSurfaceTheSameWayOnEveryRunAndOnTwoThreads) {
 }
 
 }  // namespace
+/// Scalpel 4 of the bundled scene presses through at its cut force without its button: the
+/// incision starts at the first tick whose force reached it, the blade then passes through (no
+/// force, `cutting`), and the stroke ends when the tip is lifted out. With the cut force above what
+/// the tissue gives, the same hand only presses.
+TEST(Lockstep, AScalpelPressedAboveTheScenesCutForceCutsWithoutItsButton) {
+  const SceneSpec bundled = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  const auto scalpel = std::find_if(bundled.instruments.begin(), bundled.instruments.end(), [](const InstrumentSpec& i) { return i.id == 4; });
+  ASSERT_NE(scalpel, bundled.instruments.end());
+  const double cut_force = scalpel->cut_force_n;
+  ASSERT_GT(cut_force, 0.0);
+  const auto pressed = [](const proto::Scene& scene) { return incision(scene, false); };
+  const LockstepRun a = run(1, 0, pressed), again = run(1, 0, pressed);
+  EXPECT_EQ(first_difference(a, again), "");
+  std::string why;
+  std::vector<proto::Event> events;
+  std::vector<proto::Force> forces;
+  for (const auto& r : a.results) {
+    for (const auto& p : r.events) events.push_back(*proto::decode_event(p, &why));
+    for (const auto& p : r.forces)
+      if (const auto f = proto::decode_force(p, &why); f && f->instrument_id == 4 && f->step_time_ns > 0) forces.push_back(*f);
+  }
+  const auto first = [&](proto::EventKind k) {
+    return std::find_if(events.begin(), events.end(), [&](const proto::Event& e) { return e.kind == k; });
+  };
+  const auto count = [&](proto::EventKind k) {
+    return std::count_if(events.begin(), events.end(), [&](const proto::Event& e) { return e.kind == k; });
+  };
+  ASSERT_EQ(count(proto::EventKind::cut_started), 1);
+  ASSERT_EQ(count(proto::EventKind::cut_ended), 1);
+  EXPECT_EQ(count(proto::EventKind::physics_reset), 0);
+  const std::uint64_t started = first(proto::EventKind::cut_started)->tick, ended = first(proto::EventKind::cut_ended)->tick;
+  double peak_before = 0;
+  int through = 0;
+  for (const proto::Force& f : forces) {
+    const double F = std::sqrt(f.force[0] * f.force[0] + f.force[1] * f.force[1] + f.force[2] * f.force[2]);
+    if (f.tick < started) {
+      EXPECT_LT(F, cut_force) << "tick " << f.tick;
+      EXPECT_FALSE(f.cutting) << "tick " << f.tick;
+      peak_before = std::max(peak_before, F);
+    } else if (f.tick == started) {
+      EXPECT_GE(F, cut_force);  // the force that pressed it through
+    } else if (f.tick <= ended) {  // the tick that lifted it out still stepped with the blade through
+      EXPECT_TRUE(f.cutting) << "tick " << f.tick;
+      EXPECT_FALSE(f.in_contact) << "tick " << f.tick;
+      EXPECT_EQ(F, 0.0) << "tick " << f.tick;
+      ++through;
+    } else {
+      EXPECT_FALSE(f.cutting) << "tick " << f.tick;
+    }
+  }
+  EXPECT_GT(through, 300);  // drawn along and lifted
+  EXPECT_GT(ended, kFirstTick + 400);  // lifted out on the way up (ticks 401-500), not before
+  std::cout << "[ figure ] pressed through at tick +" << started - kFirstTick << " (force before it at most " << peak_before << " N, cut force "
+            << cut_force << " N); " << first(proto::EventKind::cut_ended)->text << " (ended at +" << ended - kFirstTick << ")\n";
+
+  // A cut force above what the tissue gives: the same hand presses and cuts nothing.
+  const LockstepRun firm = run(1, 0, pressed, [](SceneSpec& s) {
+    for (InstrumentSpec& i : s.instruments) i.cut_force_n = i.kind == InstrumentKind::scalpel ? 50.0 : 0.0;
+  });
+  std::size_t cuts = 0, contacts = 0;
+  for (const auto& r : firm.results) {
+    for (const auto& p : r.events) cuts += proto::decode_event(p, &why)->kind == proto::EventKind::cut_started;
+    for (const auto& p : r.forces) contacts += proto::decode_force(p, &why)->in_contact;
+  }
+  EXPECT_EQ(cuts, 0u);
+  EXPECT_GT(contacts, 300u);
+}
+
 TEST(Lockstep, EveryForceCarriesTheOrgansLargestEdgeStrainOfItsTick) {
   const LockstepRun a = run(1);
   ASSERT_EQ(a.results.size(), static_cast<std::size_t>(kTicks + 1));

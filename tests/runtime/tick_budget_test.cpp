@@ -120,5 +120,25 @@ TEST(SceneFile, BadNumbersAndBadSiblingsNeverEscapeAsLibraryErrors) {
   EXPECT_EQ(listing.unreadable[3].first, "overflow");
 }
 
+TEST(SceneFile, ACutForceBelongsToAScalpelAndIsAPositiveForce) {
+  const std::string dir = std::string(VISCERA_TEST_TMP) + "/cut-force";
+  std::filesystem::create_directories(dir);
+  std::ifstream good(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  const std::string text((std::istreambuf_iterator<char>(good)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json").instruments.back().cut_force_n, 1.5);
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    std::ofstream(dir + "/s.json") << t;
+    return error_of([&] { read_scene_file(dir + "/s.json"); });
+  };
+  EXPECT_EQ(with("\"cut_force_n\": 1.5", "\"cut_force_n\": 0"), dir + "/s.json: instruments[3].cut_force_n: 0 is outside [0.01, 50]");
+  EXPECT_EQ(with("\"cut_force_n\": 1.5", "\"cut_force_n\": \"hard\""), dir + "/s.json: instruments[3].cut_force_n: \"hard\" is not a number");
+  EXPECT_EQ(with("\"kind\": \"probe\", \"tip_radius_m\": 0.006", "\"kind\": \"probe\", \"cut_force_n\": 2, \"tip_radius_m\": 0.006"),
+            dir + "/s.json: instruments[0].cut_force_n: is for a scalpel; this is a probe");
+}
+
 }  // namespace
 }  // namespace viscera::runtime

@@ -47,7 +47,8 @@ struct Session {
     e.text = std::move(text);
     payloads.push_back({proto::Stream::event, proto::encode(e)});
   }
-  void step(std::uint64_t tick, const proto::Vector3& tip, double force_n, double strain = 0.1, std::uint32_t buttons = 0) {
+  /// `cutting`: the server says the scalpel's blade cuts (its button held, or pressed through).
+  void step(std::uint64_t tick, const proto::Vector3& tip, double force_n, double strain = 0.1, std::uint32_t buttons = 0, bool cutting = false) {
     proto::Command c;
     c.instrument_id = instrument;
     c.client_id = 7;
@@ -64,6 +65,7 @@ struct Session {
     f.contact_point = {tip[0], tip[1], tip[2] - kTipRadius};  // the tool's sphere touches the tissue below its centre
     f.tick = tick;
     f.max_edge_strain = strain;
+    f.cutting = cutting;
     payloads.push_back({proto::Stream::force_feedback, proto::encode(f)});
   }
   ScoreReport score(const Exercise& e, const std::vector<Payload>& order) const {
@@ -260,14 +262,17 @@ TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
     "incision": {"from_m": [-0.025, 0], "to_m": [0.025, 0], "depth_m": 0.01, "depth_tolerance_m": 0.003, "line_tolerance_m": 0.004,
                  "length_tolerance_m": 0.008}})",
                                     "incision.json");
-  const auto perform = [&](double y, double depth) {
+  // `pressed_through`: the blade cuts with the button up, because the server says it pressed
+  // through above the scene's cut force (Force.cutting), until it is lifted out.
+  const auto perform = [&](double y, double depth, bool pressed_through = false) {
     Session s("liver");
     s.instrument = 4;
     std::uint64_t tick = 101;
     for (int k = 0; k <= 10; ++k, ++tick) s.step(tick, {-0.025, y, 0.05 - 0.0005 * k}, k == 10 ? 0.5 : 0.0);  // touches: its sphere at 40 mm
     const double z_cut = 0.04 - depth;  // pressed on, button up, to a tip `depth` below where it touched
     for (int k = 1; k <= 50; ++k, ++tick) s.step(tick, {-0.025, y, 0.045 - (0.045 - z_cut) * k / 50.0}, 0.5);
-    for (int k = 0; k <= 1000; ++k, ++tick) s.step(tick, {-0.025 + 0.05 * k / 1000.0, y, z_cut}, 0.0, 0.1, 1u);
+    for (int k = 0; k <= 1000; ++k, ++tick)
+      s.step(tick, {-0.025 + 0.05 * k / 1000.0, y, z_cut}, 0.0, 0.1, pressed_through ? 0u : 1u, pressed_through);
     s.step(tick++, {0.025, y, z_cut}, 0.0, 0.1, 0u);
     return std::pair{s.score(e), tick - 1};
   };
@@ -286,6 +291,13 @@ TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
   EXPECT_TRUE(has_failure(off, "off the line: 6.0 mm")) << to_markdown(off);
   const auto [shallow, t2] = perform(0.0, 0.004);
   EXPECT_TRUE(has_failure(shallow, "deep on average")) << to_markdown(shallow);
+  const auto [through, t3] = perform(0.002, 0.01, true);
+  ASSERT_TRUE(through.incision_length_m);
+  EXPECT_NEAR(*through.incision_length_m, 0.05, 1e-12);
+  EXPECT_NEAR(through.incision_mean_depth_m, 0.01, 1e-12);
+  EXPECT_TRUE(through.passed) << to_markdown(through);
+  EXPECT_EQ(through.ending, "incision made");
+  (void)t3;
   (void)t1;
   (void)t2;
 }

@@ -38,6 +38,9 @@ struct Force {
   /// schema 8: the organ's largest edge strain |L - L0| / L0 over that tick's force evaluations
   /// (a tissue-damage proxy); 0 from older servers
   double max_edge_strain = 0;
+  /// schema 17: a scalpel's blade cutting (cut button held, or pressed through above the scene's
+  /// cut force): it passes through the tissue; false from older servers
+  bool cutting = false;
 };
 
 enum class Action : std::int8_t {
@@ -259,7 +262,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 16;
+inline constexpr int kSchemaVersion = 17;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

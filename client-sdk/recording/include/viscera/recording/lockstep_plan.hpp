@@ -37,6 +37,7 @@ struct ExpectedForce {
   double max_edge_strain = 0;
   std::array<double, 9> stiffness{};
   std::uint64_t log_time_ns = 0;
+  bool cutting = false;  ///< a scalpel's blade cutting (schema 17)
 };
 
 struct ExpectedEvent {
@@ -67,6 +68,7 @@ struct LockstepPlan {
   std::uint64_t recorded_forces = 0, recorded_events = 0, recorded_frames = 0;
   std::vector<std::string> notes;  ///< what could not be reproduced, and why
   bool strain_recorded = true;  ///< forces carry the organ's edge strain (recorded with schema 8 or later)
+  bool cutting_recorded = true;  ///< forces say whether a blade cut (recorded with schema 17 or later)
   /// The step of `tick` (an empty one where nothing happens).
   protocol::LockstepStep step(std::uint64_t tick) const;
 };

@@ -84,7 +84,7 @@ class ExerciseScorer {
   double announced_hold_s_ = 0;
   bool warned_force_ = false, warned_strain_ = false;
   // incision
-  void walk_incision(const protocol::Command& k, std::uint64_t tick);
+  void walk_incision(const protocol::Command& k, const protocol::Force& f);
   std::optional<protocol::Vector3> top_;  ///< centre of the top of the organ's box (scene state)
   std::optional<double> touch_z_, surface_z_;  ///< where the newest contact began (height); the surface where the cut began
   bool in_contact_ = false;

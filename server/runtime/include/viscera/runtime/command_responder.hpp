@@ -26,6 +26,8 @@ struct Snapshot {
   double max_edge_strain = 0;  ///< the organ's largest edge strain that tick's force evaluations saw
   std::vector<Vec3> x;
   std::map<std::uint32_t, GraspHold> grasped;
+  /// The scalpels pressed through the tissue (above the scene's cut force) and cutting
+  std::set<std::uint32_t> pressed_through;
 };
 
 /// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.

@@ -20,6 +20,9 @@ struct InstrumentSpec {
   /// scalpel: the blade, a segment from the tip along the tool's z axis (the shaft) [m]; it cuts
   /// while the owner holds button 1 (blade_cuts()).
   double blade_length_m = 0.02;
+  /// scalpel: the blade also cuts once its tip presses on the tissue with this force [N], until it
+  /// is lifted out (PressThrough, simulated_tool.hpp); 0: only with the button
+  double cut_force_n = 0.0;
 };
 
 /// Button 1 (bit 0 of Command::buttons): a scalpel's blade cuts while it is held.

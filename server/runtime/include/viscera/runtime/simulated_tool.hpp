@@ -30,6 +30,14 @@ inline bool blade_cuts(const InstrumentSpec& spec, const protocol::Command& comm
   return spec.kind == InstrumentKind::scalpel && (command.buttons & kCutButton) != 0;
 }
 
+/// A scalpel presses through the tissue (docs/CUTTING.md, "Cutting above a contact force") when
+/// its contact force reaches the scene's cut force; it stays through until its tip is a tip
+/// radius above the plane of the surface where it entered.
+struct PressThrough {
+  bool through = false;
+  Vec3 entry_point = Vec3::Zero(), entry_normal = Vec3::UnitZ();  ///< where it entered, the normal out of the tissue
+};
+
 class SimulatedTool {
  public:
   explicit SimulatedTool(const InstrumentSpec& spec) : spec_(spec) {}
@@ -44,7 +52,12 @@ class SimulatedTool {
   const GraspHold& held() const { return held_; }
   /// A scalpel whose owner holds the cut button: its blade passes through the tissue, cutting,
   /// and its tip does not push it (blade_cuts()).
-  bool cutting() const { return active_ && blade_cuts(spec_, command_); }
+  bool cutting() const { return active_ && (blade_cuts(spec_, command_) || press_.through); }
+  /// A scalpel of a scene with a cut force, pressed through the tissue (PressThrough).
+  bool pressed_through() const { return active_ && press_.through; }
+  /// After a tick: a scalpel of a scene with a cut force presses through when `contact`'s force
+  /// reaches it, and comes out when its tip is back above the entry surface (PressThrough).
+  void update_press_through(const ContactResult& contact);
 
   /// The tick's command (the newest of its owner), or inactive: an instrument without an owner or
   /// command exerts nothing, and a grasper lets go. A tool that becomes active starts at its
@@ -55,6 +68,7 @@ class SimulatedTool {
   void withdraw(const Vec3& offset) {
     position_ += offset;
     velocity_ = Vec3::Zero();
+    press_ = {};
   }
   /// Moves toward the commanded tip by at most `max_speed_m_s` x `dt_s`.
   void move(double dt_s, double max_speed_m_s);
@@ -74,6 +88,7 @@ class SimulatedTool {
   Vec3 position_ = Vec3::Zero();
   Vec3 velocity_ = Vec3::Zero();  // over the current tick [m/s]
   GraspHold held_;
+  PressThrough press_;
   bool touching_ = false;
   double last_touch_s_ = 0;
 };
