@@ -5,7 +5,9 @@
 # in the tissue and drawn 6 cm along the top for the whole run, a sweep every tick), with the
 # surface frames at 60 Hz watched by the client. Reports the server's missed slots and late ticks
 # of each run, the difference in missed slots as a share of the slots, the surface's topology
-# generation the client saw, and the physics resets (an integration that failed).
+# generation the client saw, the physics resets (an integration that failed), and the changes of
+# the mesh with how often the organ's kinetic plus elastic energy rose at one (never, if the cut is
+# right) and its largest change.
 # REPEAT=N alternates the two N times. Usage: [SCENE=liver] [REPEAT=1] bench/cutting.sh [SECONDS]   (default 60)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -16,8 +18,8 @@ scene="${SCENE:-liver}"
 "$root/deploy/build.sh" "$root/build" >/dev/null
 export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
-echo "| run | seconds | ticks | late ticks | missed slots | missed share | physics resets | surface generation seen |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| run | seconds | ticks | late ticks | missed slots | missed share | physics resets | surface generation seen | changes of the mesh | energy rose at | largest energy change |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for rep in $(seq "${REPEAT:-1}"); do
   for mode in press incise; do
     domain=$(( (RANDOM % 200) + 1 ))
@@ -40,8 +42,10 @@ server, client, mode, seconds = open(sys.argv[1]).read(), open(sys.argv[2]).read
 m = re.search(r"stopped after (\d+) ticks, (\d+) late, (\d+) missed slots, (\d+) physics resets", server)
 g = re.search(r"surface generation (\d+), (\d+) vertices", client)
 ticks, late, missed, resets = (int(x) for x in m.groups())
+e = re.search(r"(\d+) changes of the mesh by cuts, kinetic plus elastic energy rose at (\d+) \(largest change (\S+) J\)", server)
+changes, rises, largest = e.groups() if e else ("-", "-", "-")
 print(f"| {mode} | {seconds} | {ticks} | {late} | {missed} | {100 * missed / (ticks + missed):.3f}% | {resets} | "
-      f"{g.group(1) + ' (' + g.group(2) + ' vertices)' if g else '-'} |")
+      f"{g.group(1) + ' (' + g.group(2) + ' vertices)' if g else '-'} | {changes} | {rises} | {largest + ' J' if e and changes != '0' else '-'} |")
 PY
   done
 done

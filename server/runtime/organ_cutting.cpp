@@ -49,8 +49,17 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
   out.split_edges = change.split_edges;
   out.duplicated_nodes = change.duplicated_nodes;
   const MeshEdit edit = change.edit();
-  gps_of(organ)->follow_edit(edit, state.memory);
+  GpsModel* gps = gps_of(organ);
+  // The energy the cut changes: the kinetic energy (masses and new nodes), and the elastic energy
+  // of the parents (their constants, their vertices before) against that of their children.
+  out.energy_before_j = organ.integrator->kinetic_energy(state);
+  for (const auto& [e, vertices] : edit.replaced) out.energy_before_j += gps->element_energy(state.x, static_cast<std::size_t>(e), vertices);
+  gps->follow_edit(edit, state.memory);
   out.added_mass_kg = organ.integrator->follow_edit(edit, state);
+  out.energy_after_j = organ.integrator->kinetic_energy(state);
+  for (const auto& [e, vertices] : edit.replaced)
+    out.energy_after_j += gps->element_energy(state.x, static_cast<std::size_t>(e), gps->element(static_cast<std::size_t>(e)));
+  for (std::size_t e = edit.elements_before; e < gps->element_count(); ++e) out.energy_after_j += gps->element_energy(state.x, e, gps->element(e));
   if (update_boundary(organ.boundary, *organ.cutter, change).changed()) {
     out.surface_changed = true;
     ++organ.topology_generation;

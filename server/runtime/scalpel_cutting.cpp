@@ -1,6 +1,7 @@
 // The server's scalpels (docs/CUTTING.md, "In the server"): after each step, a scalpel that cuts
 // sweeps its blade from where the last tick left it to where this one does, and the organ follows
 // the cut (organ_cutting.hpp). Physics thread, between the step and the snapshot.
+#include <algorithm>
 #include <cstdio>
 
 #include "viscera/runtime/organ_cutting.hpp"
@@ -13,9 +14,12 @@ using namespace viscera::tissue;
 
 void SimulationServer::Impl::end_stroke(std::uint32_t id, Tool& t) {
   Stroke& s = t.stroke;
-  char text[240];
-  std::snprintf(text, sizeof text, "stroke %d: %zu sweeps, %zu tetrahedra cut, %zu edges split, %zu nodes duplicated, %.3g g of inertia added", s.id,
-                s.sweeps, s.tets_cut, s.split_edges, s.duplicated_nodes, 1e3 * s.added_mass_kg);
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "stroke %d: %zu sweeps, %zu tetrahedra cut, %zu edges split, %zu nodes duplicated, %.3g g of inertia added; "
+                "kinetic plus elastic energy rose at %zu of its %zu changes of the mesh (largest change %.3g J)",
+                s.id, s.sweeps, s.tets_cut, s.split_edges, s.duplicated_nodes, 1e3 * s.added_mass_kg, s.energy_rises, s.changes,
+                s.energy_change_max_j);
   event(proto::EventKind::cut_ended, id, t.tool.owner(), text);
   s = Stroke{};
 }
@@ -51,6 +55,15 @@ void SimulationServer::Impl::cut_with_scalpels(const Status& status) {
     s.split_edges += o.split_edges;
     s.duplicated_nodes += o.duplicated_nodes;
     s.added_mass_kg += o.added_mass_kg;
+    if (o.topology_changed) {
+      const double change = o.energy_after_j - o.energy_before_j;
+      s.energy_change_max_j = s.changes == 0 ? change : std::max(s.energy_change_max_j, change);
+      stats.cut_energy_change_max_j = stats.cut_changes == 0 ? change : std::max(stats.cut_energy_change_max_j, change);
+      ++s.changes;
+      ++stats.cut_changes;
+      s.energy_rises += o.energy_rose();
+      stats.cut_energy_rises += o.energy_rose();
+    }
     surface_changed = surface_changed || o.surface_changed;
   }
   refresh_compliance(status);

@@ -68,8 +68,8 @@ struct SimulationServer::Impl {
   struct Stroke {  // a scalpel's cut in progress
     std::int32_t id = -1;  // -1: not cutting
     tissue::Vec3 blade_tip = tissue::Vec3::Zero(), blade_end = tissue::Vec3::Zero();  // the blade after the last tick
-    std::size_t sweeps = 0, tets_cut = 0, split_edges = 0, duplicated_nodes = 0;
-    double added_mass_kg = 0;
+    std::size_t sweeps = 0, tets_cut = 0, split_edges = 0, duplicated_nodes = 0, changes = 0, energy_rises = 0;
+    double added_mass_kg = 0, energy_change_max_j = 0;
   };
   struct Tool {  // physics thread only
     SimulatedTool tool;

@@ -97,9 +97,11 @@ int main(int argc, char** argv) {
     const auto stats = lockstep ? server->run_lockstep(g_stop, endpoints, status) : server->run(g_stop, duration, status);
     log->info(
         "stopped after {} ticks, {} late, {} missed slots, {} physics resets, {} forces sent, {} messages rejected "
-        "(malformed {}, not owner {}, unknown instrument {}, another participant's client id {}), {} mesh frames",
+        "(malformed {}, not owner {}, unknown instrument {}, another participant's client id {}), {} mesh frames; "
+        "{} changes of the mesh by cuts, kinetic plus elastic energy rose at {} (largest change {:.3g} J)",
         stats.ticks, stats.late_ticks, stats.missed_slots, stats.physics_resets, stats.forces_sent, stats.rejected, stats.rejected_malformed,
-        stats.rejected_not_owner, stats.rejected_unknown_instrument, stats.rejected_other_participant, stats.mesh_frames);
+        stats.rejected_not_owner, stats.rejected_unknown_instrument, stats.rejected_other_participant, stats.mesh_frames, stats.cut_changes,
+        stats.cut_energy_rises, stats.cut_energy_change_max_j);
     server.reset();  // leaves the DDS domain: clients see the server gone at once
     if (viscera::runtime::SimulationServer::abandoned_work() > 0) {
       // An organ still being built in the background is not waited for.

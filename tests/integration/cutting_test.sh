@@ -4,7 +4,7 @@
 # by the cutting client and by a client that joins after the cut (transient local: it gets the
 # current cut surface, not the one loaded); the cut's events in the recording; and the recorded
 # session re-simulated in lockstep bit for bit (positions, forces, events, the surface's
-# topology generation at every frame).
+# topology generation at every frame); the organ's energy at each change of the mesh, live.
 # Usage: cutting_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
@@ -26,6 +26,8 @@ kill -INT "$server"; wait "$server"; rc_server=$?
 cat "$tmp/incise.log" "$tmp/late.log"; tail -2 "$tmp/server.log"
 check "the incision ran (client $rc_incise, late client $rc_late, recorder $rc_rec, server $rc_server)" \
   "[ $rc_incise -eq 0 ] && [ $rc_late -eq 0 ] && [ $rc_rec -eq 0 ] && [ $rc_server -eq 0 ]"
+check "the organ's kinetic plus elastic energy never rose at a change of the mesh by the live cut" \
+  "grep 'stopped after' '$tmp/server.log' | grep -qE ' [1-9][0-9]* changes of the mesh by cuts, kinetic plus elastic energy rose at 0 '"
 pycheck "$tmp/incise.json" "$tmp/late.json" <<'PY'
 import json, sys
 cut, late = (json.load(open(p))["mesh"] for p in sys.argv[1:3])

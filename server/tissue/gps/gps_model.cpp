@@ -395,35 +395,6 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, cons
   return ec ? add_forces_impl<true, true, true>(x, f, &memory, b0, b1) : add_forces_impl<false, true, true>(x, f, &memory, b0, b1);
 }
 
-double GpsModel::energy(std::span<const Vec3> x) const {
-  // The elastic energy; with the edge-map stiffening there is none (linear energy returned).
-  const GpsMechanisms& mech = options_.mechanisms;
-  const double qlv = mech.stiffening.b;
-  const bool qlv_energy = mech.energy_map();
-  const double ratio = mech.asymmetry.compression_ratio;
-  double sum = 0.0;
-  for (std::size_t e = 0; e < element_count(); ++e) {
-    const auto p = gather(x, e);
-    const auto r = gather(mesh_->nodes, e);
-    Vec6 dL;
-    for (int k = 0; k < 6; ++k) {
-      const int a = kTetEdges[k][0], b = kTetEdges[k][1];
-      const Vec3 du = (p[b] - r[b]) - (p[a] - r[a]);
-      const Vec3 y = p[b] - p[a];
-      dL(k) = (2.0 * y - du).dot(du) / (y.norm() + edge_length(e, k));
-      if (qlv_energy) dL(k) = edge_length(e, k) * edge_energy_map(qlv, ratio, dL(k) / edge_length(e, k), mech.stiffening.shape).h;
-    }
-    sum += 0.5 * dL.dot(packed_hessian(e) * dL);
-    if (with_volume_) {
-      const Block& b = blocks_[e / L];
-      const double V0 = b.rest_volume[e % L];
-      const double q = signed_volume(p[0], p[1], p[2], p[3]) / V0 - 1.0;
-      sum += 0.5 * b.kappa[e % L] * V0 * q * q;
-    }
-  }
-  return sum;
-}
-
 Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e) const { return tangent(x, e, 1.0, 0.0); }
 
 Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const { return element_tangent(x, e, dt_s, {}); }

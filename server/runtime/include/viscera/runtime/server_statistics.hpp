@@ -19,6 +19,11 @@ struct ServerStats {
   std::uint64_t late_ticks = 0;  ///< ticks that ended after their 1/rate slot (the next one starts at once)
   std::uint64_t missed_slots = 0;  ///< slots of the fixed-rate grid that passed with no tick
   std::uint64_t physics_resets = 0;  ///< organ reset to rest after an integration failure
+  /// Sweeps of a scalpel that changed the mesh, those at which the organ's kinetic plus elastic
+  /// energy rose (SweepOutcome::energy_rose), and the largest change of that energy at one [J]
+  /// (0 before the first)
+  std::uint64_t cut_changes = 0, cut_energy_rises = 0;
+  double cut_energy_change_max_j = 0;
   std::uint64_t mesh_frames = 0, mesh_frames_skipped = 0;  ///< surface frames published; due but replaced
   double step_p50_us = 0, step_p99_us = 0, step_max_us = 0, jitter_p99_us = 0, rate_hz = 0;
 };

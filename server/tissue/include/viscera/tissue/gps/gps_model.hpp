@@ -44,6 +44,10 @@ class GpsModel final : public ForceModel {
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, std::span<const double> memory) const override;
   double stiffness_damping_time_s() const override { return options_.mechanisms.viscous.kelvin_voigt_time_s; }
   double energy(std::span<const Vec3> x) const override;
+  /// Element e's elastic energy [J] with its own constants and rest lengths, on the vertices `t`:
+  /// its own (element(e)) or, between a cut of the mesh and follow_edit, its vertices before the
+  /// cut (MeshEdit::replaced), whose rest positions the cut left as they were.
+  double element_energy(std::span<const Vec3> x, std::size_t e, const Tet& t) const;
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e) const override;
 
   const GpsOptions& options() const { return options_; }

@@ -1,0 +1,41 @@
+// The GPS's elastic energy, whole or one element's (docs/TISSUE.md): 0.5 dL^T H dL over the
+// elements, with the edge map's stiffening where it has an energy, plus the volume term.
+#include "viscera/tissue/element/tet_geometry.hpp"
+#include "viscera/tissue/gps/fung_map.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+
+namespace viscera::tissue {
+
+double GpsModel::element_energy(std::span<const Vec3> x, std::size_t e, const Tet& t) const {
+  // With the edge-map stiffening that has no energy, the linear energy.
+  const GpsMechanisms& mech = options_.mechanisms;
+  const double qlv = mech.stiffening.b;
+  const bool qlv_energy = mech.energy_map();
+  const double ratio = mech.asymmetry.compression_ratio;
+  const std::array<Vec3, 4> p{x[t[0]], x[t[1]], x[t[2]], x[t[3]]};
+  const std::array<Vec3, 4> r{mesh_->nodes[t[0]], mesh_->nodes[t[1]], mesh_->nodes[t[2]], mesh_->nodes[t[3]]};
+  Vec6 dL;
+  for (int k = 0; k < 6; ++k) {
+    const int a = kTetEdges[k][0], b = kTetEdges[k][1];
+    const Vec3 du = (p[b] - r[b]) - (p[a] - r[a]);
+    const Vec3 y = p[b] - p[a];
+    dL(k) = (2.0 * y - du).dot(du) / (y.norm() + edge_length(e, k));
+    if (qlv_energy) dL(k) = edge_length(e, k) * edge_energy_map(qlv, ratio, dL(k) / edge_length(e, k), mech.stiffening.shape).h;
+  }
+  double sum = 0.5 * dL.dot(packed_hessian(e) * dL);
+  if (with_volume_) {
+    const Block& b = blocks_[e / kLanes];
+    const double V0 = b.rest_volume[e % kLanes];
+    const double q = signed_volume(p[0], p[1], p[2], p[3]) / V0 - 1.0;
+    sum += 0.5 * b.kappa[e % kLanes] * V0 * q * q;
+  }
+  return sum;
+}
+
+double GpsModel::energy(std::span<const Vec3> x) const {
+  double sum = 0.0;
+  for (std::size_t e = 0; e < element_count(); ++e) sum += element_energy(x, e, element(e));
+  return sum;
+}
+
+}  // namespace viscera::tissue
