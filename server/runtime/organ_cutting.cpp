@@ -5,6 +5,7 @@
 #include "viscera/tissue/cutting/boundary_update.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/model/reserve_resident.hpp"
 
 namespace viscera::runtime {
 
@@ -24,17 +25,17 @@ void enable_cutting(Organ& organ) {
   // Half as many elements again: a long incision through the 12k liver splits a few thousand.
   const std::size_t elements = organ.mesh->tet_count() * 3 / 2;
   gps->reserve_elements(elements);
-  organ.mesh->tets.reserve(elements);
-  organ.mesh->nodes.reserve(organ.mesh->node_count() * 3 / 2);
+  reserve_resident(organ.mesh->tets, elements);
+  reserve_resident(organ.mesh->nodes, organ.mesh->node_count() * 3 / 2);
   organ.cutter = std::make_unique<MeshCutter>(*organ.mesh);
 }
 
 void reserve_for_cuts(const Organ& organ, State& state) {
   if (!organ.cutter) return;
   const std::size_t elements = organ.mesh->tets.capacity(), nodes = organ.mesh->nodes.capacity();
-  state.memory.reserve(gps_of(organ)->memory_size_for(elements));
-  state.x.reserve(nodes);
-  state.v.reserve(nodes);
+  reserve_resident(state.memory, gps_of(organ)->memory_size_for(elements));
+  reserve_resident(state.x, nodes);
+  reserve_resident(state.v, nodes);
 }
 
 bool can_cut(const Organ& organ) { return organ.cutter != nullptr; }
@@ -50,16 +51,36 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
   out.duplicated_nodes = change.duplicated_nodes;
   const MeshEdit edit = change.edit();
   GpsModel* gps = gps_of(organ);
-  // The energy the cut changes: the kinetic energy (masses and new nodes), and the elastic energy
-  // of the parents (their constants, their vertices before) against that of their children.
-  out.energy_before_j = organ.integrator->kinetic_energy(state);
-  for (const auto& [e, vertices] : edit.replaced) out.energy_before_j += gps->element_energy(state.x, static_cast<std::size_t>(e), vertices);
+  // The energy the cut changes: the kinetic energy of the nodes whose mass or velocity it can change
+  // (the vertices of the parents and of their children, the new nodes among them), and the
+  // elastic energy of the parents (their constants, their vertices before) against that of their
+  // children.
+  std::vector<std::int32_t> nodes;
+  for (const auto& [e, vertices] : edit.replaced) {
+    out.energy_before_j += gps->element_energy(state.x, static_cast<std::size_t>(e), vertices);
+    nodes.insert(nodes.end(), vertices.begin(), vertices.end());
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  const auto kinetic = [&](std::span<const std::int32_t> of) {
+    double k = 0.0;
+    for (const std::int32_t n : of)
+      k += 0.5 * organ.integrator->masses()[static_cast<std::size_t>(n)] * state.v[static_cast<std::size_t>(n)].squaredNorm();
+    return k;
+  };
+  out.energy_before_j += kinetic(nodes);
   gps->follow_edit(edit, state.memory);
   out.added_mass_kg = organ.integrator->follow_edit(edit, state);
-  out.energy_after_j = organ.integrator->kinetic_energy(state);
-  for (const auto& [e, vertices] : edit.replaced)
-    out.energy_after_j += gps->element_energy(state.x, static_cast<std::size_t>(e), gps->element(static_cast<std::size_t>(e)));
-  for (std::size_t e = edit.elements_before; e < gps->element_count(); ++e) out.energy_after_j += gps->element_energy(state.x, e, gps->element(e));
+  const auto child = [&](std::size_t e) {
+    const Tet& t = gps->element(e);
+    out.energy_after_j += gps->element_energy(state.x, e, t);
+    nodes.insert(nodes.end(), t.begin(), t.end());
+  };
+  for (const auto& [e, vertices] : edit.replaced) child(static_cast<std::size_t>(e));
+  for (std::size_t e = edit.elements_before; e < gps->element_count(); ++e) child(e);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  out.energy_after_j += kinetic(nodes);
   if (update_boundary(organ.boundary, *organ.cutter, change).changed()) {
     out.surface_changed = true;
     ++organ.topology_generation;

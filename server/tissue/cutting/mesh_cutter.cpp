@@ -75,7 +75,7 @@ MeshCutter::MeshCutter(TetMesh& mesh, CutOptions options) : mesh_(mesh), options
 
 std::int32_t MeshCutter::add_node(const Vec3& rest, const Vec3& now, std::int32_t stroke, const Vec3& cut_point, const Vec3& normal) {
   mesh_.nodes.push_back(rest);
-  now_.push_back(now);
+  added_now_.push_back(now);
   node_tets_.emplace_back();
   on_cut_.push_back(stroke);
   reach_.push_back(0.0);
@@ -104,8 +104,8 @@ void MeshCutter::split_edge(std::int32_t a, std::int32_t b, double s, std::int32
   const std::int32_t ab[2] = {a, b};
   const std::vector<std::int32_t> around = tets_with(ab);
   const auto ua = static_cast<std::size_t>(a), ub = static_cast<std::size_t>(b);
-  const std::int32_t n = add_node((1.0 - s) * mesh_.nodes[ua] + s * mesh_.nodes[ub], (1.0 - s) * now_[ua] + s * now_[ub], stroke,
-                                  (1.0 - s) * now_[ua] + s * now_[ub], normal);
+  const std::int32_t n = add_node((1.0 - s) * mesh_.nodes[ua] + s * mesh_.nodes[ub], (1.0 - s) * now(ua) + s * now(ub), stroke,
+                                  (1.0 - s) * now(ua) + s * now(ub), normal);
   change.new_nodes.push_back({a, b, s});
   // The new node's edges lie inside its parents, no longer than their longest edges.
   reach_[static_cast<std::size_t>(n)] = std::max(reach_[ua], reach_[ub]);
@@ -212,7 +212,7 @@ void MeshCutter::separate_faces(std::span<const std::int32_t> touched, std::int3
 
 Vec3 MeshCutter::tet_centroid(const Tet& t) const {
   Vec3 c = Vec3::Zero();
-  for (const std::int32_t v : t) c += now_[static_cast<std::size_t>(v)] / 4.0;
+  for (const std::int32_t v : t) c += now(static_cast<std::size_t>(v)) / 4.0;
   return c;
 }
 
@@ -253,7 +253,7 @@ void MeshCutter::duplicate_if_apart(std::int32_t node, CutChange& change) {
     std::int32_t& id = copy_of_root[static_cast<std::size_t>(r)];
     if (id < 0) {
       const auto u = static_cast<std::size_t>(node);
-      id = add_node(mesh_.nodes[u], now_[u], on_cut_[u], cut_point_[u], cut_normal_[u]);
+      id = add_node(mesh_.nodes[u], now(u), on_cut_[u], cut_point_[u], cut_normal_[u]);
       reach_[static_cast<std::size_t>(id)] = reach_[u];
       change.new_nodes.push_back({node, node, 0.0});
       ++change.duplicated_nodes;
@@ -295,7 +295,8 @@ CutChange MeshCutter::cut(const BladeSweep& sweep, std::span<const Vec3> x, std:
   if (stroke < 0) throw std::invalid_argument("MeshCutter::cut: stroke ids are >= 0");
   if (x.size() != mesh_.nodes.size()) throw std::invalid_argument("MeshCutter::cut: one position per node expected");
   CutChange change;
-  now_.assign(x.begin(), x.end());
+  x_ = x;
+  added_now_.clear();
   // The patch's mean normal (its two triangles differ by the blade's turn in one tick).
   const Vec3 normal = ((sweep.b0 - sweep.a0) + (sweep.b1 - sweep.a1)).cross((sweep.a1 - sweep.a0) + (sweep.b1 - sweep.b0)).normalized();
   change.first_new_node = mesh_.nodes.size();
@@ -316,13 +317,16 @@ CutChange MeshCutter::cut(const BladeSweep& sweep, std::span<const Vec3> x, std:
   const Vec3 m0 = 0.5 * (sweep.a0 + sweep.a1), m1 = 0.5 * (sweep.b0 + sweep.b1), blade = m1 - m0;
   const double half_travel = 0.5 * std::max((sweep.a1 - sweep.a0).norm(), (sweep.b1 - sweep.b0).norm());
   const double blade2 = std::max(blade.squaredNorm(), 1e-300);
+  // A crossing edge has an end on the patch's front side (or within its warp of the plane), and
+  // both its ends are near: the edges are looked for from the near nodes on that side only.
   std::vector<std::int32_t> near;
   for (std::size_t a = 0; a < x.size(); ++a) {
     const double t = std::clamp((x[a] - m0).dot(blade) / blade2, 0.0, 1.0);
     const double r = reach_[a] + half_travel;
-    if ((x[a] - m0 - t * blade).squaredNorm() <= r * r) near.push_back(static_cast<std::int32_t>(a));
+    if ((x[a] - m0 - t * blade).squaredNorm() <= r * r && (x[a] - centre).dot(normal) >= -warp) near.push_back(static_cast<std::int32_t>(a));
   }
   near_.resize(x.size(), 0);
+  seen_.resize(x.size(), 0);
   for (const std::int32_t a : near) near_[static_cast<std::size_t>(a)] = 1;
   struct Crossing {
     std::uint64_t key;
@@ -333,8 +337,15 @@ CutChange MeshCutter::cut(const BladeSweep& sweep, std::span<const Vec3> x, std:
   for (const std::int32_t a : near) {
     const Vec3& xa = x[static_cast<std::size_t>(a)];
     const double da = (xa - centre).dot(normal);
+    if (++seen_tag_ == 0) {  // the tags wrapped: forget them all
+      std::fill(seen_.begin(), seen_.end(), 0u);
+      seen_tag_ = 1;
+    }
     for (const std::int32_t e : node_tets_[static_cast<std::size_t>(a)])
       for (const std::int32_t b : mesh_.tets[static_cast<std::size_t>(e)]) {
+        std::uint32_t& seen = seen_[static_cast<std::size_t>(b)];
+        if (seen == seen_tag_) continue;  // a neighbour in several of a's tetrahedra: once
+        seen = seen_tag_;
         if (b == a || (near_[static_cast<std::size_t>(b)] != 0 && b < a)) continue;  // b's turn
         if (on_cut_[static_cast<std::size_t>(a)] == stroke && on_cut_[static_cast<std::size_t>(b)] == stroke) continue;
         const Vec3& xb = x[static_cast<std::size_t>(b)];
@@ -347,8 +358,7 @@ CutChange MeshCutter::cut(const BladeSweep& sweep, std::span<const Vec3> x, std:
       }
   }
   for (const std::int32_t a : near) near_[static_cast<std::size_t>(a)] = 0;
-  std::sort(found.begin(), found.end());  // an edge is found once per tetrahedron around it
-  found.erase(std::unique(found.begin(), found.end(), [](const Crossing& p, const Crossing& q) { return p.key == q.key; }), found.end());
+  std::sort(found.begin(), found.end());  // in the order of the edges' keys, whatever the scan's
 
   struct Split {
     std::int32_t a, b;
@@ -388,7 +398,8 @@ CutChange MeshCutter::cut(const BladeSweep& sweep, std::span<const Vec3> x, std:
   std::sort(opened.begin(), opened.end());
   opened.erase(std::unique(opened.begin(), opened.end()), opened.end());
   for (const std::int32_t n : opened) duplicate_if_apart(n, change);
-  now_.clear();
+  x_ = {};
+  added_now_.clear();
   for (const auto& [e, tet] : change.replaced) changed_[static_cast<std::size_t>(e)] = 0;
   return change;
 }

@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 
 #include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/model/reserve_resident.hpp"
 
 namespace viscera::tissue {
 
@@ -69,8 +70,8 @@ std::vector<double> GpsModel::memory_from(const GpsModel& before, std::span<cons
 }
 
 void GpsModel::reserve_elements(std::size_t elements) {
-  blocks_.reserve((elements + kLane - 1) / kLane);
-  if (!bulk_.empty()) bulk_.reserve((elements + kLane - 1) / kLane);
+  reserve_resident(blocks_, (elements + kLane - 1) / kLane);
+  if (!bulk_.empty()) reserve_resident(bulk_, (elements + kLane - 1) / kLane);
 }
 
 std::size_t GpsModel::memory_size_for(std::size_t elements) const {
@@ -92,26 +93,37 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
   std::vector<std::array<Vec3, 4>> parent_rest(parents);
   std::vector<Mat6> parent_h(with_memory ? parents : 0);
   std::vector<double> parent_memory(with_memory ? parents * stride : 0);
-  std::vector<std::int32_t> slot_of(before, -1);
+  // The parents by element, each with its slot: looked up by a child's origin without a pass over
+  // the whole model (a sweep of the 12k liver replaces a few tens of its elements).
+  std::vector<std::pair<std::int32_t, std::int32_t>> slot_of(parents);
   const auto& X = mesh_->nodes;
   for (std::size_t i = 0; i < parents; ++i) {
     const auto& [element, tet] = edit.replaced[i];
     const auto e = static_cast<std::size_t>(element);
-    if (element < 0 || e >= before || slot_of[e] >= 0)
-      throw std::invalid_argument("GpsModel::follow_edit: a replaced element is out of range or repeated");
-    slot_of[e] = static_cast<std::int32_t>(i);
+    if (element < 0 || e >= before) throw std::invalid_argument("GpsModel::follow_edit: a replaced element is out of range or repeated");
+    slot_of[i] = {element, static_cast<std::int32_t>(i)};
     parent_rest[i] = {X[tet[0]], X[tet[1]], X[tet[2]], X[tet[3]]};
     if (!with_memory) continue;
     parent_h[i] = packed_hessian(e);  // as write_lane calibrated it (its lane is rewritten below)
     for (std::size_t w = 0; w < stride / kLane; ++w) parent_memory[i * stride + w * kLane] = memory[(e / kLane) * stride + w * kLane + e % kLane];
   }
+  std::sort(slot_of.begin(), slot_of.end());
+  for (std::size_t i = 1; i < parents; ++i)
+    if (slot_of[i].first == slot_of[i - 1].first)
+      throw std::invalid_argument("GpsModel::follow_edit: a replaced element is out of range or repeated");
+  const auto parent_slot = [&](std::size_t p) {  // the parent's slot, -1 if p was not replaced
+    const auto it = std::lower_bound(slot_of.begin(), slot_of.end(), std::pair<std::int32_t, std::int32_t>{static_cast<std::int32_t>(p), -1});
+    return it != slot_of.end() && it->first == static_cast<std::int32_t>(p) ? it->second : -1;
+  };
+  // The changed elements in ascending order: the replaced, then the new ones.
   std::vector<std::int32_t> changed;
-  for (std::size_t e = 0; e < n; ++e) {
-    const auto p = static_cast<std::size_t>(edit.origin[e]);
+  changed.reserve(parents + (n - before));
+  for (const auto& parent : slot_of) changed.push_back(parent.first);
+  for (std::size_t e = before; e < n; ++e) changed.push_back(static_cast<std::int32_t>(e));
+  for (const std::int32_t e : changed) {
+    const auto p = static_cast<std::size_t>(edit.origin[static_cast<std::size_t>(e)]);
     if (p >= before) throw std::invalid_argument("GpsModel::follow_edit: an origin names no element before the edit");
-    if (e < before && slot_of[e] < 0) continue;
-    if (slot_of[p] < 0) throw std::invalid_argument("GpsModel::follow_edit: a new element's parent is not among the replaced");
-    changed.push_back(static_cast<std::int32_t>(e));
+    if (parent_slot(p) < 0) throw std::invalid_argument("GpsModel::follow_edit: a new element's parent is not among the replaced");
   }
   if (!material_of_tet_.empty())
     for (std::size_t e = before; e < n; ++e) material_of_tet_.push_back(material_of_tet_[static_cast<std::size_t>(edit.origin[e])]);
@@ -124,7 +136,7 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
   memory.resize(memory_size(), 0.0);
   for (const std::int32_t element : changed) {
     const auto e = static_cast<std::size_t>(element);
-    const auto i = static_cast<std::size_t>(slot_of[static_cast<std::size_t>(edit.origin[e])]);
+    const auto i = static_cast<std::size_t>(parent_slot(static_cast<std::size_t>(edit.origin[e])));
     carry_memory(parent_memory.data() + i * stride, parent_rest[i], parent_h[i], memory.data() + (e / kLane) * stride + e % kLane, e);
   }
   // Padding lanes: zero memory, as a new model's.

@@ -62,7 +62,9 @@ void GpsModel::write_lane(std::size_t slot) {
   const int j = static_cast<int>(slot % L);
   const auto rest = gather(mesh_->nodes, e);
   const std::size_t m = material_of(e);
-  Mat6 H = calibrated_hessian(rest, m);
+  // A padding lane contributes nothing: its H is zero, so it is not calibrated (a cut that grows
+  // the model rewrites up to seven of them).
+  Mat6 H = padding ? Mat6::Zero().eval() : calibrated_hessian(rest, m);
   const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
   if (!bulk_.empty()) {
     // The volumetric part of H is rank one: (K_Reuss / V0) hv hv^T (hv: J^T hv = grad V).
@@ -71,7 +73,6 @@ void GpsModel::write_lane(std::size_t slot) {
     for (int k = 0; k < 6; ++k) bb.hv[k][j] = hv(k);
     bb.scale[j] = padding ? 0.0 : (reuss_bulk_modulus(materials_[m]) - (with_volume_ ? kappa_[m] : 0.0)) / V0;
   }
-  if (padding) H.setZero();
   for (int k = 0; k < 4; ++k) b.v[k][j] = mesh_->tets[e][k];
   for (int k = 0; k < 6; ++k) {
     b.rest_length[k][j] = (rest[kTetEdges[k][1]] - rest[kTetEdges[k][0]]).norm();

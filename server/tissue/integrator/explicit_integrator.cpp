@@ -166,18 +166,20 @@ double ExplicitIntegrator::follow_edit(const MeshEdit& edit, State& state) {
   // Lumped masses: the replaced elements' shares off, the changed and new elements' on.
   std::vector<double>& inertia = scaling_.density_kg_m3;
   const auto share = [&](const Tet& t, double density) { return 0.25 * density * signed_volume(X[t[0]], X[t[1]], X[t[2]], X[t[3]]); };
-  std::vector<char> replaced(edit.elements_before, 0);
+  // The changed elements in ascending order (the replaced, then the new ones), without a pass over
+  // the whole organ: a sweep of the 12k liver changes a few tens of its elements.
+  std::vector<std::int32_t> changed;
+  changed.reserve(edit.replaced.size() + (elements - edit.elements_before));
   for (const auto& [e, t] : edit.replaced) {
-    replaced[static_cast<std::size_t>(e)] = 1;
+    changed.push_back(e);
     const double w = share(t, density_[static_cast<std::size_t>(e)]), m = share(t, inertia[static_cast<std::size_t>(e)]);
     for (const std::int32_t v : t) {
       weight_[static_cast<std::size_t>(v)] -= w;
       mass_[static_cast<std::size_t>(v)] -= m;
     }
   }
-  std::vector<std::int32_t> changed;
-  for (std::size_t e = 0; e < elements; ++e)
-    if (e >= edit.elements_before || replaced[e]) changed.push_back(static_cast<std::int32_t>(e));
+  std::sort(changed.begin(), changed.end());
+  for (std::size_t e = edit.elements_before; e < elements; ++e) changed.push_back(static_cast<std::int32_t>(e));
   for (std::size_t e = edit.elements_before; e < elements; ++e) {
     const auto p = static_cast<std::size_t>(edit.origin[e]);
     density_.push_back(density_[p]);
@@ -187,7 +189,9 @@ double ExplicitIntegrator::follow_edit(const MeshEdit& edit, State& state) {
   std::vector<double> unscaled(changed.size());
   for (std::size_t k = 0; k < changed.size(); ++k) unscaled[k] = inertia[static_cast<std::size_t>(changed[k])];
   const double added = hold_element_steps(model_, inertia, changed, element_step_s_);
-  std::vector<double> grown(nodes, 0.0);  // inertia added per node
+  grown_.resize(nodes, 0.0);  // inertia added per node (all 0 between edits)
+  std::vector<std::int32_t> touched;  // the changed elements' nodes
+  touched.reserve(4 * changed.size());
   for (std::size_t k = 0; k < changed.size(); ++k) {
     const auto e = static_cast<std::size_t>(changed[k]);
     const Tet& t = tets[e];
@@ -195,9 +199,12 @@ double ExplicitIntegrator::follow_edit(const MeshEdit& edit, State& state) {
     for (const std::int32_t v : t) {
       weight_[static_cast<std::size_t>(v)] += w;
       mass_[static_cast<std::size_t>(v)] += m;
-      grown[static_cast<std::size_t>(v)] += m - m0;
+      grown_[static_cast<std::size_t>(v)] += m - m0;
+      touched.push_back(v);
     }
   }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   // Momentum kept where inertia was added; the touched nodes' gravity and inverse masses.
   gravity_.resize(nodes);
   inv_mass_.resize(nodes);
@@ -207,8 +214,11 @@ double ExplicitIntegrator::follow_edit(const MeshEdit& edit, State& state) {
       gravity_[i] = weight_[i] * bc_.gravity_m_s2;
       for (int c = 0; c < 3; ++c) inv_mass_[i][c] = constrained_[3 * i + static_cast<std::size_t>(c)] ? 0.0 : 1.0 / mass_[i];
     }
-  for (std::size_t i = 0; i < nodes; ++i)
-    if (grown[i] > 0.0) state.v[i] *= (mass_[i] - grown[i]) / mass_[i];
+  for (const std::int32_t v : touched) {
+    const auto i = static_cast<std::size_t>(v);
+    if (grown_[i] > 0.0) state.v[i] *= (mass_[i] - grown_[i]) / mass_[i];
+    grown_[i] = 0.0;
+  }
   force_.resize(nodes);
   field_stiffness_.resize(nodes);
   field_damping_.resize(nodes);

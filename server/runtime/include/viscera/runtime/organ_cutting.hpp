@@ -20,10 +20,11 @@ struct SweepOutcome {
   std::size_t tets_cut = 0;  ///< tetrahedra of the organ before the sweep that it changed
   std::size_t split_edges = 0, duplicated_nodes = 0;
   double added_mass_kg = 0;  ///< inertia added to keep the new elements' stable step
-  /// The organ's kinetic energy and the elastic energy of the elements the sweep replaced, just
-  /// before it [J], and the kinetic energy and the elastic energy of their children just after:
-  /// the rest of the organ's elastic energy is untouched, so their difference is the change of the
-  /// whole organ's kinetic plus elastic energy (0 and 0 when the topology did not change).
+  /// The kinetic energy of the nodes the sweep touched (the vertices of the elements it replaced,
+  /// before and after, new nodes included) and the elastic energy of the elements it replaced, just
+  /// before it [J], and the same just after with their children's: nothing else changes, so their
+  /// difference is the change of the whole organ's kinetic plus elastic energy (0 and 0 when the
+  /// topology did not change).
   double energy_before_j = 0, energy_after_j = 0;
   /// Whether the energy rose, beyond rounding (1e-9 of energy_before_j).
   bool energy_rose() const { return energy_after_j - energy_before_j > 1e-9 * energy_before_j + 1e-18; }

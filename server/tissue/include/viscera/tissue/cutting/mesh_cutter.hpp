@@ -113,9 +113,14 @@ class MeshCutter {
   std::vector<std::int32_t> on_cut_;
   std::vector<Vec3> cut_point_;  ///< where the blade's surface crossed the mesh at a node (current, when cut)
   std::vector<Vec3> cut_normal_;  ///< unit normal of the blade's surface there
-  std::vector<Vec3> now_;  ///< current positions during cut(), new nodes included
+  /// During cut(): the current positions given, and those of the nodes made since.
+  std::span<const Vec3> x_;
+  std::vector<Vec3> added_now_;
+  const Vec3& now(std::size_t n) const { return n < x_.size() ? x_[n] : added_now_[n - x_.size()]; }
   std::vector<char> changed_;  ///< during cut(): tetrahedra already in CutChange::replaced
   std::vector<char> near_;  ///< during cut(): nodes near the sweep (all 0 between calls)
+  std::vector<std::uint32_t> seen_;  ///< during cut(): the tag of the last node whose neighbours reached it
+  std::uint32_t seen_tag_ = 0;
   std::unordered_set<FaceKey, FaceHash> separated_;
   std::vector<double> reach_;  ///< per node, 1.5 x its longest rest edge [m] (splits only shorten edges)
 };

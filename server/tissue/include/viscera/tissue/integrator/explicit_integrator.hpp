@@ -100,6 +100,7 @@ class ExplicitIntegrator {
   std::vector<Vec3> force_, x_prev_, v_prev_;
   std::vector<double> field_stiffness_, field_damping_;
   double t_prev_ = 0.0;
+  std::vector<double> grown_;  ///< follow_edit's scratch: inertia added per node, all 0 between edits
   double max_edge_strain_ = 0.0;
   double element_step_s_ = 0.0;
 };
