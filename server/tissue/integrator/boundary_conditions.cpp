@@ -1,5 +1,7 @@
 #include "viscera/tissue/integrator/boundary_conditions.hpp"
 
+#include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include "viscera/tissue/element/tet_geometry.hpp"
@@ -58,6 +60,33 @@ std::vector<std::int32_t> surface_nodes_in_box(const TetMesh& mesh, const Box& b
   for (auto i : extract_boundary(mesh).nodes)
     if (box.contains(mesh.nodes[i])) out.push_back(i);
   return out;
+}
+
+void extend_constraints(BoundaryConditions& bc, std::span<const NewNodeEnds> new_nodes, std::size_t nodes_before) {
+  const std::size_t nodes = nodes_before + new_nodes.size();
+  // Which axes each node holds at rest, as a fixed node or by an axis of its own.
+  std::vector<std::array<char, 3>> held(nodes, {0, 0, 0});
+  for (const std::int32_t n : bc.fixed_nodes) held[static_cast<std::size_t>(n)] = {1, 1, 1};
+  for (const AxisConstraint& c : bc.fixed_axes) held[static_cast<std::size_t>(c.node)][static_cast<std::size_t>(c.axis)] = 1;
+  const auto both_in = [](std::vector<std::int32_t>& set, const NewNodeEnds& n, std::size_t i) {
+    const bool a = std::find(set.begin(), set.end(), n.a) != set.end(), b = std::find(set.begin(), set.end(), n.b) != set.end();
+    if (a && b) set.push_back(static_cast<std::int32_t>(i));
+  };
+  for (std::size_t k = 0; k < new_nodes.size(); ++k) {
+    const NewNodeEnds& n = new_nodes[k];
+    const std::size_t i = nodes_before + k;
+    const auto &a = held[static_cast<std::size_t>(n.a)], &b = held[static_cast<std::size_t>(n.b)];
+    for (std::size_t c = 0; c < 3; ++c) held[i][c] = static_cast<char>(a[c] && b[c]);
+    if (held[i][0] && held[i][1] && held[i][2]) {
+      bc.fixed_nodes.push_back(static_cast<std::int32_t>(i));
+    } else {
+      for (int c = 0; c < 3; ++c)
+        if (held[i][static_cast<std::size_t>(c)]) bc.fixed_axes.push_back({static_cast<std::int32_t>(i), c});
+    }
+    for (PrescribedMotion& p : bc.prescribed) both_in(p.nodes, n, i);
+    for (PrescribedAxisMotion& p : bc.prescribed_axes) both_in(p.nodes, n, i);
+  }
+  if (!bc.nodal_forces.empty()) bc.nodal_forces.resize(nodes, Vec3::Zero());
 }
 
 }  // namespace viscera::tissue

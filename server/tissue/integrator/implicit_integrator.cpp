@@ -21,26 +21,37 @@ double norm(const std::vector<double>& r) {
 ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<double> density_kg_m3, BoundaryConditions bc, ImplicitOptions options)
     : model_(model), bc_(std::move(bc)), options_(options) {
   if (!(options_.dt_s > 0)) throw std::invalid_argument("ImplicitOptions.dt_s must be > 0");
-  mass_ = lumped_masses(model.rest_mesh(), density_kg_m3);
+  density_ = std::move(density_kg_m3);
+  mass_ = lumped_masses(model.rest_mesh(), density_);
   const std::size_t n = mass_.size();
-  external_.resize(n);
   if (!bc_.nodal_forces.empty() && bc_.nodal_forces.size() != n)
     throw std::invalid_argument("BoundaryConditions.nodal_forces: one force per node expected");
-  const auto mask = bc_.constrained_mask(n);
-  dof_.assign(3 * n, -1);
-  for (std::size_t c = 0; c < 3 * n; ++c)
-    if (!mask[c]) dof_[c] = free_dofs_++;
-  force_.resize(n);
   // Largest diagonal stiffness at rest: with the largest displacement it gives the size of the
   // element forces, whose round-off bounds how small a residual can get.
   for (std::size_t e = 0; e < model.element_count(); ++e)
     stiffness_scale_ = std::max(stiffness_scale_, model.element_tangent(model.rest_mesh().nodes, e).diagonal().cwiseAbs().maxCoeff());
+  analyse_pattern();
+}
+
+void ImplicitIntegrator::analyse_pattern() {
+  const std::size_t n = mass_.size();
+  external_.resize(n);
+  force_.resize(n);
+  const auto mask = bc_.constrained_mask(n);
+  dof_.assign(3 * n, -1);
+  free_dofs_ = 0;
+  for (std::size_t c = 0; c < 3 * n; ++c)
+    if (!mask[c]) dof_[c] = free_dofs_++;
+  solver_.reset();
+  element_slots_.clear();
+  diagonal_slots_.clear();
+  ++pattern_analyses_;
   if (free_dofs_ == 0) return;
 
   // Sparsity pattern of the upper triangle over free dofs: 3x3 blocks between nodes of a tet.
   std::vector<std::vector<int>> rows(static_cast<std::size_t>(free_dofs_));
-  for (std::size_t e = 0; e < model.element_count(); ++e) {
-    const Tet& t = model.element(e);
+  for (std::size_t e = 0; e < model_.element_count(); ++e) {
+    const Tet& t = model_.element(e);
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 12; ++q) {
         const int dp = dof_[3 * t[p / 3] + p % 3], dq = dof_[3 * t[q / 3] + q % 3];
@@ -55,9 +66,9 @@ ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<doub
     colptr.push_back(static_cast<int>(rowidx.size()));
   }
   solver_ = std::make_unique<SparseCholesky>(free_dofs_, std::move(colptr), std::move(rowidx));
-  element_slots_.assign(144 * model.element_count(), -1);
-  for (std::size_t e = 0; e < model.element_count(); ++e) {
-    const Tet& t = model.element(e);
+  element_slots_.assign(144 * model_.element_count(), -1);
+  for (std::size_t e = 0; e < model_.element_count(); ++e) {
+    const Tet& t = model_.element(e);
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 12; ++q) {
         const int r = dof_[3 * t[p / 3] + p % 3], c = dof_[3 * t[q / 3] + q % 3];
@@ -66,6 +77,33 @@ ImplicitIntegrator::ImplicitIntegrator(const ForceModel& model, std::vector<doub
   }
   diagonal_slots_.resize(static_cast<std::size_t>(free_dofs_));
   for (int d = 0; d < free_dofs_; ++d) diagonal_slots_[static_cast<std::size_t>(d)] = solver_->slot(d, d);
+}
+
+void ImplicitIntegrator::follow_edit(const MeshEdit& edit, State& state) {
+  const std::size_t nodes = model_.node_count(), elements = model_.element_count();
+  if (edit.nodes_before != mass_.size() || edit.nodes_before + edit.new_nodes.size() != nodes || edit.elements_before != density_.size() ||
+      edit.origin.size() != elements || state.x.size() != edit.nodes_before || state.v.size() != edit.nodes_before)
+    throw std::invalid_argument("ImplicitIntegrator::follow_edit: the edit does not match the integrator, its model or the state");
+  std::vector<NewNodeEnds> ends;
+  ends.reserve(edit.new_nodes.size());
+  for (const MeshEdit::NewNode& n : edit.new_nodes) {
+    const auto a = static_cast<std::size_t>(n.a), b = static_cast<std::size_t>(n.b);
+    state.x.push_back((1.0 - n.t) * state.x[a] + n.t * state.x[b]);
+    state.v.push_back((1.0 - n.t) * state.v[a] + n.t * state.v[b]);
+    ends.push_back({n.a, n.b});
+  }
+  extend_constraints(bc_, ends, edit.nodes_before);
+  for (std::size_t e = edit.elements_before; e < elements; ++e) density_.push_back(density_[static_cast<std::size_t>(edit.origin[e])]);
+  mass_ = lumped_masses(model_.rest_mesh(), density_);
+  const auto& rest = model_.rest_mesh().nodes;
+  const auto rescale = [&](std::size_t e) {
+    stiffness_scale_ = std::max(stiffness_scale_, model_.element_tangent(rest, e).diagonal().cwiseAbs().maxCoeff());
+  };
+  for (const auto& [e, before] : edit.replaced) rescale(static_cast<std::size_t>(e));
+  for (std::size_t e = edit.elements_before; e < elements; ++e) rescale(e);
+  // The pattern changed (new nodes, new elements): analysed again, once, here; the steps after
+  // reuse it, refactorising numerically only.
+  analyse_pattern();
 }
 
 ImplicitIntegrator::~ImplicitIntegrator() = default;

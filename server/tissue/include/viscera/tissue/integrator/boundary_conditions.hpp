@@ -64,6 +64,7 @@ struct BoundaryConditions {
     std::span<double> damping;  ///< per node [N s/m]
     double dt_s = 0.0;  ///< the step these forces will be integrated over [s]
   };
+
   std::function<void(const FieldEvaluation&)> force_field;
 
   /// 1 for each coordinate (3 per node) that is fixed or prescribed, else 0.
@@ -74,6 +75,15 @@ struct BoundaryConditions {
     return force_amplitude ? Vec3(force_amplitude(t) * nodal_forces[i]) : nodal_forces[i];
   }
 };
+
+/// The constraints of nodes a cut made (MeshEdit::new_nodes, numbered from `nodes_before`, each
+/// at (1 - t) x[a] + t x[b], a copy when a = b; a node may come from one made before it): a new
+/// node is held as both its ends are, fixed when both are fixed, an axis held when both hold it,
+/// moved with a prescribed motion when both are; it carries no nodal force.
+struct NewNodeEnds {
+  std::int32_t a = 0, b = 0;
+};
+void extend_constraints(BoundaryConditions& bc, std::span<const NewNodeEnds> new_nodes, std::size_t nodes_before);
 
 /// Node selections for fixed regions.
 std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Box& box);

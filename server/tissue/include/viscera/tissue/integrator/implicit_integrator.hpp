@@ -54,6 +54,16 @@ class ImplicitIntegrator {
   /// constrained coordinates get 0. Several threads must not call it at once.
   void compliance(std::span<const Vec3> f, std::span<Vec3> u);
 
+  /// Follows an edit of the mesh its model holds (a cut; the model follows it first, as
+  /// GpsModel::follow_edit): new nodes get interpolated positions and velocities and their ends'
+  /// constraints (extend_constraints), new elements their parent's density, the lumped masses are
+  /// summed again, and the stiffness's sparsity pattern is analysed again for CHOLMOD. That is the
+  /// only time the pattern is analysed after construction (pattern_analyses()): a step refactorises
+  /// numerically on the pattern it has.
+  void follow_edit(const MeshEdit& edit, State& state);
+  /// How often the sparsity pattern was analysed: 1 at construction, +1 per edit followed.
+  int pattern_analyses() const { return pattern_analyses_; }
+
   const std::vector<double>& masses() const { return mass_; }
   /// Internal forces [N] at the state the last step or solve ended in (reactions at constrained
   /// coordinates are their negatives).
@@ -62,6 +72,7 @@ class ImplicitIntegrator {
   void set_dt(double dt_s) { options_.dt_s = dt_s; }
 
  private:
+  void analyse_pattern();  ///< the free dofs, and the stiffness's sparsity pattern for CHOLMOD
   NewtonReport newton(State& state, bool dynamic, const std::vector<Vec3>& x_n, const std::vector<Vec3>& v_n);
   double residual(const std::vector<Vec3>& x, bool dynamic, const std::vector<Vec3>& x_n, const std::vector<Vec3>& v_n, std::vector<double>& r);
   void assemble(const std::vector<Vec3>& x, double mass_scale, double regularisation);
@@ -71,8 +82,10 @@ class ImplicitIntegrator {
   const ForceModel& model_;
   BoundaryConditions bc_;
   ImplicitOptions options_;
+  std::vector<double> density_;  ///< per element [kg/m^3]
   std::vector<double> mass_;
   std::vector<Vec3> external_;
+  int pattern_analyses_ = 0;
   std::vector<int> dof_;  // dof of each coordinate (3 per node), -1 if constrained
   int free_dofs_ = 0;
   std::unique_ptr<SparseCholesky> solver_;
