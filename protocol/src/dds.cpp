@@ -169,6 +169,12 @@ int Writer::matched() const {
   return static_cast<int>(st.current_count);
 }
 
+std::uint64_t Writer::matched_ever() const {
+  dds_publication_matched_status_t st{};
+  dds_get_publication_matched_status(handle_, &st);
+  return st.total_count;
+}
+
 bool Writer::wait_for_readers(std::chrono::milliseconds timeout) const {
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (matched() == 0) {

@@ -10,6 +10,7 @@ class DdsMeshStream final : public MeshStream {
   explicit DdsMeshStream(proto::Participant& p) : topology_(p, proto::Stream::surface_topology), frames_(p, proto::Stream::mesh_frame) {}
   void write_topology(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) override { topology_.write(mesh_id, payload); }
   void write_frame(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) override { frames_.write(mesh_id, payload); }
+  std::uint64_t topology_readers_ever() const override { return topology_.matched_ever(); }
 
  private:
   proto::Writer topology_, frames_;

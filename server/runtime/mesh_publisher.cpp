@@ -14,8 +14,10 @@ void copy_surface(std::span<const tissue::Vec3> x, std::span<const std::int32_t>
 MeshPublisher::MeshPublisher(std::unique_ptr<MeshStream> stream, const proto::SurfaceTopology& topology, std::vector<std::int32_t> surface_nodes,
                              double rate_hz)
     : stream_(std::move(stream)), nodes_(std::move(surface_nodes)), mesh_id_(topology.mesh_id), period_ns_(static_cast<std::int64_t>(1e9 / rate_hz)) {
+  readers_ever_ = stream_->topology_readers_ever();
   stream_->write_topology(mesh_id_, proto::encode(topology));
   sent_ = {topology.mesh_id, topology.topology_generation, nodes_, topology.triangles};
+  whole_ = topology;
   pending_.mesh_id = mesh_id_;
   pending_.positions.resize(3 * nodes_.size());
   thread_ = std::thread([this] {
@@ -100,10 +102,22 @@ void MeshPublisher::publish_loop() {
       topology_nodes.swap(pending_topology_nodes_);
     }
     try {
+      // A reader joined: its history (the last 16 messages) may hold only patches, so the whole
+      // surface goes out now (the new one, if it changed, else the one the others hold).
+      const std::uint64_t readers = stream_->topology_readers_ever();
+      const bool joined = readers > readers_ever_;
+      if (joined && !topology) {
+        stream_->write_topology(mesh_id_, proto::encode(whole_));
+        readers_ever_ = readers;
+        patches_since_whole_ = 0;
+        std::lock_guard lock(mutex_);
+        ++topologies_;
+      }
       if (topology) {
-        // A patch of what the readers hold where it is smaller; whole every kPatchesPerWhole.
+        // A patch of what the readers hold where it is smaller; whole when a reader joined, and
+        // after kPatchesPerWhole patches.
         std::optional<proto::SurfaceTopology> patch;
-        if (patches_since_whole_ < kPatchesPerWhole) patch = surface_patch(sent_, *topology, topology_nodes);
+        if (!joined && patches_since_whole_ < kPatchesPerWhole) patch = surface_patch(sent_, *topology, topology_nodes);
         const proto::SurfaceTopology& message = patch ? *patch : *topology;
         // Reliable: a topology that cannot be written is written again before the next frame.
         try {
@@ -117,11 +131,13 @@ void MeshPublisher::publish_loop() {
           continue;
         }
         patches_since_whole_ = patch ? patches_since_whole_ + 1 : 0;
+        if (joined) readers_ever_ = readers;
         std::lock_guard lock(mutex_);
         ++topologies_;
         patches_ += patch ? 1 : 0;
         change_bytes_ += surface_array_bytes(message);
-        sent_ = {topology->mesh_id, topology->topology_generation, std::move(topology_nodes), std::move(topology->triangles)};
+        sent_ = {topology->mesh_id, topology->topology_generation, std::move(topology_nodes), topology->triangles};
+        whole_ = std::move(*topology);
       }
       stream_->write_frame(mesh_id_, proto::encode(frame));
     } catch (const proto::DdsError&) {

@@ -113,6 +113,8 @@ class Writer {
   void write(std::uint32_t source_id, std::span<const std::uint8_t> payload);
   /// Number of matched readers.
   int matched() const;
+  /// Readers matched since the writer was made, those gone included: it grows when one joins.
+  std::uint64_t matched_ever() const;
   /// Waits until at least one reader is matched (a new writer's first samples reach only the
   /// readers discovered by then); false on timeout.
   bool wait_for_readers(std::chrono::milliseconds timeout) const;

@@ -5,8 +5,8 @@
 // the surface positions into a hand-over buffer, and if the publisher is still busy with that
 // buffer it skips the frame instead of waiting. The topology is published reliably and transient
 // local, so clients that join later still get it; after a cut as a patch of the one before
-// (surface_message.hpp), whole again every kPatchesPerWhole patches, so that the stream's last 16
-// messages always hold a whole surface for a late joiner.
+// (surface_message.hpp). The whole surface goes out again when a reader joins (the stream's last 16
+// messages may all be patches), and after kPatchesPerWhole patches for a reader that lost some.
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -48,8 +48,9 @@ class MeshPublisher {
   /// Of them, the patches, and the bytes of the arrays written for topologies after the first.
   std::uint64_t patches_published() const;
   std::uint64_t topology_change_bytes() const;
-  /// A whole surface after at most this many patches (the stream keeps 16 messages).
-  static constexpr int kPatchesPerWhole = 12;
+  /// A whole surface after at most this many patches, for a reader that fell more than the
+  /// stream's 16 messages behind and lost patches (a reader that joins gets one at once).
+  static constexpr int kPatchesPerWhole = 64;
   std::uint64_t frames_published() const;
   /// Frames that were due while the publisher was still writing the previous one.
   std::uint64_t frames_skipped() const { return skipped_; }
@@ -72,6 +73,8 @@ class MeshPublisher {
   bool ready_ = false, stop_ = false;
   std::uint64_t published_ = 0, topologies_ = 1, patches_ = 0, change_bytes_ = 0;  // guarded by mutex_
   SentSurface sent_;  // publisher thread: what the stream's readers hold
+  protocol::SurfaceTopology whole_;  // publisher thread: the whole surface they hold
+  std::uint64_t readers_ever_ = 0;  // publisher thread: topology readers matched, when the last whole surface went out
   int patches_since_whole_ = 0;  // publisher thread
   std::thread thread_;
 };

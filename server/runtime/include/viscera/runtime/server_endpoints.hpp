@@ -21,6 +21,8 @@ class MeshStream {
   virtual ~MeshStream() = default;
   virtual void write_topology(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) = 0;
   virtual void write_frame(std::uint32_t mesh_id, std::span<const std::uint8_t> payload) = 0;
+  /// Readers of the topology matched since the stream was opened: it grows when one joins.
+  virtual std::uint64_t topology_readers_ever() const { return 0; }
 };
 
 class ServerEndpoints {
