@@ -91,7 +91,8 @@ class PlanBuilder {
     }
     if (schema < 17) {
       plan_.cutting_recorded = false;
-      plan_.notes.push_back("recorded with protocol schema " + version + ": its forces do not say whether a blade cut, which is not compared");
+      plan_.notes.push_back("recorded with protocol schema " + version +
+                            ": its forces do not say whether a blade cut, nor the strain where it cut, which are not compared");
     }
   }
 
@@ -252,7 +253,8 @@ class PlanBuilder {
       const bool stepped = f.step_time_ns > 0;
       const std::uint64_t result_tick = stepped ? f.tick : f.tick + 1;
       plan_.forces[result_tick].push_back({f.instrument_id, f.client_id, f.command_seq, stepped, f.in_contact, f.force, f.torque, f.contact_point,
-                                           f.contact_normal, f.penetration_m, f.max_edge_strain, f.stiffness, force_log_times_[i], f.cutting});
+                                           f.contact_normal, f.penetration_m, f.max_edge_strain, f.stiffness, force_log_times_[i], f.cutting,
+                                           f.cut_edge_strain});
       ++plan_.recorded_forces;
       plan_.last_tick = std::max(plan_.last_tick, result_tick);
       if (stepped) {

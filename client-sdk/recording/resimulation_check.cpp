@@ -29,6 +29,8 @@ std::optional<std::tuple<std::string, std::string, std::string>> force_differenc
                                                                                   bool compare_cutting) {
   if (e.in_contact != f.in_contact) return std::make_tuple("in_contact", e.in_contact ? "true" : "false", f.in_contact ? "true" : "false");
   if (compare_cutting && e.cutting != f.cutting) return std::make_tuple("cutting", e.cutting ? "true" : "false", f.cutting ? "true" : "false");
+  if (compare_cutting && !same_bits(e.cut_edge_strain, f.cut_edge_strain))
+    return std::make_tuple("cut_edge_strain", exact_number(e.cut_edge_strain), exact_number(f.cut_edge_strain));
   const char* axes = "xyz";
   const auto vec = [&](const char* name, const proto::Vector3& a,
                        const proto::Vector3& b) -> std::optional<std::tuple<std::string, std::string, std::string>> {

@@ -159,6 +159,7 @@ void ExerciseScorer::process_force(const proto::Force& f, const std::optional<pr
   ++r_.samples;
   r_.peak_force_n = std::max(r_.peak_force_n, F);
   r_.max_edge_strain = std::max(r_.max_edge_strain, f.max_edge_strain);
+  r_.incision_cut_strain = std::max(r_.incision_cut_strain, f.cut_edge_strain);
   if (f.in_contact) {
     contact_force_sum_ += F;
     ++contact_samples_;
@@ -330,6 +331,8 @@ ScoreReport ExerciseScorer::report() const {
       add("length error", dl, exercise_.length_tolerance_m, "m", dl <= exercise_.length_tolerance_m,
           format("%.1f mm long, %.1f mm asked", 1e3 * *r.incision_length_m, 1e3 * target) +
               format(" (within %.1f mm)", 1e3 * exercise_.length_tolerance_m));
+      add("strain at the cut", r.incision_cut_strain, exercise_.edge_strain_limit, "", r.incision_cut_strain <= exercise_.edge_strain_limit,
+          format("the tissue was torn where the blade cut: strain %.3f there (at most %.3f)", r.incision_cut_strain, exercise_.edge_strain_limit));
     }
   }
   if (exercise_.kind == ExerciseKind::retraction)

@@ -43,7 +43,8 @@ nlohmann::json to_json(const ScoreReport& r) {
             {"incision_length_m", r.incision_length_m ? nlohmann::json(*r.incision_length_m) : nlohmann::json()},
             {"incision_deviation_m", r.incision_deviation_m},
             {"incision_mean_depth_m", r.incision_mean_depth_m},
-            {"incision_max_depth_m", r.incision_max_depth_m}}},
+            {"incision_max_depth_m", r.incision_max_depth_m},
+            {"incision_cut_strain", r.incision_cut_strain}}},
           {"criteria", criteria},
           {"failures", r.failures}};
 }
@@ -71,8 +72,11 @@ std::string to_markdown(const ScoreReport& r) {
                 r.path_length_m, r.peak_force_n, r.mean_contact_force_n, r.time_above_force_limit_s, r.max_edge_strain, r.longest_hold_s);
   s += b;
   if (r.incision_length_m) {
-    std::snprintf(b, sizeof b, "Incision %.1f mm long, %.1f mm deep on average (%.1f mm at most), at most %.1f mm off the line.\n",
-                  1e3 * *r.incision_length_m, 1e3 * r.incision_mean_depth_m, 1e3 * r.incision_max_depth_m, 1e3 * r.incision_deviation_m);
+    std::snprintf(b, sizeof b,
+                  "Incision %.1f mm long, %.1f mm deep on average (%.1f mm at most), at most %.1f mm off the line; largest strain where the "
+                  "blade cut %.3f.\n",
+                  1e3 * *r.incision_length_m, 1e3 * r.incision_mean_depth_m, 1e3 * r.incision_max_depth_m, 1e3 * r.incision_deviation_m,
+                  r.incision_cut_strain);
     s += b;
   }
   if (r.mark_distance_m) {

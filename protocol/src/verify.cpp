@@ -52,7 +52,7 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
   return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force,
-                                           &torque, model, f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting));
+                                           &torque, model, f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting, f.cut_edge_strain));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -184,6 +184,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   f.tick = m->tick();
   f.max_edge_strain = m->max_edge_strain();
   f.cutting = m->cutting();
+  f.cut_edge_strain = m->cut_edge_strain();
   if (const auto* lm = m->local_model()) {
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());
@@ -191,7 +192,8 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
     if (const auto* k = lm->stiffness()) f.stiffness = {k->m00(), k->m01(), k->m02(), k->m10(), k->m11(), k->m12(), k->m20(), k->m21(), k->m22()};
   }
   if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point) || !std::isfinite(f.penetration_m) ||
-      std::abs(f.penetration_m) > kMaxPositionM || !(f.max_edge_strain >= 0 && f.max_edge_strain <= kMaxEdgeStrain)) {
+      std::abs(f.penetration_m) > kMaxPositionM || !(f.max_edge_strain >= 0 && f.max_edge_strain <= kMaxEdgeStrain) ||
+      !(f.cut_edge_strain >= 0 && f.cut_edge_strain <= kMaxEdgeStrain)) {
     *why = "force, torque, contact point, penetration or edge strain not finite or out of range";
     return std::nullopt;
   }

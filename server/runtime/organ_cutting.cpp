@@ -74,6 +74,7 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
   const auto child = [&](std::size_t e) {
     const Tet& t = gps->element(e);
     out.energy_after_j += gps->element_energy(state.x, e, t);
+    out.cut_edge_strain = std::max(out.cut_edge_strain, gps->element_max_edge_strain(state.x, e));
     nodes.insert(nodes.end(), t.begin(), t.end());
   };
   for (const auto& [e, vertices] : edit.replaced) child(static_cast<std::size_t>(e));

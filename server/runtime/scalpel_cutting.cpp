@@ -30,6 +30,7 @@ void SimulationServer::Impl::cut_with_scalpels(const Status& status) {
     const InstrumentSpec& spec = t.tool.spec();
     if (spec.kind != InstrumentKind::scalpel) continue;
     t.tool.update_press_through(t.result);  // the contact of the step just taken
+    t.cut_edge_strain = 0;
     // A material change being built reads the mesh: the blade waits for it (a few hundred ms).
     const bool cutting = t.tool.cutting() && can_cut(*organ) && !session.preparing_material();
     Stroke& s = t.stroke;
@@ -51,6 +52,7 @@ void SimulationServer::Impl::cut_with_scalpels(const Status& status) {
     s.blade_end = end;
     const SweepOutcome o = cut_organ(*organ, sweep, state, s.id);
     ++s.sweeps;
+    t.cut_edge_strain = o.cut_edge_strain;
     s.tets_cut += o.tets_cut;
     s.split_edges += o.split_edges;
     s.duplicated_nodes += o.duplicated_nodes;

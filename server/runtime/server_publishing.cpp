@@ -77,10 +77,11 @@ void SimulationServer::Impl::publish_snapshot(std::uint64_t tick) {
 /// `tick`: the tick that stepped with the command, or whose state answered it; `strain`: the
 /// organ's largest edge strain that tick.
 void SimulationServer::Impl::publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r,
-                                           std::int64_t step_time_ns, std::uint64_t tick, double strain) {
+                                           std::int64_t step_time_ns, std::uint64_t tick, double strain, double cut_edge_strain) {
   proto::Force f = force_message(id, owner, command, r, local_stiffness(r, *organ->compliance, lockstep), proto::now_ns(), step_time_ns);
   f.tick = tick;
   f.max_edge_strain = strain;
+  f.cut_edge_strain = cut_edge_strain;
   auto payload = proto::encode(f);
   if (capture)
     capture->forces.push_back(std::move(payload));
@@ -94,7 +95,7 @@ void SimulationServer::Impl::publish_forces(std::int64_t step_time_ns) {
   for (auto& [id, t] : tools) {
     if (t.tool.active())
       publish_force(id, t.tool.owner(), t.tool.command(), t.result, std::max<std::int64_t>(step_time_ns, 1), current_tick(),
-                    organ->integrator->max_edge_strain());
+                    organ->integrator->max_edge_strain(), t.cut_edge_strain);
     if (const ToolEvent e = t.tool.update_contact(t.result.in_contact, sim_time_s); e != ToolEvent::none)
       event(e == ToolEvent::contact_started ? proto::EventKind::contact_started : proto::EventKind::contact_ended, id, t.tool.owner());
   }

@@ -76,6 +76,7 @@ struct SimulationServer::Impl {
     std::unique_ptr<ProbeContact> contact;
     ContactResult result;
     Stroke stroke;
+    double cut_edge_strain = 0;  // the largest edge strain of what its blade cut this tick
   };
   std::map<std::uint32_t, Tool> tools;
   std::int32_t strokes = 0;  // physics thread: strokes begun on this organ (the next one's id)
@@ -145,9 +146,9 @@ struct SimulationServer::Impl {
   void publish_snapshot(std::uint64_t tick);
 
   /// `tick`: the tick that stepped with the command, or whose state answered it; `strain`: the
-  /// organ's largest edge strain that tick.
+  /// organ's largest edge strain that tick; `cut_edge_strain`: a scalpel's, of what it cut that tick.
   void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns,
-                     std::uint64_t tick, double strain);
+                     std::uint64_t tick, double strain, double cut_edge_strain = 0);
 
   /// After a tick: every active tool's force, and its contact and grasp events.
   void publish_forces(std::int64_t step_time_ns);

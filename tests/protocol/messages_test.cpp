@@ -38,9 +38,11 @@ TEST(Messages, RoundTripsEveryMessage) {
   f.stiffness[4] = 200;
   f.max_edge_strain = 0.137;
   f.cutting = true;
+  f.cut_edge_strain = 0.31;
   const auto fd = decode_force(encode(f), &why);
   ASSERT_TRUE(fd) << why;
   EXPECT_TRUE(fd->cutting);
+  EXPECT_EQ(fd->cut_edge_strain, 0.31);
   EXPECT_EQ(fd->force[2], 3.0);
   EXPECT_TRUE(fd->in_contact);
   EXPECT_EQ(fd->stiffness[4], 200);
@@ -50,6 +52,9 @@ TEST(Messages, RoundTripsEveryMessage) {
     Force g = f;
     g.max_edge_strain = bad;
     EXPECT_FALSE(decode_force(encode(g), &why)) << bad;
+    Force h = f;
+    h.cut_edge_strain = bad;
+    EXPECT_FALSE(decode_force(encode(h), &why)) << bad;
   }
   const auto s = decode_session_request(encode(SessionRequest{7, Action::release_instrument, 2}), &why);
   ASSERT_TRUE(s) << why;

@@ -122,7 +122,7 @@ std::string first_difference(const LockstepRun& a, const LockstepRun& b) {
           (f->step_time_ns > 0) != (g->step_time_ns > 0) || f->in_contact != g->in_contact || f->cutting != g->cutting ||
           !same_bits(f->force, g->force) || !same_bits(f->torque, g->torque) || !same_bits(f->contact_point, g->contact_point) ||
           !same_bits(f->contact_normal, g->contact_normal) || !same_bits(f->stiffness, g->stiffness) ||
-          !same_bits(f->penetration_m, g->penetration_m))
+          !same_bits(f->penetration_m, g->penetration_m) || !same_bits(f->cut_edge_strain, g->cut_edge_strain))
         return at + "force " + std::to_string(k);
     }
     if (x.events.size() != y.events.size()) return at + "event counts";
@@ -308,6 +308,21 @@ TEST(Lockstep, AnIncisionOpensTheSurfaceTheSameWayOnEveryRunAndOnTwoThreads) {
   EXPECT_GT(frames.back().positions.size(), frames.front().positions.size());
   std::cout << "[ figure ] incision: surface generation " << frames.back().topology_generation << ", surface vertices "
             << frames.front().positions.size() / 3 << " -> " << frames.back().positions.size() / 3 << "\n";
+  // The scalpel's forces carry the strain where it cut, in the ticks it cut something, and only
+  // while it cuts.
+  int strained = 0;
+  double cut_strain = 0;
+  for (const auto& r : a.results)
+    for (const auto& p : r.forces) {
+      const auto f = proto::decode_force(p, &why);
+      if (!f || f->instrument_id != 4 || f->cut_edge_strain == 0) continue;
+      EXPECT_TRUE(f->cutting) << "tick " << f->tick;
+      ++strained;
+      cut_strain = std::max(cut_strain, f->cut_edge_strain);
+    }
+  EXPECT_GT(strained, 10);
+  EXPECT_LT(cut_strain, 0.5);
+  std::cout << "[ figure ] incision: " << strained << " forces carry the strain where the blade cut, at most " << cut_strain << "\n";
   // The probe on the cut's line feels the cut organ: its local model's stiffness is the tissue's
   // in series with the contact penalty (1000 N/m), from the compliance rebuilt after the stroke,
   // never the penalty's bound that a node the uncut compliance does not know would give.
@@ -380,9 +395,15 @@ TEST(Lockstep, AScalpelPressedAboveTheScenesCutForceCutsWithoutItsButton) {
     }
   }
   EXPECT_GT(through, 300);  // drawn along and lifted
+  // Pressed in, the blade cut tissue its tip had strained: the strain where it cut shows it.
+  double cut_strain = 0;
+  for (const proto::Force& f : forces) cut_strain = std::max(cut_strain, f.cut_edge_strain);
+  EXPECT_GT(cut_strain, 1e-3);
+  EXPECT_LT(cut_strain, 0.5);
   EXPECT_GT(ended, kFirstTick + 400);  // lifted out on the way up (ticks 401-500), not before
   std::cout << "[ figure ] pressed through at tick +" << started - kFirstTick << " (force before it at most " << peak_before << " N, cut force "
-            << cut_force << " N); " << first(proto::EventKind::cut_ended)->text << " (ended at +" << ended - kFirstTick << ")\n";
+            << cut_force << " N), strain where it cut up to " << cut_strain << "; " << first(proto::EventKind::cut_ended)->text << " (ended at +"
+            << ended - kFirstTick << ")\n";
 
   // A cut force above what the tissue gives: the same hand presses and cuts nothing.
   const LockstepRun firm = run(1, 0, pressed, [](SceneSpec& s) {

@@ -4,7 +4,17 @@
 // reach, and the broad phase still finds the contact on a plate stretched well beyond rest.
 #include "viscera/runtime/probe_contact.hpp"
 
+#include <algorithm>
+#include <memory>
+
 #include <gtest/gtest.h>
+
+#include "viscera/tissue/cutting/mesh_cutter.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
 
 using namespace viscera::runtime;
 using viscera::tissue::Triangle;
@@ -94,4 +104,55 @@ TEST(ProbeContact, HuntCrossleyDashpotGrowsWithDepthAndRateAndNeverPulls) {
       }
   // Without velocities (the command thread's query) the contact is the spring alone.
   EXPECT_NEAR(contact.query(tip, p.x).force_on_tool.z(), k * depth, 1e-9);
+}
+
+// A piece cut free is still tissue under the probe: a 10 x 2 x 2 cm bar held at its left end is
+// cut through at x = 5.4 cm, and a probe pressed 3 mm into the top of the free piece (no gravity)
+// pushes it away, while the held piece does not move: no force crosses the cut.
+TEST(ProbeContact, APieceCutFreeIsPushedByTheProbeAndTheHeldPieceFeelsNothing) {
+  using namespace viscera::tissue;
+  const auto mesh = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(0.10, 0.02, 0.02), 10, 2, 2));
+  MeshCutter cutter(*mesh);
+  for (int i = 0; i < 20; ++i) {
+    const double za = 0.03 - 0.002 * i, zb = za - 0.002, xc = 0.054;
+    const std::vector<Vec3> x = mesh->nodes;
+    cutter.cut({Vec3(xc, -0.01, za), Vec3(xc, 0.03, za), Vec3(xc, -0.01, zb), Vec3(xc, 0.03, zb)}, x, 0);
+  }
+  GpsOptions o;
+  o.variant = GpsVariant::energy_consistent;
+  o.volume_stiffness_fraction = 0.3;
+  const GpsModel gps(mesh, {elasticity_matrix(IsotropicElasticity{5e3, 0.45})}, {}, o);
+  const ProbeContact probe(extract_boundary(*mesh).triangles, mesh->nodes, 0.005, 1000.0);
+  const Vec3 tip(0.08, 0.01, 0.02 + 0.005 - 0.003);
+  ContactResult first;
+  BoundaryConditions bc;
+  bc.fixed_nodes = nodes_in_box(*mesh, Box{Vec3(-1, -1, -1), Vec3(1e-9, 1, 1)});
+  bc.force_field = [&](const BoundaryConditions::FieldEvaluation& e) {
+    const ContactResult r = probe.apply(tip, Vec3::Zero(), e);
+    if (!first.in_contact) first = r;
+  };
+  ExplicitIntegrator integrator(gps, std::vector<double>(mesh->tet_count(), 1000.0), bc);
+  State s = State::at_rest(*mesh);
+  const std::vector<double> m = integrator.masses();
+  const auto free_centre_z = [&] {
+    double mz = 0, mass = 0;
+    for (std::size_t i = 0; i < s.x.size(); ++i)
+      if (mesh->nodes[i].x() > 0.056) {
+        mz += m[i] * s.x[i].z();
+        mass += m[i];
+      }
+    return mz / mass;
+  };
+  const double z0 = free_centre_z();
+  for (int k = 0; k < 100; ++k) integrator.step(s);
+  ASSERT_TRUE(first.in_contact);
+  EXPECT_NEAR(first.force_on_tool.z(), 1000.0 * 0.003, 1e-9);  // the penalty at 3 mm, on the tool
+  EXPECT_LT(free_centre_z(), z0 - 1e-5);  // pushed down, away from the probe
+  // The held piece moves by rounding only (its forces at rest are 1e-16 N, not 0), ten orders
+  // below the pushed piece.
+  double held = 0;
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    if (mesh->nodes[i].x() < 0.05) held = std::max(held, (s.x[i] - mesh->nodes[i]).norm());
+  }
+  EXPECT_LT(held, 1e-15);
 }

@@ -48,7 +48,9 @@ struct Session {
     payloads.push_back({proto::Stream::event, proto::encode(e)});
   }
   /// `cutting`: the server says the scalpel's blade cuts (its button held, or pressed through).
-  void step(std::uint64_t tick, const proto::Vector3& tip, double force_n, double strain = 0.1, std::uint32_t buttons = 0, bool cutting = false) {
+  /// `cut_strain`: the strain where the blade cut that tick (Force.cut_edge_strain).
+  void step(std::uint64_t tick, const proto::Vector3& tip, double force_n, double strain = 0.1, std::uint32_t buttons = 0, bool cutting = false,
+            double cut_strain = 0) {
     proto::Command c;
     c.instrument_id = instrument;
     c.client_id = 7;
@@ -66,6 +68,7 @@ struct Session {
     f.tick = tick;
     f.max_edge_strain = strain;
     f.cutting = cutting;
+    f.cut_edge_strain = cut_strain;
     payloads.push_back({proto::Stream::force_feedback, proto::encode(f)});
   }
   ScoreReport score(const Exercise& e, const std::vector<Payload>& order) const {
@@ -264,7 +267,7 @@ TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
                                     "incision.json");
   // `pressed_through`: the blade cuts with the button up, because the server says it pressed
   // through above the scene's cut force (Force.cutting), until it is lifted out.
-  const auto perform = [&](double y, double depth, bool pressed_through = false) {
+  const auto perform = [&](double y, double depth, bool pressed_through = false, double cut_strain = 0.2) {
     Session s("liver");
     s.instrument = 4;
     std::uint64_t tick = 101;
@@ -272,7 +275,7 @@ TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
     const double z_cut = 0.04 - depth;  // pressed on, button up, to a tip `depth` below where it touched
     for (int k = 1; k <= 50; ++k, ++tick) s.step(tick, {-0.025, y, 0.045 - (0.045 - z_cut) * k / 50.0}, 0.5);
     for (int k = 0; k <= 1000; ++k, ++tick)
-      s.step(tick, {-0.025 + 0.05 * k / 1000.0, y, z_cut}, 0.0, 0.1, pressed_through ? 0u : 1u, pressed_through);
+      s.step(tick, {-0.025 + 0.05 * k / 1000.0, y, z_cut}, 0.0, 0.1, pressed_through ? 0u : 1u, pressed_through, k == 500 ? cut_strain : 0.05);
     s.step(tick++, {0.025, y, z_cut}, 0.0, 0.1, 0u);
     return std::pair{s.score(e), tick - 1};
   };
@@ -282,6 +285,7 @@ TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
   EXPECT_NEAR(good.incision_deviation_m, 0.002, 1e-12);
   EXPECT_NEAR(good.incision_mean_depth_m, 0.01, 1e-12);
   EXPECT_NEAR(good.incision_max_depth_m, 0.01, 1e-12);
+  EXPECT_EQ(good.incision_cut_strain, 0.2);  // the largest the forces carried
   EXPECT_TRUE(good.passed) << to_markdown(good);
   EXPECT_TRUE(good.completed);
   EXPECT_EQ(good.ending, "incision made");
@@ -297,6 +301,13 @@ TEST(ExerciseScorer, IncisionLengthDepthAndLineAreThoseOfTheBladesPath) {
   EXPECT_NEAR(through.incision_mean_depth_m, 0.01, 1e-12);
   EXPECT_TRUE(through.passed) << to_markdown(through);
   EXPECT_EQ(through.ending, "incision made");
+  // Tissue pulled apart where the blade cut (strain 0.6 above the limit 0.5) fails, naming it,
+  // while the organ's largest strain (0.1) stays within it.
+  const auto [torn, t4] = perform(0.002, 0.01, false, 0.6);
+  EXPECT_FALSE(torn.passed);
+  EXPECT_TRUE(has_failure(torn, "torn where the blade cut: strain 0.600")) << to_markdown(torn);
+  EXPECT_FALSE(has_failure(torn, "strained too far")) << to_markdown(torn);
+  (void)t4;
   (void)t3;
   (void)t1;
   (void)t2;

@@ -87,7 +87,9 @@ void bind_session(py::module_& m) {
       .def_readonly("server_stamp_ns", &protocol::Force::server_stamp_ns, "[ns] the server's clock when sent (DDS time)")
       .def_readonly("max_edge_strain", &protocol::Force::max_edge_strain, "the organ's largest edge strain |L - L0| / L0 over that tick [-]")
       .def_readonly("cutting", &protocol::Force::cutting,
-                    "a scalpel's blade cutting: its button held, or pressed through above the scene's cut force");
+                    "a scalpel's blade cutting: its button held, or pressed through above the scene's cut force")
+      .def_readonly("cut_edge_strain", &protocol::Force::cut_edge_strain,
+                    "a cutting scalpel's: the largest edge strain of the tetrahedra it cut that tick, just after it cut them [-]");
   py::class_<protocol::Event>(m, "Event", "A session event (server) or an annotation (client).")
       .def_property_readonly(
           "kind", [](const protocol::Event& e) { return std::string(protocol::event_name(e.kind)); },

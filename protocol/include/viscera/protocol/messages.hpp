@@ -41,6 +41,9 @@ struct Force {
   /// schema 17: a scalpel's blade cutting (cut button held, or pressed through above the scene's
   /// cut force): it passes through the tissue; false from older servers
   bool cutting = false;
+  /// schema 17: for a cutting scalpel, the largest edge strain of the tetrahedra its blade cut in
+  /// that tick, just after it cut them (0 when it cut none); 0 from older servers
+  double cut_edge_strain = 0;
 };
 
 enum class Action : std::int8_t {

@@ -38,6 +38,7 @@ struct ExpectedForce {
   std::array<double, 9> stiffness{};
   std::uint64_t log_time_ns = 0;
   bool cutting = false;  ///< a scalpel's blade cutting (schema 17)
+  double cut_edge_strain = 0;  ///< the largest edge strain of what it cut that tick (schema 17)
 };
 
 struct ExpectedEvent {

@@ -39,6 +39,9 @@ struct ScoreReport {
   std::optional<double> incision_length_m;  ///< the extent of the tip's path along the line
   double incision_deviation_m = 0;  ///< the tip's largest distance from the line, across it (horizontal)
   double incision_mean_depth_m = 0, incision_max_depth_m = 0;  ///< below the surface where the blade first touched
+  /// The largest edge strain of the tissue the blade cut, just after it cut it (the forces'
+  /// cut_edge_strain, schema 17): how far the tissue next to the cut was pulled
+  double incision_cut_strain = 0;
   std::vector<Criterion> criteria;
   std::vector<std::string> failures;  ///< the failed criteria's reasons, most telling first
 };

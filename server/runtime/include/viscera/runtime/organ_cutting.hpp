@@ -26,6 +26,9 @@ struct SweepOutcome {
   /// difference is the change of the whole organ's kinetic plus elastic energy (0 and 0 when the
   /// topology did not change).
   double energy_before_j = 0, energy_after_j = 0;
+  /// The largest edge strain |L - L0| / L0 of the sweep's new and changed elements just after it:
+  /// the tissue where the blade cut (0 when the topology did not change).
+  double cut_edge_strain = 0;
   /// Whether the energy rose, beyond rounding (1e-9 of energy_before_j).
   bool energy_rose() const { return energy_after_j - energy_before_j > 1e-9 * energy_before_j + 1e-18; }
 };
