@@ -1,5 +1,9 @@
 // The GPS's elastic energy, whole or one element's (docs/TISSUE.md): 0.5 dL^T H dL over the
-// elements, with the edge map's stiffening where it has an energy, plus the volume term.
+// elements, with the edge map's stiffening where it has an energy, plus the volume term; and how
+// much stiffer than at rest the energy's curvature grows with the edge strain.
+#include <algorithm>
+#include <cmath>
+
 #include "viscera/tissue/element/tet_geometry.hpp"
 #include "viscera/tissue/gps/fung_map.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
@@ -36,6 +40,20 @@ double GpsModel::energy(std::span<const Vec3> x) const {
   double sum = 0.0;
   for (std::size_t e = 0; e < element_count(); ++e) sum += element_energy(x, e, element(e));
   return sum;
+}
+
+double GpsModel::stiffness_growth(double edge_strain) const {
+  const GpsMechanisms& mech = options_.mechanisms;
+  if (!mech.stiffening.active() && !mech.asymmetry.active()) return 1.0;
+  // h h' is the edge map g in both forms, so h'^2 + h h'' = g' (the published form's tangent
+  // H diag(g')); the curvature grows monotonically in |e| for every shape, so its ends bound it.
+  const double b = mech.stiffening.b, r = mech.asymmetry.compression_ratio, e = std::abs(edge_strain);
+  const auto curvature = [&](double strain) {
+    const FungEnergyMap f = edge_energy_map(b, r, strain, mech.stiffening.shape);
+    return f.dh * f.dh + std::abs(f.h * f.d2h);
+  };
+  const double rest = edge_energy_map(b, r, 0.0, mech.stiffening.shape).dh;
+  return std::max({1.0, curvature(e) / (rest * rest), curvature(-e) / (rest * rest)});
 }
 
 }  // namespace viscera::tissue

@@ -80,6 +80,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
     throw SimulationError(msg.str());
   }
   max_edge_strain_ = std::max(max_edge_strain_, stats.max_edge_strain);
+  last_edge_strain_ = stats.max_edge_strain;
   x_prev_ = state.x;
   v_prev_ = state.v;
   t_prev_ = state.time_s;
@@ -112,22 +113,58 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
       state.x[i][p.axis] = target;
     }
   state.time_s = t1;
+  last_step_end_s_ = t1;
 }
+
+double ExplicitIntegrator::stiffened_step_s() const {
+  // The strain the next sub-step starts from is near the last one's; a tenth more (and 0.002)
+  // covers its rise over a sub-step where the tissue is pulled fast.
+  return dt_ / std::sqrt(model_.stiffness_growth(1.1 * last_edge_strain_ + 0.002));
+}
+
+namespace {
+
+// More sub-steps than this per step of dt_s() and the tissue is past what an explicit step can
+// follow (a run away, not a stiffening organ): reported as an instability.
+constexpr double kMaxStiffenedSubSteps = 64;
+
+}  // namespace
 
 long ExplicitIntegrator::advance(State& state, double duration_s) {
   if (!(duration_s > 0)) return 0;
   if (!std::isfinite(dt_) || !(dt_ > 0)) throw SimulationError("the explicit step " + short_number(dt_) + " s cannot be run");
   // Equal sub-steps no longer than dt: symplectic Euler is stable at a constant step below the
   // limit, but a short last sub-step after full ones breaks its staggering and can pump energy
-  // into the highest modes (seen on the 12k liver at 0.85 of the critical step).
-  const long steps = static_cast<long>(std::ceil(duration_s / dt_ * (1 - 1e-12)));
-  const double dt = duration_s / static_cast<double>(steps);
-  const double start = state.time_s;
+  // into the highest modes (seen on the 12k liver at 0.85 of the critical step). When the
+  // stiffened tissue needs shorter ones mid-way, what is left is divided into equal ones again.
+  const auto sub_steps = [this](double duration, double longest) {
+    if (!(longest * kMaxStiffenedSubSteps >= dt_))
+      throw SimulationError("explicit integration went unstable: at edge strain " + short_number(last_edge_strain_) + " the tissue is " +
+                            short_number(model_.stiffness_growth(1.1 * last_edge_strain_ + 0.002)) + " times as stiff as at rest, its stable step " +
+                            short_number(longest) + " s is below dt / " + short_number(kMaxStiffenedSubSteps));
+    return std::max(1L, static_cast<long>(std::ceil(duration / longest * (1 - 1e-12))));
+  };
+  if (state.time_s != last_step_end_s_) last_edge_strain_ = 0.0;  // a state not left by the last step (reset, reloaded)
+  const double start = state.time_s, end = start + duration_s;
+  double from = start;  // where the current division into equal sub-steps began
+  long steps = sub_steps(duration_s, std::min(dt_, stiffened_step_s()));
+  double dt = duration_s / static_cast<double>(steps);
+  long done = 0, since = 0;  // sub-steps taken, of them in the current division
   max_edge_strain_ = 0.0;
-  for (long k = 1; k <= steps; ++k) {
+  while (done < steps) {
     step_with(state, dt);
-    state.time_s = start + static_cast<double>(k) * dt;
-    if (k < steps && interrupted_ && interrupted_()) return k;
+    ++done;
+    ++since;
+    state.time_s = last_step_end_s_ = from + static_cast<double>(since) * dt;
+    if (done == steps) break;
+    if (const double longest = stiffened_step_s(); dt > longest) {
+      from = state.time_s;
+      since = 0;
+      const long rest = sub_steps(end - from, longest);
+      steps = done + rest;
+      dt = (end - from) / static_cast<double>(rest);
+    }
+    if (interrupted_ && interrupted_()) return done;
   }
   return steps;
 }

@@ -43,6 +43,10 @@ class GpsModel final : public ForceModel {
   /// With first-load softening the tangent depends on each edge's extremes in `memory`.
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, std::span<const double> memory) const override;
   double stiffness_damping_time_s() const override { return options_.mechanisms.viscous.kelvin_voigt_time_s; }
+  /// From the edge map h (gps/fung_map.hpp): the tangent of a tetrahedron holds h'_i H_ij h'_j and
+  /// h''_i (H h)_i, so it grows at most by max(h'^2 + |h h''|) over |e| <= edge_strain, against
+  /// h'(0)^2 at rest.
+  double stiffness_growth(double edge_strain) const override;
   double energy(std::span<const Vec3> x) const override;
   /// Element e's elastic energy [J] with its own constants and rest lengths, on the vertices `t`:
   /// its own (element(e)) or, between a cut of the mesh and follow_edit, its vertices before the

@@ -42,12 +42,18 @@ class ExplicitIntegrator {
   /// the element and the time, and puts `state` back to the last step that passed the check.
   void step(State& state);
   /// Equal sub-steps, each at most dt_s(), until state.time_s has advanced by `duration_s`.
-  /// Returns the number of sub-steps. Between sub-steps it asks the interruption (if set) and
-  /// returns early when it says so, with the state at the last sub-step taken.
+  /// Returns the number of sub-steps. A strain-stiffening model shortens them: each is at most
+  /// dt_s() / sqrt(growth), the model's stiffness_growth at the largest edge strain the last force
+  /// evaluation saw (with a tenth more as headroom); when it falls below the sub-step, the rest of
+  /// the duration is divided anew. Between sub-steps it asks the interruption (if set) and returns
+  /// early when it says so, with the state at the last sub-step taken.
   long advance(State& state, double duration_s);
   /// The largest edge strain |L - L0| / L0 that the force evaluations of the last advance() saw
   /// (at the start of each sub-step).
   double max_edge_strain() const { return max_edge_strain_; }
+  /// The longest sub-step the model's stiffening allows after the last force evaluation [s]
+  /// (dt_s() for a model without stiffening).
+  double stiffened_step_s() const;
   /// Asked between the sub-steps of advance(): true stops it (a program that must stop at once).
   void set_interruption(std::function<bool()> interrupted) { interrupted_ = std::move(interrupted); }
 
@@ -102,6 +108,8 @@ class ExplicitIntegrator {
   double t_prev_ = 0.0;
   std::vector<double> grown_;  ///< follow_edit's scratch: inertia added per node, all 0 between edits
   double max_edge_strain_ = 0.0;
+  double last_edge_strain_ = 0.0;  // of the last force evaluation, for the next sub-step's length
+  double last_step_end_s_ = -1.0;  // the time the last step left its state at
   double element_step_s_ = 0.0;
 };
 

@@ -91,6 +91,13 @@ class ForceModel {
   }
   /// Stiffness-proportional (Kelvin-Voigt) damping time [s], which shortens the explicit step.
   virtual double stiffness_damping_time_s() const { return 0.0; }
+  /// How many times stiffer than at rest an element's tangent may be while no edge strain
+  /// |dL| / L0 exceeds `edge_strain` (>= 1; 1 for a model without strain stiffening). The
+  /// explicit integrator shortens its step by its square root.
+  virtual double stiffness_growth(double edge_strain) const {
+    (void)edge_strain;
+    return 1.0;
+  }
 
   /// Elastic potential energy [J]. For the paper-form GPS (not conservative at finite strain)
   /// this is the energy of its energy-consistent sibling, 0.5 dL^T H dL.
