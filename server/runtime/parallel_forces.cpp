@@ -1,5 +1,6 @@
 #include "viscera/runtime/parallel_forces.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -53,8 +54,20 @@ void ParallelForces::helper() {
   // core was not idle and they could queue behind the physics thread (the runs are in
   // docs/SCENE.md, "Physics threads"). The physics thread takes the
   // helper's chunks itself when the helper is held off. Nice 19 where SCHED_IDLE is refused.
-  const sched_param idle{};
-  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+  // A server started with real-time priority (a station's unit, docs/DEPLOY.md) keeps it for the
+  // helper: a SCHED_IDLE helper that has taken a chunk is held off by any other process on its
+  // core (a browser drawing the console), and the real-time physics thread waits for that chunk
+  // (bench/station.sh on the 12k liver, three interleaved pairs of 30 s: 33-40% of the slots
+  // missed with SCHED_IDLE, 17-27% with this). Two levels below the process, so that a haptic
+  // client deployed one below the server (49 under 50) still preempts it.
+  const int process_policy = sched_getscheduler(getpid());
+  if (sched_param p{}; (process_policy == SCHED_FIFO || process_policy == SCHED_RR) && sched_getparam(getpid(), &p) == 0) {
+    p.sched_priority = std::max(sched_get_priority_min(process_policy), p.sched_priority - 2);
+    pthread_setschedparam(pthread_self(), process_policy, &p);
+  } else {
+    const sched_param idle{};
+    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+  }
   pthread_setname_np(pthread_self(), "forces-helper");
   std::uint64_t seen = 0;
   for (;;) {
