@@ -88,7 +88,7 @@ SofteningEvidence softening_evidence(const MaterialModel& model, const Dataset& 
 
 // Residual signatures of a fitted model (data - model), the evidence behind each mechanism.
 std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) {
-  double hold_drift = 0, hold_n = 0, big = 0, big_n = 0, mid = 0, mid_n = 0, comp = 0, comp_n = 0, tens = 0, tens_n = 0;
+  double hold_drift = 0, hold_n = 0, big = 0, big_n = 0, mid = 0, mid_n = 0, small = 0, small_n = 0, comp = 0, comp_n = 0, tens = 0, tens_n = 0;
   double virgin = 0, virgin_n = 0, reload = 0, reload_n = 0;
   double max_strain = 0;
   for (const auto& t : d.tests)
@@ -106,6 +106,8 @@ std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) 
         big += r, ++big_n;
       else if (std::abs(e) > 0.2 * max_strain)
         mid += r, ++mid_n;
+      else if (std::abs(e) > 0.01 * max_strain)
+        small += r * (e < 0 ? -1 : 1), ++small_n;
       if (e < -0.05 * max_strain) comp += r * (e < 0 ? -1 : 1), ++comp_n;
       if (e > 0.05 * max_strain) tens += r, ++tens_n;
       const double peak = e >= 0 ? peak_t : peak_c;
@@ -135,6 +137,11 @@ std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) 
     case Mechanism::first_load_softening:
       return format_figures("first loading stiffer than reloading: mean residual %.3g Pa on virgin loading, %.3g Pa on reloading",
                             mean(virgin, virgin_n), mean(reload, reload_n));
+    case Mechanism::contact_take_up:
+      return format_figures(
+          "the first loading carries less than the model: mean residual %.3g Pa (sign-corrected; positive: less stress than the model) "
+          "below 20%% of the largest strain, %.3g Pa at 20-70%%",
+          -mean(small, small_n), mean(mid, mid_n));
   }
   return "";
 }
@@ -274,13 +281,15 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
   // How long the rest will take: at most 4 + 3 + 2 + 1 candidate evaluations, each timed.
   const auto started = std::chrono::steady_clock::now();
   int evaluated = 0;
-  const int at_most = static_cast<int>(kMechanisms.size() * (kMechanisms.size() + 1) / 2);
   Selection sel;
   ModelEvaluation current = start;
   std::vector<Mechanism> remaining(kMechanisms.begin(), kMechanisms.end());
   // In simple shear an isotropic solid's stress is odd in the strain: no tension/compression
   // asymmetry to find there (and stiffening is offered in its odd forms only).
   if (start.model.odd_only) remaining.erase(std::find(remaining.begin(), remaining.end(), Mechanism::tension_compression_asymmetry));
+  // A contact to take up only where the specimen sat between platens.
+  if (!start.model.platens) remaining.erase(std::find(remaining.begin(), remaining.end(), Mechanism::contact_take_up));
+  const int at_most = static_cast<int>(remaining.size() * (remaining.size() + 1) / 2);
   for (int round = 1; !remaining.empty(); ++round) {
     std::optional<ModelEvaluation> current_blocks;  // the current model on held-out blocks, when needed
     const Mechanism* best = nullptr;
@@ -436,6 +445,14 @@ std::string verdict_of(const Analysis& a, bool odd_only) {
          "isotropic solid's shear stress is odd in the shear strain).";
   if (a.supported_model().has(Mechanism::strain_stiffening))
     v << " Stiffening form chosen by the fit: " << name(a.supported_model().stiffening_form) << ".";
+  if (a.supported_model().platens) {
+    v << " Between platens: the model's stress is never a pull (contact is lost where it would pull)";
+    if (a.supported_model().has(Mechanism::contact_take_up))
+      v << ", and the platens closed a gap of " << 100 * a.supported_model().contact_strain
+        << "% of the specimen's height before they loaded it (contact_take_up: a property of the test, left out of the material handed to the "
+           "organ)";
+    v << ".";
+  }
   if (const Adequacy& q = a.adequacy; q.explained) {
     v << " The model it stands by explains the data within the noise: its residual is " << q.residual_to_noise << "x the noise.";
   } else {
@@ -476,9 +493,8 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
   if (a.noise_check.tests > 0)
     say(format_figures("noise: %.4g Pa from second differences; %.4g Pa from the spread in ", a.noise_check.first_pa, a.noise_check.holds_pa) +
         std::to_string(a.noise_check.holds) + " holds" + (a.noise_check.agree ? " (they agree)" : " (they disagree)"));
-  MaterialModel structure;
+  MaterialModel structure = for_dataset({}, d);
   structure.relaxation_time_s = relaxation_times_for(d);
-  structure.odd_only = d.mode == Mode::simple_shear;
   say("fitting the baseline (linear elastic + Kelvin-Voigt) to " + std::to_string(d.tests.size()) + " tests, leaving each out in turn");
   a.baseline = evaluate(structure, d);
   say(format_figures("baseline: fit RMS %.4g Pa, held-out RMS %.4g Pa, noise %.4g Pa", a.baseline.fit_rms_pa, a.baseline.heldout_rms_pa, a.noise_pa));

@@ -243,12 +243,14 @@ Dataset read_dataset(const std::string& folder) {
   if (!std::filesystem::exists(meta)) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");
   const json j = common::read_json_file(meta);
   const JsonObject top(j, meta);
-  top.require_known({"name", "mode", "specimen", "tests", "max_test_duration_s", "import"});
+  top.require_known({"name", "mode", "contact", "specimen", "tests", "max_test_duration_s", "import"});
   Dataset d;
   d.folder = folder;
   d.name = top.text("name", std::filesystem::path(folder).filename().string());
   d.import_note = top.text("import", "");
   d.mode = top.choice("mode", {"uniaxial", "simple_shear"}, "") == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
+  d.platens = top.choice("contact", {"bonded", "platens"}, "bonded") == "platens";
+  if (d.platens && d.mode != Mode::uniaxial) top.fail("contact", "\"platens\" needs \"mode\": \"uniaxial\" (platens compress; they do not shear)");
   d.specimen = read_specimen(top.object("specimen"), nullptr);
   // Longer tests exist (creep over days) but are rare; a span beyond a day is more often a time
   // column in another unit, so it must be declared.
@@ -270,6 +272,18 @@ Dataset read_dataset(const std::string& folder) {
                            " s: is the time in another unit? (a longer test is declared with \"max_test_duration_s\" in dataset.json)");
   }
   check_stress_units(d, meta);
+  if (d.platens)
+    for (const auto& t : d.tests) {
+      // Platens compress: a stretch larger than the strain column's own scatter is a sign flipped.
+      double largest = 0.0;
+      for (const double e : t.strain) largest = std::max(largest, std::abs(e));
+      for (std::size_t k = 0; k < t.strain.size(); ++k)
+        if (t.strain[k] > 0.01 * largest)
+          throw InputError((std::filesystem::path(folder) / t.file).string(), static_cast<long>(k + 2), "strain",
+                           common::short_number(t.strain[k]) +
+                               " is a stretch, but \"contact\": \"platens\" compresses (compression is negative strain and stress; "
+                               "viscera-lab import --compression-positive negates exports that count it positive)");
+    }
   return d;
 }
 
@@ -278,6 +292,7 @@ void write_dataset(const Dataset& d, const std::string& folder) {
   json j;
   j["name"] = d.name;
   j["mode"] = to_string(d.mode);
+  if (d.platens) j["contact"] = "platens";
   if (!d.import_note.empty()) j["import"] = d.import_note;
   const auto specimen = [](const Specimen& sp) {
     return json{{"length_m", sp.length_m}, {"width_m", sp.width_m}, {"thickness_m", sp.thickness_m}, {"density_kg_m3", sp.density_kg_m3}};

@@ -88,9 +88,10 @@ TestData import_test(const std::string& path, const ImportOptions& o, ImportOffs
       if (!v) throw InputError(path, row, c.name, why);
       return *v * c.to_si;
     };
+    const double sign = o.compression_positive ? -1.0 : 1.0;
     t.time_s.push_back(value(ct, o.time));
-    t.strain.push_back(value(cd, o.displacement) / gauge);
-    t.stress_pa.push_back(value(cf, o.force) / area);
+    t.strain.push_back(sign * value(cd, o.displacement) / gauge + 0.0);  // + 0: no -0 from a negated 0
+    t.stress_pa.push_back(sign * value(cf, o.force) / area + 0.0);
   }
   if (t.time_s.size() < 3) throw InputError(path, row, "rows", std::to_string(t.time_s.size()) + " rows of data: a test needs at least 3");
   ImportOffsets off;
@@ -109,6 +110,16 @@ TestData import_test(const std::string& path, const ImportOptions& o, ImportOffs
     const double first_strain = t.strain.front();
     for (double& e : t.strain) e -= first_strain;
   }
+  if (o.platens) {
+    // Checked here, before anything is written, as read_dataset checks it, but naming the export's row.
+    double largest = 0.0;
+    for (const double e : t.strain) largest = std::max(largest, std::abs(e));
+    for (std::size_t k = 0; k < t.strain.size(); ++k)
+      if (t.strain[k] > 0.01 * largest)
+        throw InputError(path, static_cast<long>(k + 2), o.displacement.name,
+                         common::short_number(t.strain[k] * gauge) +
+                             " m is a stretch, but --platens compresses (--compression-positive negates exports that count compression positive)");
+  }
   if (taken_off) *taken_off = off;
   return t;
 }
@@ -119,6 +130,7 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   Dataset d;
   d.name = o.name.empty() ? std::filesystem::path(folder).filename().string() : o.name;
   d.mode = o.mode;
+  d.platens = o.platens;
   d.specimen = o.specimen;
   std::set<std::string> names;
   std::string offsets;
@@ -139,6 +151,8 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
                   " / (specimen." + area + ")";
   if (o.tare) d.import_note += "; tare: each test's force at rest (its leading rows before the displacement moves) subtracted (a preload)";
   if (o.zero_displacement) d.import_note += "; displacement from each test's first row";
+  if (o.compression_positive) d.import_note += "; compression positive in the exports: force and displacement negated";
+  if (o.platens) d.import_note += "; between platens (contact: platens)";
   if (!offsets.empty()) d.import_note += " (taken off: " + offsets + ")";
   write_dataset(d, folder);
   return read_dataset(folder);

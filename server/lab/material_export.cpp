@@ -53,6 +53,12 @@ std::string material_file_text(const MaterialModel& m, const Dataset& d, const s
     v["compression_ratio"] = g.asymmetry.compression_ratio;
   }
   if (g.softening.active()) v["softening_d"] = g.softening.d;
+  if (m.has(Mechanism::contact_take_up) && note) {
+    char b[200];
+    std::snprintf(b, sizeof b, "%sthe platens' gap (contact taken up over the first %.3g%% of compression) belongs to the test: left out",
+                  note->empty() ? "" : "; ", 100 * m.contact_strain);
+    *note += b;
+  }
   j["viscoelasticity"] = v;
   return j.dump(2) + "\n";
 }

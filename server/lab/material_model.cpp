@@ -14,6 +14,7 @@ const char* name(Mechanism m) {
     case Mechanism::strain_stiffening: return "strain_stiffening";
     case Mechanism::tension_compression_asymmetry: return "tension_compression_asymmetry";
     case Mechanism::first_load_softening: return "first_load_softening";
+    case Mechanism::contact_take_up: return "contact_take_up";
   }
   return "?";
 }
@@ -60,6 +61,17 @@ int MaterialModel::parameter_count() const {
   return n;
 }
 
+MaterialModel for_dataset(MaterialModel m, const Dataset& d) {
+  m.odd_only = d.mode == Mode::simple_shear;
+  m.platens = d.platens;
+  return m;
+}
+
+double specimen_strain(const MaterialModel& m, double e) {
+  if (!m.has(Mechanism::contact_take_up)) return e;
+  return std::min(0.0, e + m.contact_strain);
+}
+
 namespace {
 // Ogden's one-term incompressible response with exponent a, normalised to slope 1 at rest:
 // uniaxial nominal stress over 3 mu, or the simple-shear stress over mu (docs in the header).
@@ -74,7 +86,8 @@ double ogden_response(double a, double e, bool shear) {
 }
 }  // namespace
 
-double ElasticShape::value(double e) const {
+double ElasticShape::value(double test_strain) const {
+  const double e = specimen_strain(m, test_strain);
   double v = e;
   if (m.has(Mechanism::strain_stiffening) && m.stiffening_b > 0) {
     const double B = m.stiffening_b;
@@ -93,7 +106,8 @@ double ElasticShape::value(double e) const {
   return v;
 }
 
-void ElasticShape::advance(double e) {
+void ElasticShape::advance(double test_strain) {
+  const double e = specimen_strain(m, test_strain);
   if (e >= 0)
     max_tension = std::max(max_tension, e);
   else
@@ -101,7 +115,8 @@ void ElasticShape::advance(double e) {
 }
 
 double ElasticShape::strain_for(double s) const {
-  // value() is increasing in e for every mechanism (softening's factor keeps d < 1).
+  // value() is increasing in e for every mechanism (softening's factor keeps d < 1; flat over a
+  // contact gap, where any strain in it will do).
   double lo = -1.0, hi = 1.0;
   while (value(lo) > s && lo > -1e6) lo *= 2;
   while (value(hi) < s && hi < 1e6) hi *= 2;
@@ -165,7 +180,8 @@ void set_linear_coefficients(MaterialModel& m, const Eigen::VectorXd& c) {
 }
 
 std::vector<double> predict_stress(const MaterialModel& m, const TestData& t) {
-  const Eigen::VectorXd y = basis(m, t) * linear_coefficients(m);
+  Eigen::VectorXd y = basis(m, t) * linear_coefficients(m);
+  if (m.platens) y = y.cwiseMin(0.0);
   return {y.data(), y.data() + y.size()};
 }
 

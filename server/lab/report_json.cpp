@@ -158,7 +158,10 @@ json report_json(const Analysis& a, const Dataset& d, double seconds, const Mate
   return j;
 }
 
-json prediction_json(const MaterialModel& m, const std::string& model_path, const Dataset& d) {
+json prediction_json(const MaterialModel& model, const std::string& model_path, const Dataset& d) {
+  // Ogden's form responds as the data's mode loads it, and platens never pull, whatever data set
+  // the model came from.
+  const MaterialModel m = for_dataset(model, d);
   json j;
   j["model"] = m.describe();
   j["model_file"] = model_path;

@@ -157,10 +157,13 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   c.law_b = c.gps_b = stiffens ? m.stiffening_b : 0.0;
   c.law_r = c.gps_r = asymmetric ? m.compression_ratio : 1.0;
   if (!stiffens && !asymmetric) return c;
+  // The tissue's own curve over the strains the specimen itself went through (after a platens' gap).
+  MaterialModel tissue = m;
+  tissue.mechanisms &= ~(1u << static_cast<unsigned>(Mechanism::contact_take_up));
   for (const auto& t : d.tests)
     for (const double e : t.strain) {
-      c.strain_lo = std::min(c.strain_lo, e);
-      c.strain_hi = std::max(c.strain_hi, e);
+      c.strain_lo = std::min(c.strain_lo, specimen_strain(m, e));
+      c.strain_hi = std::max(c.strain_hi, specimen_strain(m, e));
     }
   // Six strains on each side of rest that the data reach, from 0 outwards (each static solve
   // starts from the last).
@@ -171,7 +174,7 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   }
   const Rig rig = make_rig(d.mode, d.specimen);  // the shape is calibrated on the data set's specimen
   const double E = 1e4;  // the shape is what is calibrated (the stress scales with the modulus)
-  const auto law = [&](double e) { return E * ElasticShape{m}.value(e); };  // the virgin curve
+  const auto law = [&](double e) { return E * ElasticShape{tissue}.value(e); };  // the virgin curve
   const StiffeningShape shape = gps_shape(m.stiffening_form);
   const auto mismatch = [&](double b, double r, const std::vector<double>& strains) {
     if (strains.empty()) return 0.0;
@@ -300,7 +303,22 @@ SpecimenResult simulate_specimen(const MaterialModel& m, const Dataset& d, const
   if (!r.supported) return r;
   const GpsLaw law = gps_law(m, d, calibration);
   const std::string note = r.note;
-  r = simulate_specimen(law.mechanisms, specimen_elasticity(law.unrelaxed_modulus_pa, d.mode == Mode::simple_shear), d, t, max_seconds);
+  // The test's part: the specimen is compressed by what is left after the platens' gap, and the
+  // platens do not pull.
+  const bool fixture = m.has(Mechanism::contact_take_up) && t.control == Control::strain;
+  TestData on_specimen = t;
+  if (fixture)
+    for (double& e : on_specimen.strain) e = specimen_strain(m, e);
+  r = simulate_specimen(law.mechanisms, specimen_elasticity(law.unrelaxed_modulus_pa, d.mode == Mode::simple_shear), d, on_specimen, max_seconds);
+  if (m.platens && t.control == Control::strain) {
+    double sq = 0.0;
+    for (std::size_t k = 0; k < r.stress_pa.size(); ++k) {
+      r.stress_pa[k] = std::min(0.0, r.stress_pa[k]);
+      r.strain[k] = t.strain[k];
+      sq += (r.stress_pa[k] - t.stress_pa[k]) * (r.stress_pa[k] - t.stress_pa[k]);
+    }
+    if (!r.stress_pa.empty()) r.rms_pa = std::sqrt(sq / static_cast<double>(r.stress_pa.size()));
+  }
   r.note = note;
   r.shape = law.shape;
   return r;

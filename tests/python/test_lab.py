@@ -40,7 +40,7 @@ def test_analyze_gives_the_programs_report(tmp_path: Path) -> None:
     written = json.loads((tmp_path / "cli/report.json").read_text())
     lines: List[str] = []
     d = viscera.lab.read_dataset(TITIN)
-    assert d.name.startswith("titin-passive-muscle") and len(d.tests) == 4
+    assert d.name.startswith("titin-passive-muscle") and len(d.tests) == 4 and d.contact == "bonded"
     a = viscera.lab.analyze(d, progress=lines.append)
     assert len(lines) >= 3, "progress lines arrive while it runs"
     figures_equal(written, a.report)

@@ -117,6 +117,13 @@ mkdir -p "$tmp/in" && cp "$tmp/export.txt" "$tmp/in/export.csv"
 expect lab-import-over-input 2 "is the same file as" -- "$lab" import "$tmp/in/export.csv" --out "$tmp/in" "${import[@]}"
 expect lab-import-mm-as-m 2 "strain: 50 cannot be right" -- "$lab" import "$tmp/export.txt" --out "$tmp/i4" "${import[@]}" --displacement Disp:m
 expect lab-import-no-geometry 2 "import needs --length-m" -- "$lab" import "$tmp/export.txt" --out "$tmp/i3" --force Force --displacement Disp
+# A compression between platens exported with compression positive: negated, and declared.
+expect lab-import-platens 0 "export.csv: 5 rows, 4 s, strain -0.1 to 0, stress -1e+04 to 0 Pa" -- "$lab" import "$tmp/export.txt" --out "$tmp/platens" "${import[@]}" --platens --compression-positive
+expect lab-import-platens-declared 0 '"contact": "platens"' -- cat "$tmp/platens/dataset.json"
+# Declared between platens but stretched (the sign not flipped): the file, the row and the strain.
+expect lab-import-platens-stretch 2 "export.txt:3: Disp: 0.0005 m is a stretch" -- "$lab" import "$tmp/export.txt" --out "$tmp/i5" "${import[@]}" --platens
+mkdir -p "$tmp/glued" && cp "$tmp/imported/export.csv" "$tmp/glued/" && python3 -c "import json; j=json.load(open('$tmp/imported/dataset.json')); j['contact']='glued'; json.dump(j, open('$tmp/glued/dataset.json','w'))"
+expect lab-contact-unknown 2 "dataset.json: contact: 'glued' is not one of bonded | platens" -- "$lab" analyze "$tmp/glued" --out "$tmp/o"
 fi
 if [ "$part" != programs ]; then
 expect lab-analyze 0 "causes (confirmed): broadband_relaxation strain_stiffening" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/titin" --quiet

@@ -62,6 +62,9 @@ void bind_lab(py::module_& m) {
       .def_readonly("import_note", &Dataset::import_note, "how viscera-lab import made it, with its units (empty otherwise)")
       .def_property_readonly(
           "mode", [](const Dataset& d) { return std::string(to_string(d.mode)); }, "uniaxial or simple_shear")
+      .def_property_readonly(
+          "contact", [](const Dataset& d) { return std::string(d.platens ? "platens" : "bonded"); },
+          "bonded, or platens (compressed between platens it was not bonded to: they cannot pull)")
       .def_readonly("tests", &Dataset::tests, "the tests, in dataset.json's order");
   m.def("read_dataset", &read_dataset, py::arg("folder"),
         "Reads DATASET_DIR/dataset.json and its CSVs; raises InputError naming file, line and field.");

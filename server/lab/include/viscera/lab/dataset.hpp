@@ -28,6 +28,9 @@ struct Dataset {
   std::string name, folder;
   std::string import_note;  ///< how `viscera-lab import` made it, with its units ("import" in dataset.json; "" otherwise)
   Mode mode = Mode::uniaxial;
+  /// "contact": "platens" in dataset.json: the specimen was compressed between platens it was not
+  /// bonded to (they take up contact, and cannot pull); "bonded" (the default): glued or gripped.
+  bool platens = false;
   Specimen specimen;
   std::vector<TestData> tests;
 };

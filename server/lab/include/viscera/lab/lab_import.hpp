@@ -38,6 +38,11 @@ struct ImportOptions {
   bool tare = false;
   /// Displacements from each export's first row instead of the export's own zero.
   bool zero_displacement = false;
+  /// Compressed between platens it is not bonded to (dataset.json "contact": "platens").
+  bool platens = false;
+  /// The exports count compression as positive force and displacement: both are negated (the data
+  /// set's compression is negative strain and stress).
+  bool compression_positive = false;
 };
 
 /// What import_test took off an export (SI): its first force and first displacement, 0 when not asked.

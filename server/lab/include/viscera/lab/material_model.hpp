@@ -20,6 +20,11 @@
 //   tension_compression_asymmetry s = eps (eps >= 0), r eps (eps < 0)
 //   first_load_softening          s = eps on the virgin curve, (1 - d (1 - |eps|/m)) eps below the
 //                                 previous extreme m (Ogden-Roxburgh-like softening on reloading)
+//   contact_take_up               a property of the test, not of the tissue, offered only where the
+//                                 data set declares platens (a specimen compressed between plates it
+//                                 is not bonded to): the platens close a gap c before they load it,
+//                                 so the specimen's own strain is min(0, eps + c) (a toe), and they
+//                                 cannot pull: the stress is min(0, sigma) (loss of contact)
 // For given nonlinear parameters (B, r, d) the stress is linear in (E, eta, E_l) >= 0.
 #include <array>
 #include <string>
@@ -31,9 +36,13 @@
 
 namespace viscera::lab {
 
-enum class Mechanism { broadband_relaxation, strain_stiffening, tension_compression_asymmetry, first_load_softening };
-inline constexpr std::array<Mechanism, 4> kMechanisms{Mechanism::broadband_relaxation, Mechanism::strain_stiffening,
-                                                      Mechanism::tension_compression_asymmetry, Mechanism::first_load_softening};
+enum class Mechanism { broadband_relaxation, strain_stiffening, tension_compression_asymmetry, first_load_softening, contact_take_up };
+inline constexpr std::array<Mechanism, 5> kMechanisms{Mechanism::broadband_relaxation, Mechanism::strain_stiffening,
+                                                      Mechanism::tension_compression_asymmetry, Mechanism::first_load_softening,
+                                                      Mechanism::contact_take_up};
+/// Whether a mechanism belongs to the test rather than to the tissue (left out of the material
+/// handed to the organ).
+inline bool of_the_test(Mechanism m) { return m == Mechanism::contact_take_up; }
 const char* name(Mechanism m);
 /// Parses a mechanism name; false if unknown.
 bool parse_mechanism(const std::string& s, Mechanism* out);
@@ -49,10 +58,15 @@ struct MaterialModel {
   /// the fit offers only odd stiffening forms, and Ogden's form is its shear response. Set from
   /// the data set's mode.
   bool odd_only = false;
+  /// The specimen sat between platens it is not bonded to (dataset.json "contact": "platens"): they
+  /// cannot pull, so every predicted stress is min(0, sigma), and contact_take_up is a candidate.
+  /// Set from the data set.
+  bool platens = false;
   StiffeningForm stiffening_form = StiffeningForm::exponential;
   double stiffening_b = 0.0;
   double compression_ratio = 1.0;
   double softening_d = 0.0;
+  double contact_strain = 0.0;  ///< contact_take_up: the gap the platens close before they load, as a strain
   double modulus_pa = 0.0;
   double viscosity_pa_s = 0.0;
   std::vector<double> relaxation_time_s;  ///< broadband only
@@ -64,6 +78,13 @@ struct MaterialModel {
   /// Number of free parameters (non-zero linear ones and the nonlinear ones).
   int parameter_count() const;
 };
+
+/// The model as it applies to a data set's tests: odd_only from its mode, platens from its contact.
+MaterialModel for_dataset(MaterialModel m, const Dataset& d);
+
+/// The strain the specimen itself undergoes at the test's strain eps: eps, or with contact_take_up
+/// min(0, eps + c).
+double specimen_strain(const MaterialModel& m, double eps);
 
 /// The elastic shape s(eps) of a model along one history (first-load softening remembers the
 /// largest strain seen in tension and in compression).
@@ -88,7 +109,8 @@ Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t);
 Eigen::VectorXd linear_coefficients(const MaterialModel& m);
 void set_linear_coefficients(MaterialModel& m, const Eigen::VectorXd& c);
 
-/// Stress from the measured strain (the equation the fit minimises, for any control).
+/// Stress from the measured strain (the equation the fit minimises, for any control); between
+/// platens, never a pull.
 std::vector<double> predict_stress(const MaterialModel& m, const TestData& t);
 
 /// Log-spaced relaxation times, one per decade, covering the sampling intervals and durations.
