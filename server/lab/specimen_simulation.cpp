@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/lab/command_path.hpp"
@@ -178,7 +179,12 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   const StiffeningShape shape = gps_shape(m.stiffening_form);
   const auto mismatch = [&](double b, double r, const std::vector<double>& strains) {
     if (strains.empty()) return 0.0;
-    const auto curve = static_curve(rig, E, shape, b, r, strains);
+    std::vector<double> curve;
+    try {
+      curve = static_curve(rig, E, shape, b, r, strains);
+    } catch (const SimulationError&) {
+      return std::numeric_limits<double>::infinity();  // the specimen cannot follow this B: not a candidate
+    }
     double sq = 0.0, norm = 0.0;
     for (std::size_t k = 0; k < strains.size(); ++k) {
       sq += (curve[k] - law(strains[k])) * (curve[k] - law(strains[k]));
@@ -193,9 +199,12 @@ ShapeCalibration calibrate_elastic_shape(const MaterialModel& m, const Dataset& 
   // B from the tension side, r from the compression side; twice, since the lateral edges of a
   // stretched specimen are compressed (and those of a compressed one stretched).
   for (int round = 0; round < 2; ++round) {
-    if (stiffens && !tension.empty())
-      c.gps_b =
-          golden_section([&](double b) { return mismatch(b, c.gps_r, tension); }, 0.2 * c.law_b, (rig.shear ? 4.0 : 1.5) * c.law_b, 1e-4 * c.law_b).x;
+    // B from the compression side where the data never stretch (a disc between platens).
+    const std::vector<double>& b_side = tension.empty() ? compression : tension;
+    if (stiffens && !b_side.empty())
+      c.gps_b = golden_section([&](double b) { return mismatch(b, c.gps_r, b_side); }, (tension.empty() ? 0.02 : 0.2) * c.law_b,
+                               (rig.shear ? 4.0 : 1.5) * c.law_b, 1e-4 * c.law_b)
+                    .x;
     if (asymmetric && !compression.empty())
       c.gps_r = std::exp(
           golden_section([&](double lr) { return mismatch(c.gps_b, std::exp(lr), compression); }, std::log(c.law_r / 4), std::log(c.law_r * 4), 1e-4)

@@ -28,25 +28,52 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double d
   }
   const double kv = dt_s > 0 ? viscous.kelvin_voigt_time_s / dt_s : 0.0;
   const double d = mech.softening.d;
-  if (!(d > 0) || memory.size() != memory_size()) return tangent(x, e, shear + kv, bulk - shear);
+  if (memory.size() != memory_size()) return tangent(x, e, shear + kv, bulk - shear);
+  // What the step's start holds (add_forces_impl's memory update, its part that does not depend
+  // on x): the relaxed elongation (or, in the energy form, tension) is
+  // (shear + kv) a + sum_l y_s,l (-(e_l zeta_l + (a_l - c_l) a_prev)) - kv a_prev, and the bulk part
+  // adds s hv hv . sum_l (y_s,l - y_b,l) (e_l zeta_l + (a_l - c_l) a_prev). Without it the
+  // geometric stiffness took (shear + kv) times the tension: under a long Kelvin-Voigt time that
+  // is thousands of times the tension, and Newton's steps stopped descending.
+  const double* in = memory.data() + (e / kLanes) * memory_stride();
+  const std::size_t j = e % kLanes;
+  Vec6 held_a = Vec6::Zero(), held_b = Vec6::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double prev = in[k * kLanes + j];
+    held_a(k) = -kv * prev;
+    for (std::size_t l = 0; l < mechanisms_; ++l) {
+      const MemoryStep st = MemoryStep::make(viscous.omega_rad_s[l], dt_s);
+      const double z = st.e * in[((1 + l) * 6 + static_cast<std::size_t>(k)) * kLanes + j] + (st.a - st.c) * prev;
+      held_a(k) -= viscous.shear_weight[l] * z;
+      held_b(k) += (viscous.shear_weight[l] - viscous.bulk(l)) * z;
+    }
+  }
+  Vec6 held = options_.mechanisms.energy_map() ? held_a : Vec6(packed_hessian(e) * held_a);
+  if (!bulk_.empty()) {
+    const BulkBlock& bb = bulk_[e / kLanes];
+    Vec6 hv;
+    for (int k = 0; k < 6; ++k) hv(k) = bb.hv[k][j];
+    held += bb.scale[j] * hv * hv.dot(held_b);
+  }
+  if (!(d > 0)) return tangent(x, e, shear + kv, bulk - shear, nullptr, nullptr, &held);
   // First-load softening: the factors at x for the extremes the step started with.
   const auto p = gather(x, e);
-  const double* peaks = memory.data() + (e / kLanes) * memory_stride() + softening_offset();
+  const double* peaks = in + softening_offset();
   Vec6 phi = Vec6::Ones(), dphi = Vec6::Zero();
   for (int k = 0; k < 6; ++k) {
     const int a = kTetEdges[k][0], b = kTetEdges[k][1];
     const double strain = ((p[b] - p[a]).norm() - edge_length(e, k)) / edge_length(e, k);
-    const double peak = strain >= 0 ? peaks[k * kLanes + e % kLanes] : peaks[(6 + k) * kLanes + e % kLanes];
+    const double peak = strain >= 0 ? peaks[k * kLanes + j] : peaks[(6 + k) * kLanes + j];
     if (std::abs(strain) < peak) {
       phi(k) = 1.0 - d * (1.0 - std::abs(strain) / peak);
       dphi(k) = d * (strain >= 0 ? 1.0 : -1.0) / peak;
     }
   }
-  return tangent(x, e, shear + kv, bulk - shear, &phi, &dphi);
+  return tangent(x, e, shear + kv, bulk - shear, &phi, &dphi, &held);
 }
 
-Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi,
-                        const Vec6* dphi_de) const {
+Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi, const Vec6* dphi_de,
+                        const Vec6* held) const {
   // f = P t with P_e = (+Y_e at a, -Y_e at b), t = S h, h = H dL, dL = G dx,
   // G_e = (-y_e at a, +y_e at b), y_e = Y_e / L_e. K = -df/dx (see docs/MODEL.md section 1).
   const auto p = gather(x, e);
@@ -107,11 +134,12 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
   for (int k = 0; k < 6; ++k) {
     const int a = kTetEdges[k][0], b = kTetEdges[k][1];
     const double s = ec ? 1.0 / len(k) : 1.0 / edge_length(e, k);
-    const double tk = s * h(k);
+    const double tension = h(k) + (held ? (*held)(k) : 0.0);
+    const double tk = s * tension;
     // Material part: -P_k dt_k/dx with dt_k/dx = s (H G)_k [- h_k / L_k^2 G_k for EC].
     Eigen::Matrix<double, 1, 12> dt = s * soft(k) * dh(k) * (H.row(k) * Gm);
     if (qlv_energy) dt += s * soft(k) * d2h(k) * Hh(k) * G.row(k) + s * dsoft(k) * dh(k) * Hh(k) * G.row(k);
-    if (ec) dt -= h(k) / (len(k) * len(k)) * G.row(k);
+    if (ec) dt -= tension / (len(k) * len(k)) * G.row(k);
     K.block<3, 12>(3 * a, 0) -= Y.col(k) * dt;
     K.block<3, 12>(3 * b, 0) += Y.col(k) * dt;
     // Geometric part: -t_k dP_k/dx, dP_k/dx = [[-I, I], [I, -I]] on (a, b).

@@ -105,8 +105,11 @@ class GpsModel final : public ForceModel {
   ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory, std::size_t first_block,
                              std::size_t end_block) const;
   /// phi, dphi_de: first-load softening factors per edge and their derivatives in the edge strain.
+  /// held: the part of the edge tensions (before the 1/L scaling) that the step's start holds, the
+  /// same for every x of the step (the memory variables' and the Kelvin-Voigt rate's share of the
+  /// previous elongations): it adds to the geometric stiffness only.
   Mat12 tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi = nullptr,
-                const Vec6* dphi_de = nullptr) const;
+                const Vec6* dphi_de = nullptr, const Vec6* held = nullptr) const;
   /// Offset of the softening extremes in a block's memory (tension extremes, then compression).
   std::size_t softening_offset() const { return (1 + mechanisms_) * 6 * kLanes; }
   std::size_t memory_stride() const { return (1 + mechanisms_ + (options_.mechanisms.softening.active() ? 2 : 0)) * 6 * kLanes; }
