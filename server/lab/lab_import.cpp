@@ -51,6 +51,52 @@ ImportColumn parse_import_column(const std::string& flag, const std::string& tex
   throw common::UsageError("--" + flag + ": unit '" + c.unit + "' is not a " + quantity_name(q) + " unit (" + known + ")");
 }
 
+std::map<std::string, Specimen> read_specimen_table(const std::string& path, const Specimen& defaults) {
+  const std::string content = common::read_text_file(path, std::size_t{1} << 24);
+  CsvLines lines(content);
+  const auto first = lines.next();
+  if (!first) throw InputError(path, 1, "header", "file is empty");
+  char separator = ',';
+  for (const char c : {';', '\t'})
+    if (std::count(first->begin(), first->end(), c) > std::count(first->begin(), first->end(), separator)) separator = c;
+  const auto header = csv_cells(*first, separator);
+  static const std::vector<std::string> known{"file", "length_m", "width_m", "thickness_m", "density_kg_m3"};
+  for (const auto& h : header)
+    if (std::find(known.begin(), known.end(), h) == known.end())
+      throw InputError(path, 1, common::printable(h, 30), "unknown column (file, length_m, width_m, thickness_m, density_kg_m3)");
+  if (std::find(header.begin(), header.end(), "file") == header.end()) throw InputError(path, 1, "file", "no such column: each row names an export");
+  std::map<std::string, Specimen> table;
+  long row = 1;
+  while (const auto line = lines.next()) {
+    ++row;
+    if (line->empty() || *line == "\r") continue;
+    const auto cells = csv_cells(*line, separator);
+    std::string file;
+    Specimen sp = defaults;
+    for (std::size_t c = 0; c < header.size(); ++c) {
+      const std::string cell = c < cells.size() ? cells[c] : "";
+      if (header[c] == "file") {
+        file = cell;
+        continue;
+      }
+      if (cell.empty()) continue;  // the data set's value
+      std::string why;
+      const auto v = common::read_number(cell, &why);
+      if (!v) throw InputError(path, row, header[c], why);
+      const double hi = header[c] == "density_kg_m3" ? 1e5 : 10.0;
+      if (!(*v > 0 && *v <= hi))
+        throw InputError(path, row, header[c], common::short_number(*v) + " is outside (0, " + common::short_number(hi) + "]");
+      (header[c] == "length_m"      ? sp.length_m
+       : header[c] == "width_m"     ? sp.width_m
+       : header[c] == "thickness_m" ? sp.thickness_m
+                                    : sp.density_kg_m3) = *v;
+    }
+    if (file.empty()) throw InputError(path, row, "file", "empty: each row names an export");
+    if (!table.emplace(file, sp).second) throw InputError(path, row, "file", "'" + common::printable(file, 60) + "' is named twice");
+  }
+  return table;
+}
+
 TestData import_test(const std::string& path, const ImportOptions& o, ImportOffsets* taken_off) {
   const std::string content = common::read_text_file(path, kMaxExportBytes);
   CsvLines lines(content);
@@ -71,7 +117,8 @@ TestData import_test(const std::string& path, const ImportOptions& o, ImportOffs
   };
   const std::size_t ct = column(o.time, "time"), cf = column(o.force, "force"), cd = column(o.displacement, "displacement");
   const bool shear = o.mode == Mode::simple_shear;
-  const Specimen& sp = o.specimen;
+  const auto own = o.specimen_of.find(std::filesystem::path(path).filename().string());
+  const Specimen& sp = own == o.specimen_of.end() ? o.specimen : own->second;
   const double gauge = shear ? sp.thickness_m : sp.length_m, area = shear ? sp.length_m * sp.width_m : sp.width_m * sp.thickness_m;
   TestData t;
   t.file = std::filesystem::path(path).stem().string() + ".csv";
@@ -134,9 +181,14 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   d.specimen = o.specimen;
   std::set<std::string> names;
   std::string offsets;
+  for (const auto& [name, sp] : o.specimen_of)
+    if (std::none_of(files.begin(), files.end(), [&](const std::string& f) { return std::filesystem::path(f).filename().string() == name; }))
+      throw common::UsageError("--specimens: the table names '" + common::printable(name, 60) + "', which is not one of the exports given");
   for (const auto& f : files) {
     ImportOffsets off;
     d.tests.push_back(import_test(f, o, &off));
+    if (const auto own = o.specimen_of.find(std::filesystem::path(f).filename().string()); own != o.specimen_of.end())
+      d.tests.back().specimen = own->second;
     if (o.tare || o.zero_displacement)
       offsets += (offsets.empty() ? "" : ", ") + d.tests.back().file + ":" + (o.tare ? " force " + common::short_number(off.force_n) + " N" : "") +
                  (o.zero_displacement ? " displacement " + common::short_number(off.displacement_m) + " m" : "");
@@ -153,6 +205,9 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   if (o.zero_displacement) d.import_note += "; displacement from each test's first row";
   if (o.compression_positive) d.import_note += "; compression positive in the exports: force and displacement negated";
   if (o.platens) d.import_note += "; between platens (contact: platens)";
+  if (!o.specimen_of.empty())
+    d.import_note +=
+        "; " + std::to_string(o.specimen_of.size()) + " tests on their own specimens (each test's \"specimen\"; its geometry converts it)";
   if (!offsets.empty()) d.import_note += " (taken off: " + offsets + ")";
   write_dataset(d, folder);
   return read_dataset(folder);

@@ -20,6 +20,7 @@
 
 #include <gtest/gtest.h>
 
+#include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/fit.hpp"
@@ -632,5 +633,60 @@ TEST(OtherLabs, DiscLikeRunsOnTheSpecimenToSixtyPercentAndSaysWhereItLeavesTheLa
     const double strain = std::stod(c.note.substr(at + said.size()));
     EXPECT_LT(strain, -0.15) << c.note;
     EXPECT_GT(strain, -0.45) << c.note;
+  }
+}
+
+// A machine's exports of the three rough discs as it writes them (compression positive, N and mm,
+// one file per disc) and the lab's table of their thicknesses: imported between platens, each test
+// is converted with its own specimen's height and area and keeps it, and the data are the
+// generator's to the files' precision, so the analysis above is what a researcher gets from the
+// exports without editing a number.
+TEST(Import, SeveralSpecimensFromATableBetweenPlatens) {
+  const Dataset direct = rough_discs(0.05, true);
+  const std::string dir = std::string(VISCERA_TEST_TMP) + "/import_discs";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::vector<std::string> files;
+  std::ofstream table(dir + "/specimens.csv");
+  table << "file,length_m\n";
+  for (const TestData& t : direct.tests) {
+    const Specimen& sp = specimen_of(direct, t);
+    files.push_back(dir + "/" + t.file.substr(0, t.file.size() - 4) + ".txt");
+    table << t.file.substr(0, t.file.size() - 4) << ".txt," << sp.length_m << "\n";
+    std::ofstream f(files.back());
+    f.precision(12);
+    f << "Time [s]\tForce [N]\tPosition [mm]\n";
+    for (std::size_t i = 0; i < t.time_s.size(); ++i)
+      f << t.time_s[i] << '\t' << -t.stress_pa[i] * sp.width_m * sp.thickness_m << '\t' << -1e3 * t.strain[i] * sp.length_m << '\n';
+  }
+  table.close();
+  ImportOptions o;
+  o.specimen = direct.specimen;
+  o.time = parse_import_column("time", "Time [s]", ImportQuantity::time);
+  o.force = parse_import_column("force", "Force [N]:N", ImportQuantity::force);
+  o.displacement = parse_import_column("displacement", "Position [mm]:mm", ImportQuantity::displacement);
+  o.platens = o.compression_positive = true;
+  o.specimen_of = read_specimen_table(dir + "/specimens.csv", o.specimen);
+  const Dataset d = import_dataset(files, o, dir + "/discs");
+  EXPECT_TRUE(d.platens);
+  ASSERT_EQ(d.tests.size(), direct.tests.size());
+  for (std::size_t k = 0; k < d.tests.size(); ++k) {
+    const Specimen& want = specimen_of(direct, direct.tests[k]);
+    ASSERT_TRUE(d.tests[k].specimen.has_value()) << k;
+    EXPECT_DOUBLE_EQ(d.tests[k].specimen->length_m, want.length_m) << k;
+    for (std::size_t i = 0; i < d.tests[k].time_s.size(); i += 53) {
+      EXPECT_NEAR(d.tests[k].strain[i], direct.tests[k].strain[i], 1e-10) << k << " row " << i;
+      // dataset.json's CSVs carry 10 significant digits.
+      EXPECT_NEAR(d.tests[k].stress_pa[i], direct.tests[k].stress_pa[i], 1e-9 * std::abs(direct.tests[k].stress_pa[i]) + 1e-9) << k << " row " << i;
+    }
+  }
+  // A table with a row for a file that is not an export given is refused, naming it.
+  std::ofstream(dir + "/extra.csv") << "file,length_m\ndisc9.txt,0.004\n";
+  o.specimen_of = read_specimen_table(dir + "/extra.csv", o.specimen);
+  try {
+    import_dataset(files, o, dir + "/extra");
+    FAIL() << "a table naming no export was taken";
+  } catch (const viscera::common::UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("disc9.txt"), std::string::npos) << e.what();
   }
 }

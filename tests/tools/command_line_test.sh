@@ -122,6 +122,15 @@ expect lab-import-platens 0 "export.csv: 5 rows, 4 s, strain -0.1 to 0, stress -
 expect lab-import-platens-declared 0 '"contact": "platens"' -- cat "$tmp/platens/dataset.json"
 # Declared between platens but stretched (the sign not flipped): the file, the row and the strain.
 expect lab-import-platens-stretch 2 "export.txt:3: Disp: 0.0005 m is a stretch" -- "$lab" import "$tmp/export.txt" --out "$tmp/i5" "${import[@]}" --platens
+# A table of specimens: each export converted with its own length; mistakes named by table, row and column.
+printf 'file,length_m\nexport.txt,0.02\n' > "$tmp/specimens.csv"
+expect lab-import-table 0 "export.csv: 5 rows, 4 s, strain 0 to 0.05," -- "$lab" import "$tmp/export.txt" --out "$tmp/tabled" "${import[@]}" --specimens "$tmp/specimens.csv"
+printf 'file,length_mm\nexport.txt,20\n' > "$tmp/specimens-mm.csv"
+expect lab-import-table-column 2 "specimens-mm.csv:1: length_mm: unknown column" -- "$lab" import "$tmp/export.txt" --out "$tmp/i6" "${import[@]}" --specimens "$tmp/specimens-mm.csv"
+printf 'file,thickness_m\nexport.txt,-0.002\n' > "$tmp/specimens-neg.csv"
+expect lab-import-table-value 2 "specimens-neg.csv:2: thickness_m: -0.002 is outside (0, 10]" -- "$lab" import "$tmp/export.txt" --out "$tmp/i7" "${import[@]}" --specimens "$tmp/specimens-neg.csv"
+printf 'file,length_m\nexport.txt,0.02\nother.txt,0.02\n' > "$tmp/specimens-other.csv"
+expect lab-import-table-other 2 "--specimens: the table names 'other.txt', which is not one of the exports" -- "$lab" import "$tmp/export.txt" --out "$tmp/i8" "${import[@]}" --specimens "$tmp/specimens-other.csv"
 mkdir -p "$tmp/glued" && cp "$tmp/imported/export.csv" "$tmp/glued/" && python3 -c "import json; j=json.load(open('$tmp/imported/dataset.json')); j['contact']='glued'; json.dump(j, open('$tmp/glued/dataset.json','w'))"
 expect lab-contact-unknown 2 "dataset.json: contact: 'glued' is not one of bonded | platens" -- "$lab" analyze "$tmp/glued" --out "$tmp/o"
 fi

@@ -69,7 +69,10 @@ void run_analyze(const std::vector<std::string>& positional, const std::string& 
 void run_import(const std::vector<std::string>& positional, const std::string& out, const viscera::common::CommandLine& cl) {
   if (positional.size() < 2) throw UsageError("import takes one or more EXPORT files");
   const std::vector<std::string> files(positional.begin() + 1, positional.end());
-  for (const auto& f : files) viscera::common::refuse_overwrite(out + "/" + std::filesystem::path(f).stem().string() + ".csv", {f}, "--out");
+  // Nothing import writes may be one of its inputs: any export, or the specimens table.
+  std::vector<std::string> inputs = files;
+  if (cl.has("specimens")) inputs.push_back(cl.text("specimens"));
+  for (const auto& f : files) viscera::common::refuse_overwrite(out + "/" + std::filesystem::path(f).stem().string() + ".csv", inputs, "--out");
   ImportOptions o;
   o.name = cl.has("name") ? cl.text("name") : "";
   const std::string mode = cl.text("mode"), control = cl.text("control");
@@ -86,6 +89,7 @@ void run_import(const std::vector<std::string>& positional, const std::string& o
   o.displacement = parse_import_column("displacement", cl.text("displacement"), ImportQuantity::displacement);
   o.tare = cl.has("tare");
   o.zero_displacement = cl.has("zero-displacement");
+  if (cl.has("specimens")) o.specimen_of = read_specimen_table(cl.text("specimens"), o.specimen);
   o.platens = cl.has("platens");
   o.compression_positive = cl.has("compression-positive");
   const Dataset d = import_dataset(files, o, out);
@@ -125,7 +129,7 @@ int main(int argc, char** argv) {
       "viscera-lab analyze DATASET_DIR --out OUT_DIR\n       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR\n"
       "       viscera-lab import EXPORT... --out DATASET_DIR --length-m L --width-m W --thickness-m T --time COLUMN[:UNIT]\n"
       "                          --force COLUMN[:UNIT] --displacement COLUMN[:UNIT] [--mode uniaxial|simple_shear] [--control strain|stress]\n"
-      "                          [--tare] [--zero-displacement] [--platens] [--compression-positive]");
+      "                          [--specimens TABLE] [--tare] [--zero-displacement] [--platens] [--compression-positive]");
   cl.flag("out", "DIR", "output folder (required)");
   cl.option_switch("quiet", "no progress lines");
   cl.flag("mode", "MODE", "import: uniaxial | simple_shear", "uniaxial");
@@ -144,6 +148,9 @@ int main(int argc, char** argv) {
   cl.option_switch("platens",
                    "import: compressed between platens it is not bonded to (\"contact\": \"platens\"): the platens cannot pull, and the\n"
                    "  contact they take up at the start (a toe) is a candidate cause");
+  cl.flag("specimens", "TABLE",
+          "import: a CSV table of the specimens, a row per export: file (its file name) and any of length_m, width_m,\n"
+          "  thickness_m, density_kg_m3 (an empty cell: the --length-m ... value); each test is converted with its own");
   cl.option_switch("compression-positive", "import: the exports count compression as positive force and displacement (both are negated)");
   cl.allow_positional(1000);
   const auto usage_error = [](const std::string& what) {

@@ -5,6 +5,7 @@
 // what the lab fits can be traced back to the files a researcher measured.
 //  - uniaxial: strain = displacement / length, stress = force / (width x thickness) (nominal);
 //  - simple shear: strain = displacement / thickness, stress = force / (length x width).
+#include <map>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,16 @@ struct ImportOptions {
   /// The exports count compression as positive force and displacement: both are negated (the data
   /// set's compression is negative strain and stress).
   bool compression_positive = false;
+  /// Each export's own specimen where it differs from `specimen` (read_specimen_table), by the
+  /// export's file name as given (its last path component).
+  std::map<std::string, Specimen> specimen_of;
 };
+
+/// A lab's table of specimens: a CSV with a header row, a column `file` naming each export (its
+/// file name) and any of length_m, width_m, thickness_m, density_kg_m3; an empty cell keeps
+/// `defaults`' value. Throws common::InputError naming the table, the row and the column (an
+/// unknown column, a value outside (0, 10] m or (0, 1e5] kg/m^3, a file named twice).
+std::map<std::string, Specimen> read_specimen_table(const std::string& path, const Specimen& defaults);
 
 /// What import_test took off an export (SI): its first force and first displacement, 0 when not asked.
 struct ImportOffsets {
