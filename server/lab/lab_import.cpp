@@ -30,6 +30,16 @@ const char* quantity_name(ImportQuantity q) {
   return "?";
 }
 
+// The header row of a table a machine or a lab wrote, and its separator: comma, semicolon or tab,
+// whichever the header holds most of.
+std::vector<std::string> read_header(CsvLines& lines, const std::string& path, char* separator) {
+  const auto first = lines.next();
+  if (!first) throw InputError(path, 1, "header", "file is empty");
+  for (const char c : {';', '\t'})
+    if (std::count(first->begin(), first->end(), c) > std::count(first->begin(), first->end(), *separator)) *separator = c;
+  return csv_cells(*first, *separator);
+}
+
 }  // namespace
 
 ImportColumn parse_import_column(const std::string& flag, const std::string& text, ImportQuantity q) {
@@ -54,12 +64,8 @@ ImportColumn parse_import_column(const std::string& flag, const std::string& tex
 std::map<std::string, Specimen> read_specimen_table(const std::string& path, const Specimen& defaults) {
   const std::string content = common::read_text_file(path, std::size_t{1} << 24);
   CsvLines lines(content);
-  const auto first = lines.next();
-  if (!first) throw InputError(path, 1, "header", "file is empty");
   char separator = ',';
-  for (const char c : {';', '\t'})
-    if (std::count(first->begin(), first->end(), c) > std::count(first->begin(), first->end(), separator)) separator = c;
-  const auto header = csv_cells(*first, separator);
+  const auto header = read_header(lines, path, &separator);
   static const std::vector<std::string> known{"file", "length_m", "width_m", "thickness_m", "density_kg_m3"};
   for (const auto& h : header)
     if (std::find(known.begin(), known.end(), h) == known.end())
@@ -100,12 +106,8 @@ std::map<std::string, Specimen> read_specimen_table(const std::string& path, con
 TestData import_test(const std::string& path, const ImportOptions& o, ImportOffsets* taken_off) {
   const std::string content = common::read_text_file(path, kMaxExportBytes);
   CsvLines lines(content);
-  const auto first = lines.next();
-  if (!first) throw InputError(path, 1, "header", "file is empty");
   char separator = ',';
-  for (const char c : {';', '\t'})
-    if (std::count(first->begin(), first->end(), c) > std::count(first->begin(), first->end(), separator)) separator = c;
-  const auto header = csv_cells(*first, separator);
+  const auto header = read_header(lines, path, &separator);
   const auto column = [&](const ImportColumn& c, const char* flag) {
     const auto at = std::find(header.begin(), header.end(), c.name);
     if (at == header.end()) {
@@ -181,8 +183,9 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   d.specimen = o.specimen;
   std::set<std::string> names;
   std::string offsets;
-  for (const auto& [name, sp] : o.specimen_of)
-    if (std::none_of(files.begin(), files.end(), [&](const std::string& f) { return std::filesystem::path(f).filename().string() == name; }))
+  for (const auto& named : o.specimen_of)
+    if (const std::string& name = named.first;
+        std::none_of(files.begin(), files.end(), [&](const std::string& f) { return std::filesystem::path(f).filename().string() == name; }))
       throw common::UsageError("--specimens: the table names '" + common::printable(name, 60) + "', which is not one of the exports given");
   for (const auto& f : files) {
     ImportOffsets off;

@@ -28,6 +28,23 @@ namespace {
 
 ConstantQTarget paper_target(int mechanisms) { return {4.8, 0.01, 10.0, mechanisms, 1e3, 2.0}; }
 
+// -df/dx of a one-element model's step of dt from the memory `before`, by central differences
+// (every evaluation advances the memory from the same start).
+Mat12 step_tangent_by_differences(const GpsModel& model, const std::vector<Vec3>& x, const std::vector<double>& before, double dt) {
+  Mat12 fd;
+  const double h = 1e-8;
+  std::vector<double> scratch(before.size());
+  for (int c = 0; c < 12; ++c) {
+    std::vector<Vec3> xp = x, xm = x, fp(4, Vec3::Zero()), fm(4, Vec3::Zero());
+    xp[c / 3][c % 3] += h;
+    xm[c / 3][c % 3] -= h;
+    model.add_forces(xp, fp, {before, scratch, dt});
+    model.add_forces(xm, fm, {before, scratch, dt});
+    for (int r = 0; r < 12; ++r) fd(r, c) = -(fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h);
+  }
+  return fd;
+}
+
 // A regular tetrahedron with a GPS built from the viscoelastic setup (shear Q 4.8, bulk Q 20).
 struct Element {
   std::array<Vec3, 4> rest{Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.005, 0.00866, 0), Vec3(0.005, 0.00289, 0.00816)};
@@ -246,17 +263,7 @@ TEST(FirstLoadSoftening, TangentIsTheDerivativeOfTheForcesAtTheExtremesTheStepSt
     model.add_forces(x, f, {before, before, 1e-3});
     for (int i = 0; i < 4; ++i) x[i] = rest[i] + 0.4 * (x[i] - rest[i]) + 0.0005 * Vec3::Random();  // below them
     const Mat12 K = model.element_tangent(x, 0, 1e-3, before);
-    Mat12 fd;
-    const double h = 1e-8;
-    std::vector<double> scratch(before.size());
-    for (int c = 0; c < 12; ++c) {
-      std::vector<Vec3> xp = x, xm = x, fp(4, Vec3::Zero()), fm(4, Vec3::Zero());
-      xp[c / 3][c % 3] += h;
-      xm[c / 3][c % 3] -= h;
-      model.add_forces(xp, fp, {before, scratch, 1e-3});
-      model.add_forces(xm, fm, {before, scratch, 1e-3});
-      for (int r = 0; r < 12; ++r) fd(r, c) = -(fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h);
-    }
+    const Mat12 fd = step_tangent_by_differences(model, x, before, 1e-3);
     const Mat12 unsoftened = model.element_tangent(x, 0, 1e-3);
     EXPECT_LT((K - fd).norm(), 1e-5 * fd.norm()) << (energy ? "energy" : "edge map");
     EXPECT_GT((unsoftened - fd).norm(), 1e-2 * fd.norm()) << "the softening matters here";
@@ -293,17 +300,7 @@ TEST(GpsMemoryVariables, TangentIsTheDerivativeOfTheForcesWhenTheStepStartsLoade
     }
     for (int i = 0; i < 4; ++i) x[i] = rest[i] + 0.8 * (x[i] - rest[i]) + 0.0005 * Vec3::Random();  // the next step's state
     const Mat12 K = model.element_tangent(x, 0, dt, before);
-    Mat12 fd;
-    const double h = 1e-8;
-    std::vector<double> scratch(before.size());
-    for (int c = 0; c < 12; ++c) {
-      std::vector<Vec3> xp = x, xm = x, fp(4, Vec3::Zero()), fm(4, Vec3::Zero());
-      xp[c / 3][c % 3] += h;
-      xm[c / 3][c % 3] -= h;
-      model.add_forces(xp, fp, {before, scratch, dt});
-      model.add_forces(xm, fm, {before, scratch, dt});
-      for (int r = 0; r < 12; ++r) fd(r, c) = -(fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h);
-    }
+    const Mat12 fd = step_tangent_by_differences(model, x, before, dt);
     const Mat12 fresh = model.element_tangent(x, 0, dt, std::vector<double>(before.size(), 0.0));
     std::cout << "[ figure ] tangent with a loaded memory (" << (energy ? "energy form" : "edge map") << "): " << (K - fd).norm() / fd.norm()
               << " of |K| from central differences; without the memory's tension " << (fresh - fd).norm() / fd.norm() << "\n";

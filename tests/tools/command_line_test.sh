@@ -100,6 +100,8 @@ expect hc-bad-frame 2 "--frame: 'world'" -- "$hc" --frame world
 expect bench-thread-cpu-help 0 "Usage: .*thread_cpu.sh" -- "$src/bench/thread_cpu.sh" --help
 expect bench-thread-cpu-scene 2 "no scene 'nowhere'" -- "$src/bench/thread_cpu.sh" nowhere
 expect bench-thread-cpu-window 2 "SECONDS: '0'" -- "$src/bench/thread_cpu.sh" liver 0
+expect bench-palpation-help 0 "Usage: .*palpation.sh" -- "$src/bench/palpation.sh" --help
+expect bench-palpation-seeds 2 "SEEDS: 'three' is not a whole number" -- env SEEDS=three "$src/bench/palpation.sh"
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
 expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"
