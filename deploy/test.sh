@@ -32,7 +32,7 @@ release_tests() { (cd "$root/build" && ctest --output-on-failure -j "$(nproc)");
 # probe entering the 12k liver (the 1.5k liver's runs the same code here) and the honest-gain analyses,
 # and the ten thousand random cuts followed by both integrators (10 s here; the cutting fuzz target
 # runs the same code under the sanitizers).
-release_only='^CuttingFuzz\.TenThousand|^OtherLabs\.RoughDiscs|^(Specimen|HiddenEffect|BaselineFamily)\.|^Dataset\.(AMillionRow|TitinAnalysis)|^tools\.lab_command_line$|^ToolEntry\..*FineLiver|^HonestGain\.|^Adequacy\.OutsideTheCatalogue|^MaterialHandOver\.'
+release_only='^CuttingFuzz\.TenThousand|^Platens\.RoughDiscs|^(Specimen|HiddenEffect|BaselineFamily)\.|^Dataset\.(AMillionRow|TitinAnalysis)|^tools\.lab_command_line$|^ToolEntry\..*FineLiver|^HonestGain\.|^Adequacy\.OutsideTheCatalogue|^MaterialHandOver\.'
 sanitized_tests() {
   (cd "$root/build-sanitize" && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --output-on-failure -j "$(nproc)" -L 'unit|lab|tools' -E "$release_only")
