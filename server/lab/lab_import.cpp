@@ -40,6 +40,17 @@ std::vector<std::string> read_header(CsvLines& lines, const std::string& path, c
   return csv_cells(*first, *separator);
 }
 
+// A cell beyond the header's columns belongs to no column: a separator inside a value (a decimal
+// comma in a comma-separated file), or a column left unnamed. Empty ones (a spreadsheet's trailing
+// separators) say nothing.
+void refuse_cells_beyond(const std::vector<std::string>& cells, std::size_t columns, const std::string& path, long row) {
+  for (std::size_t c = columns; c < cells.size(); ++c)
+    if (!cells[c].empty() && cells[c] != "\r")
+      throw InputError(path, row, "cell " + std::to_string(c + 1),
+                       "'" + common::printable(cells[c], 30) + "' lies beyond the header's " + std::to_string(columns) +
+                           " columns (a separator inside a value, or a column without a name)");
+}
+
 }  // namespace
 
 ImportColumn parse_import_column(const std::string& flag, const std::string& text, ImportQuantity q) {
@@ -65,11 +76,17 @@ std::map<std::string, Specimen> read_specimen_table(const std::string& path, con
   const std::string content = common::read_text_file(path, std::size_t{1} << 24);
   CsvLines lines(content);
   char separator = ',';
-  const auto header = read_header(lines, path, &separator);
+  auto header = read_header(lines, path, &separator);
+  while (!header.empty() && (header.back().empty() || header.back() == "\r")) header.pop_back();  // a spreadsheet's trailing separators
   static const std::vector<std::string> known{"file", "length_m", "width_m", "thickness_m", "density_kg_m3"};
+  for (std::size_t c = 0; c < header.size(); ++c)
+    if (header[c].empty()) throw InputError(path, 1, "column " + std::to_string(c + 1), "has no name");
   for (const auto& h : header)
     if (std::find(known.begin(), known.end(), h) == known.end())
       throw InputError(path, 1, common::printable(h, 30), "unknown column (file, length_m, width_m, thickness_m, density_kg_m3)");
+  for (std::size_t c = 1; c < header.size(); ++c)
+    if (std::find(header.begin(), header.begin() + static_cast<long>(c), header[c]) != header.begin() + static_cast<long>(c))
+      throw InputError(path, 1, header[c], "named twice in the header");
   if (std::find(header.begin(), header.end(), "file") == header.end()) throw InputError(path, 1, "file", "no such column: each row names an export");
   std::map<std::string, Specimen> table;
   long row = 1;
@@ -77,6 +94,7 @@ std::map<std::string, Specimen> read_specimen_table(const std::string& path, con
     ++row;
     if (line->empty() || *line == "\r") continue;
     const auto cells = csv_cells(*line, separator);
+    refuse_cells_beyond(cells, header.size(), path, row);
     std::string file;
     Specimen sp = defaults;
     for (std::size_t c = 0; c < header.size(); ++c) {
@@ -130,6 +148,7 @@ TestData import_test(const std::string& path, const ImportOptions& o, ImportOffs
     ++row;
     if (line->empty() || *line == "\r") continue;
     const auto cells = csv_cells(*line, separator);
+    refuse_cells_beyond(cells, header.size(), path, row);
     const auto value = [&](std::size_t col, const ImportColumn& c) {
       if (col >= cells.size()) throw InputError(path, row, c.name, "missing value");
       std::string why;
