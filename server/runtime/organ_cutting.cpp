@@ -71,6 +71,7 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
   out.energy_before_j += kinetic(nodes);
   gps->follow_edit(edit, state.memory);
   out.added_mass_kg = organ.integrator->follow_edit(edit, state);
+  organ.parallel_forces->follow_model();
   const auto child = [&](std::size_t e) {
     const Tet& t = gps->element(e);
     out.energy_after_j += gps->element_energy(state.x, e, t);

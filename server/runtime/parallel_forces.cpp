@@ -12,6 +12,8 @@
 
 #include <sched.h>
 
+#include "viscera/tissue/mesh/locality_order.hpp"
+
 namespace viscera::runtime {
 
 using tissue::ElementPart;
@@ -20,9 +22,22 @@ using tissue::Vec3;
 
 ParallelForces::ParallelForces(const tissue::ForceModel& model, int threads, int chunks) : model_(model), chunks_(static_cast<std::size_t>(chunks)) {
   if (threads < 1 || chunks < threads) throw std::invalid_argument("ParallelForces: needs threads >= 1 and chunks >= threads");
-  buffers_.assign(chunks_ - 1, std::vector<Vec3>(model.node_count()));
   stats_.resize(chunks_);
+  follow_model();
   for (int t = 1; t < threads; ++t) helpers_.emplace_back([this] { helper(); });
+}
+
+void ParallelForces::follow_model() {
+  const std::size_t nodes = model_.node_count();
+  buffers_.assign(chunks_ - 1, std::vector<Vec3>(nodes, Vec3::Zero()));
+  ranges_.assign(chunks_, {0, 0});
+  const auto& mesh = model_.rest_mesh();
+  for (std::size_t c = 1; c < chunks_; ++c) {
+    const auto [first, last] = model_.part_elements(ElementPart{c, chunks_});
+    const auto [lo, hi] = tissue::node_range(mesh, first, last);
+    ranges_[c] = {static_cast<std::size_t>(lo), static_cast<std::size_t>(hi)};
+  }
+  elements_ = model_.element_count();
 }
 
 ParallelForces::~ParallelForces() {
@@ -39,7 +54,7 @@ void ParallelForces::take_chunks(std::uint64_t generation) {
     if (!next_.compare_exchange_weak(v, v + 1, std::memory_order_acq_rel)) continue;
     const std::size_t c = v & 0xffffffffu;
     auto& buffer = buffers_[c - 1];
-    std::fill(buffer.begin(), buffer.end(), Vec3::Zero());
+    std::fill(buffer.begin() + static_cast<long>(ranges_[c].first), buffer.begin() + static_cast<long>(ranges_[c].second), Vec3::Zero());
     stats_[c] = model_.add_forces(x_, buffer, memory_, ElementPart{c, chunks_});
     finished_.fetch_add(1, std::memory_order_acq_rel);
     finished_.notify_one();
@@ -81,8 +96,9 @@ void ParallelForces::helper() {
 ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
   x_ = x;
   memory_ = memory;
-  if (!buffers_.empty() && buffers_[0].size() != f.size())  // the organ was cut: more nodes
-    for (auto& b : buffers_) b.resize(f.size());
+  // A model that grew (a cut the caller did not report) is followed here; one whose elements were
+  // changed in place must be reported (follow_model).
+  if (model_.element_count() != elements_ || (!buffers_.empty() && buffers_[0].size() != f.size())) follow_model();
   finished_.store(0, std::memory_order_relaxed);
   const std::uint64_t g = ++generation_;
   next_.store(g << 32 | 1u, std::memory_order_release);
@@ -102,7 +118,7 @@ ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f
   double worst = stats_[0].max_edge_strain;
   for (std::size_t c = 1; c < chunks_; ++c) {
     const auto& b = buffers_[c - 1];
-    for (std::size_t i = 0; i < f.size(); ++i) f[i] += b[i];
+    for (std::size_t i = ranges_[c].first; i < ranges_[c].second; ++i) f[i] += b[i];
     const double s = stats_[c].max_edge_strain;
     worst = std::isnan(s) || std::isnan(worst) ? std::numeric_limits<double>::quiet_NaN() : std::max(worst, s);
   }

@@ -9,8 +9,12 @@
 
 #include <gtest/gtest.h>
 
+#include "viscera/tissue/cutting/mesh_cutter.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/mesh/locality_order.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/model/model_factory.hpp"
 #include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
@@ -124,4 +128,64 @@ TEST(ParallelForces, AnExplicitRunOnTwoThreadsFollowsTheOneThreadRun) {
   for (std::size_t i = 0; i < a.x.size(); ++i) d = std::max(d, (a.x[i] - b.x[i]).norm());
   EXPECT_GT(sag, 1e-3);
   EXPECT_LT(d, 1e-10 * sag);
+}
+
+// Each chunk's buffer is cleared and added only over the nodes its elements name. A cut changes
+// elements in place and adds elements and nodes: told of it (follow_model), the chunks' forces
+// still add up to the model's forces in one piece; and an ordered mesh gives the same forces as
+// the mesh it renumbers.
+TEST(ParallelForces, FollowACutOfTheModelAndTheLocalityOrder) {
+  const auto mesh = std::make_shared<TetMesh>(ordered_for_locality(make_box_mesh(Vec3(0, 0, 0), Vec3(0.10, 0.02, 0.02), 10, 2, 2)));
+  const Mat6 D = elasticity_matrix(IsotropicElasticity{5e3, 0.45});
+  const ViscoelasticSetup ve = make_viscoelastic(D, ViscoelasticSpec{});
+  GpsOptions o;
+  o.variant = GpsVariant::energy_consistent;
+  o.volume_stiffness_fraction = 0.5;
+  o.mechanisms = ve.gps;
+  GpsModel gps(mesh, {ve.unrelaxed_elasticity}, {}, o);
+  ParallelForces parallel(gps, 2, 4);
+  const auto deformed = [](const std::vector<Vec3>& rest) {
+    std::vector<Vec3> x = rest;
+    for (auto& p : x) p = Vec3(1.03 * p.x(), p.y() + 0.2 * p.x() * p.x(), p.z());
+    return x;
+  };
+  const auto compare = [&](const char* when) {
+    const auto x = deformed(mesh->nodes);
+    std::vector<double> m1(gps.memory_size(), 0.0), m2 = m1;
+    std::vector<Vec3> one(x.size(), Vec3::Zero()), two = one;
+    gps.add_forces(x, one, {m1, m1, 1e-3});
+    parallel(x, two, {m2, m2, 1e-3});
+    EXPECT_LT(max_relative_difference(two, one), 1e-13) << when;
+    EXPECT_EQ(m1, m2) << when;
+  };
+  compare("before the cut");
+  // The order changes nothing but the numbering: the renumbered mesh's forces, mapped back.
+  {
+    Renumbering r;
+    const auto raw = std::make_shared<TetMesh>(make_box_mesh(Vec3(0, 0, 0), Vec3(0.10, 0.02, 0.02), 10, 2, 2));
+    const TetMesh again = ordered_for_locality(*raw, &r);
+    ASSERT_EQ(again.tets, mesh->tets);
+    const GpsModel unordered(raw, {ve.unrelaxed_elasticity}, {}, o);
+    const auto xr = deformed(raw->nodes), xo = deformed(mesh->nodes);
+    std::vector<Vec3> fr(xr.size(), Vec3::Zero()), fo(xo.size(), Vec3::Zero());
+    unordered.add_forces(xr, fr);
+    gps.add_forces(xo, fo);
+    std::vector<Vec3> back(fo.size());
+    for (std::size_t v = 0; v < fo.size(); ++v) back[static_cast<std::size_t>(r.old_node[v])] = fo[v];
+    EXPECT_LT(max_relative_difference(back, fr), 1e-13);
+  }
+  // Two blades into the bar, each followed.
+  MeshCutter cutter(*mesh);
+  std::vector<double> memory(gps.memory_size(), 0.0);
+  for (const double xc : {0.034, 0.071}) {
+    for (int i = 0; i < 6; ++i) {
+      const double za = 0.03 - 0.004 * i, zb = za - 0.004;
+      const std::vector<Vec3> x = mesh->nodes;
+      const CutChange c = cutter.cut({Vec3(xc, -0.01, za), Vec3(xc, 0.03, za), Vec3(xc, -0.01, zb), Vec3(xc, 0.03, zb)}, x, 0);
+      gps.follow_edit(c.edit(), memory);
+      parallel.follow_model();
+    }
+    compare(xc < 0.05 ? "after the first cut" : "after the second cut");
+  }
+  EXPECT_GT(mesh->tet_count(), 240u);  // the blades cut
 }

@@ -380,10 +380,20 @@ ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, cons
   return add_forces(x, f, memory, ElementPart{});
 }
 
-ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const {
-  if (part.count == 0 || part.index >= part.count) throw std::invalid_argument("GpsModel::add_forces: part index outside the part count");
+std::pair<std::size_t, std::size_t> GpsModel::part_blocks(ElementPart part) const {
+  if (part.count == 0 || part.index >= part.count) throw std::invalid_argument("GpsModel: part index outside the part count");
   const std::size_t n = blocks_.size();
-  const std::size_t b0 = n * part.index / part.count, b1 = n * (part.index + 1) / part.count;
+  return {n * part.index / part.count, n * (part.index + 1) / part.count};
+}
+
+std::pair<std::size_t, std::size_t> GpsModel::part_elements(ElementPart part) const {
+  const auto [b0, b1] = part_blocks(part);
+  // A block's padding lanes repeat its first element: within the range.
+  return {std::min(b0 * L, element_count()), std::min(b1 * L, element_count())};
+}
+
+ForceStats GpsModel::add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const {
+  const auto [b0, b1] = part_blocks(part);
   const bool ec = options_.variant == GpsVariant::energy_consistent;
   // Without memory attached (or none to keep): the unrelaxed (instantaneous) response.
   if (memory_size() == 0 || memory.before.size() != memory_size() || memory.after.size() != memory_size()) {

@@ -7,14 +7,17 @@
 // differ from ForceModel::add_forces in one piece only by rounding). One thread takes every chunk
 // itself: the server evaluates in kForceChunks chunks on one thread and on two, so that a session
 // re-simulated on the other number gives the same bits (docs/RECORDING.md); more threads than
-// that take a chunk each. Every chunk beyond the first costs a buffer to clear and to add (on the
-// 12k liver, 8 chunks made the tick 30-45% slower than 2: docs/PERFORMANCE-LOG.md).
+// that take a chunk each. Every chunk beyond the first costs its buffer, cleared and added over
+// the nodes its elements name only: a narrow range of indices once the mesh is in locality order
+// (mesh/locality_order.hpp, as the server orders an organ). More chunks than threads did not pay
+// on the 12k liver, even so (docs/PERFORMANCE-LOG.md).
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
 // calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
 // caller, waiting for a helper's chunk, spins briefly and then sleeps.
 #include <atomic>
 #include <cstdint>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "viscera/tissue/model/force_model.hpp"
@@ -34,6 +37,8 @@ class ParallelForces {
 
   /// f += the model's internal forces at x, memory advanced (as ForceModel::add_forces).
   tissue::ForceStats operator()(std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& memory);
+  /// After the model's mesh changed (a cut): the nodes each chunk writes to, found again.
+  void follow_model();
 
  private:
   void helper();
@@ -45,7 +50,10 @@ class ParallelForces {
   // The evaluation in progress: written by the calling thread before it publishes the generation.
   std::span<const tissue::Vec3> x_;
   tissue::MemoryUpdate memory_;
-  std::vector<std::vector<tissue::Vec3>> buffers_;  // chunks 1 .. chunks-1
+  std::vector<std::vector<tissue::Vec3>> buffers_;  // chunks 1 .. chunks-1, a force per node of the model
+  // The nodes chunk c writes to, [first, second): only those of its buffer are cleared and added.
+  std::vector<std::pair<std::size_t, std::size_t>> ranges_;
+  std::size_t elements_ = 0;  // the model's element count when the ranges were found
   std::vector<tissue::ForceStats> stats_;
   // next_: generation in the high 32 bits, next chunk in the low 32; taken by compare-exchange so
   // a helper still in an old evaluation never takes a chunk of a new one.

@@ -38,6 +38,7 @@ class GpsModel final : public ForceModel {
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory) const override;
   /// Parts are contiguous ranges of blocks (kLanes elements each).
   ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const override;
+  std::pair<std::size_t, std::size_t> part_elements(ElementPart part) const override;
   std::size_t memory_size() const override;
   Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const override;
   /// With first-load softening the tangent depends on each edge's extremes in `memory`.
@@ -101,6 +102,8 @@ class GpsModel final : public ForceModel {
   };
 
  private:
+  /// The blocks [first, last) of a part.
+  std::pair<std::size_t, std::size_t> part_blocks(ElementPart part) const;
   template <bool kEnergyConsistent, bool kVolume, bool kMemory>
   ForceStats add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate* memory, std::size_t first_block,
                              std::size_t end_block) const;

@@ -78,6 +78,10 @@ class ForceModel {
   virtual ForceStats add_forces(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory, ElementPart part) const {
     return part.index == 0 ? add_forces(x, f, memory) : ForceStats{};
   }
+  /// The elements [first, last) whose forces that part computes (it writes only to their nodes).
+  virtual std::pair<std::size_t, std::size_t> part_elements(ElementPart part) const {
+    return part.index == 0 ? std::pair<std::size_t, std::size_t>{0, element_count()} : std::pair<std::size_t, std::size_t>{0, 0};
+  }
   /// Tangent of the forces of a step of dt_s (memory variables make the stiffness depend on dt).
   virtual Mat12 element_tangent(std::span<const Vec3> x, std::size_t e, double dt_s) const {
     (void)dt_s;
