@@ -191,7 +191,7 @@ std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& bud
   }
   organ->mesh = std::make_shared<TetMesh>(read_tet_mesh(scene.mesh));
   for (int k = 0; k < scene.refine; ++k) *organ->mesh = refine_uniform(*organ->mesh);
-  // Tetrahedra along a space-filling curve, nodes in the order they touch them: each chunk of the
+  // Tetrahedra along a space-filling curve, nodes in the order they last touch them: each chunk of the
   // force evaluation then writes to a narrow range of nodes (ParallelForces).
   *organ->mesh = ordered_for_locality(*organ->mesh);
   scale_mesh(*organ->mesh, scene.scale_m_per_unit);

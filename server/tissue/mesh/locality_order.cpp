@@ -63,19 +63,27 @@ TetMesh ordered_for_locality(const TetMesh& mesh, Renumbering* renumbering) {
   std::iota(old_tet.begin(), old_tet.end(), 0);
   std::stable_sort(old_tet.begin(), old_tet.end(),
                    [&](std::int32_t a, std::int32_t b) { return key[static_cast<std::size_t>(a)] < key[static_cast<std::size_t>(b)]; });
-  // Nodes in the order the reordered tetrahedra first name them, then the unnamed ones.
-  std::vector<std::int32_t> new_node(nn, -1), old_node;
-  old_node.reserve(nn);
-  for (const std::int32_t e : old_tet)
-    for (const std::int32_t v : mesh.tets[static_cast<std::size_t>(e)])
-      if (new_node[static_cast<std::size_t>(v)] < 0) {
-        new_node[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(old_node.size());
-        old_node.push_back(v);
+  // Nodes in the order the reordered tetrahedra last name them, then the unnamed ones: walking the
+  // tetrahedra from the end, each node takes the highest number left when first met.
+  std::vector<char> named(nn, 0);
+  for (const Tet& t : mesh.tets)
+    for (const std::int32_t v : t) named[static_cast<std::size_t>(v)] = 1;
+  const auto named_count = static_cast<std::int32_t>(std::count(named.begin(), named.end(), 1));
+  std::vector<std::int32_t> new_node(nn, -1), old_node(nn, -1);
+  std::int32_t next = named_count;
+  for (auto e = old_tet.rbegin(); e != old_tet.rend(); ++e) {
+    const Tet& t = mesh.tets[static_cast<std::size_t>(*e)];
+    for (auto v = t.rbegin(); v != t.rend(); ++v)
+      if (new_node[static_cast<std::size_t>(*v)] < 0) {
+        new_node[static_cast<std::size_t>(*v)] = --next;
+        old_node[static_cast<std::size_t>(next)] = *v;
       }
+  }
+  next = named_count;
   for (std::size_t v = 0; v < nn; ++v)
-    if (new_node[v] < 0) {
-      new_node[v] = static_cast<std::int32_t>(old_node.size());
-      old_node.push_back(static_cast<std::int32_t>(v));
+    if (!named[v]) {
+      new_node[v] = next;
+      old_node[static_cast<std::size_t>(next++)] = static_cast<std::int32_t>(v);
     }
   out.nodes.resize(nn);
   for (std::size_t v = 0; v < nn; ++v) out.nodes[v] = mesh.nodes[static_cast<std::size_t>(old_node[v])];

@@ -8,9 +8,9 @@
 // itself: the server evaluates in kForceChunks chunks on one thread and on two, so that a session
 // re-simulated on the other number gives the same bits (docs/RECORDING.md); more threads than
 // that take a chunk each. Every chunk beyond the first costs its buffer, cleared and added over
-// the nodes its elements name only: a narrow range of indices once the mesh is in locality order
-// (mesh/locality_order.hpp, as the server orders an organ). More chunks than threads did not pay
-// on the 12k liver, even so (docs/PERFORMANCE-LOG.md).
+// the nodes its elements name only: in locality order (mesh/locality_order.hpp, as the server
+// orders an organ) the last chunk's range is exactly its own nodes. More chunks than threads did
+// not pay on the 12k liver, even so (docs/PERFORMANCE-LOG.md).
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
 // calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
 // caller, waiting for a helper's chunk, spins briefly and then sleeps.

@@ -1,8 +1,8 @@
 #pragma once
 // Tetrahedra in the order of a space-filling curve through their centroids, and nodes numbered in
-// the order those tetrahedra first touch them: consecutive elements then share vertices, and the
-// nodes a range of elements touches lie in a narrow range of indices (docs/PERFORMANCE.md,
-// "Locality").
+// the order those tetrahedra last touch them: consecutive elements then share vertices, and the
+// nodes of the elements from any one onwards to the end are exactly the highest-numbered ones (so
+// the last force chunks write to narrow ranges; docs/PERFORMANCE.md, "Locality").
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -19,7 +19,7 @@ struct Renumbering {
 
 /// The same mesh (the same tetrahedra, each with its vertices in the same order, so the same
 /// orientation; the same element sets), renumbered: tetrahedra along a Hilbert curve through
-/// their centroids, nodes in the order the reordered tetrahedra first name them (nodes no
+/// their centroids, nodes in the order the reordered tetrahedra last name them (nodes no
 /// tetrahedron names keep their relative order, after the others). Deterministic.
 TetMesh ordered_for_locality(const TetMesh& mesh, Renumbering* renumbering = nullptr);
 
