@@ -37,7 +37,6 @@ void ParallelForces::follow_model() {
     const auto [lo, hi] = tissue::node_range(mesh, first, last);
     ranges_[c] = {static_cast<std::size_t>(lo), static_cast<std::size_t>(hi)};
   }
-  elements_ = model_.element_count();
 }
 
 ParallelForces::~ParallelForces() {
@@ -96,9 +95,9 @@ void ParallelForces::helper() {
 ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
   x_ = x;
   memory_ = memory;
-  // A model that grew (a cut the caller did not report) is followed here; one whose elements were
-  // changed in place must be reported (follow_model).
-  if (model_.element_count() != elements_ || (!buffers_.empty() && buffers_[0].size() != f.size())) follow_model();
+  // The model's mesh is not read here: a material being built on another thread may share it. A
+  // cut is reported (follow_model); forces for more nodes than the buffers hold follow it too.
+  if (!buffers_.empty() && buffers_[0].size() != f.size()) follow_model();
   finished_.store(0, std::memory_order_relaxed);
   const std::uint64_t g = ++generation_;
   next_.store(g << 32 | 1u, std::memory_order_release);

@@ -53,7 +53,6 @@ class ParallelForces {
   std::vector<std::vector<tissue::Vec3>> buffers_;  // chunks 1 .. chunks-1, a force per node of the model
   // The nodes chunk c writes to, [first, second): only those of its buffer are cleared and added.
   std::vector<std::pair<std::size_t, std::size_t>> ranges_;
-  std::size_t elements_ = 0;  // the model's element count when the ranges were found
   std::vector<tissue::ForceStats> stats_;
   // next_: generation in the high 32 bits, next chunk in the low 32; taken by compare-exchange so
   // a helper still in an old evaluation never takes a chunk of a new one.
