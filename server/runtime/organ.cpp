@@ -208,7 +208,9 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
   auto next = std::make_unique<Organ>();
   next->scene = organ.scene;
   next->material = organ.material;
-  next->mesh = organ.mesh;
+  // Its own copy of the mesh: a cuttable organ reserves room for its cuts in its mesh's vectors
+  // (enable_cutting), which must not move under the live organ's physics thread.
+  next->mesh = std::make_shared<TetMesh>(*organ.mesh);
   next->bounds = organ.bounds;
   next->boundary = organ.boundary;
   next->sources = organ.sources;
