@@ -76,6 +76,15 @@ TEST(LocalityOrder, RenumbersTheSameTetrahedraWithTheirOrientationAndSets) {
     EXPECT_EQ(back, m.element_sets[s].tets);
     EXPECT_TRUE(std::is_sorted(o.element_sets[s].tets.begin(), o.element_sets[s].tets.end()));
   }
+  // No tetrahedra, or every point in one place: nodes kept, nothing divided by a zero extent.
+  TetMesh empty;
+  empty.nodes = {Vec3(1, 2, 3), Vec3(1, 2, 3)};
+  EXPECT_EQ(ordered_for_locality(empty).nodes, empty.nodes);
+  TetMesh flat;
+  flat.nodes.assign(4, Vec3(0.5, 0.5, 0.5));
+  flat.tets = {{0, 1, 2, 3}, {3, 2, 1, 0}};
+  EXPECT_EQ(ordered_for_locality(flat).tet_count(), 2u);
+  EXPECT_EQ(node_range(empty, 0, 0), (std::pair<std::int32_t, std::int32_t>{0, 0}));
   // Deterministic, and an ordered mesh is already in order.
   const TetMesh again = ordered_for_locality(m), twice = ordered_for_locality(o);
   EXPECT_EQ(again.tets, o.tets);
