@@ -9,18 +9,21 @@
 # real-time FIFO priority 50 and 49 (chrt; REALTIME=0 starts them plainly). Prints a markdown
 # table and writes bench/results/station.json.
 # MESH_HZ sets the scene's surface frames per second (default: the scene's, 60).
-# Usage: [RUNS=5] [SCENE=liver-12k] [REALTIME=1] [MESH_HZ=N] bench/station.sh [SECONDS]   (default 60 s)
+# CLIENT_PRIO sets the haptic client's FIFO priority (default 49, one below the server's 50).
+# Usage: [RUNS=5] [SCENE=liver-12k] [REALTIME=1] [MESH_HZ=N] [CLIENT_PRIO=49] bench/station.sh [SECONDS]   (default 60 s)
 set -euo pipefail
-if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"; runs="${RUNS:-5}"; scene="${SCENE:-liver-12k}"
 [[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -ge 10 ] || { echo "station.sh: SECONDS: '$seconds' is not a whole number of at least 10" >&2; exit 2; }
 [[ "$runs" =~ ^[0-9]+$ ]] && [ "$runs" -ge 1 ] || { echo "station.sh: RUNS: '$runs' is not a positive whole number" >&2; exit 2; }
+client_prio="${CLIENT_PRIO:-49}"
+[[ "$client_prio" =~ ^[0-9]+$ ]] && [ "$client_prio" -ge 1 ] && [ "$client_prio" -le 99 ] || { echo "station.sh: CLIENT_PRIO: '$client_prio' is not a FIFO priority (1-99)" >&2; exit 2; }
 [ -f "$root/data/scenes/$scene.json" ] || { echo "station.sh: no scene '$scene' in data/scenes" >&2; exit 2; }
 rt_server=(); rt_client=(); rt_probe=()
 if [ "${REALTIME:-1}" != 0 ]; then
   chrt -f 50 true 2>/dev/null || { echo "station.sh: real-time priority is not allowed here (chrt -f 50 failed); REALTIME=0 runs without it" >&2; exit 2; }
-  rt_server=(chrt -f 50); rt_client=(chrt -f 49); rt_probe=(chrt -f 60)
+  rt_server=(chrt -f 50); rt_client=(chrt -f "$client_prio"); rt_probe=(chrt -f 60)
 fi
 mkdir -p "$root/bench/results"
 "$root/deploy/build.sh" "$root/build" >/dev/null

@@ -15,8 +15,8 @@ def main(path):
             continue
         med[b["run_name"]] = b
     ctx = data["context"]
-    print(f"machine: {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, caches "
-          + ", ".join(f"L{c['level']} {c['size']//1024} KiB" for c in ctx.get("caches", [])))
+    caches = ", ".join(f"L{c['level']} {c['size']//1024} KiB" for c in ctx.get("caches", []))
+    print(f"machine: {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz" + (f", caches {caches}" if caches else ", caches not reported"))
     meshes = ["liver2_1.5k", "liver2_12k", "liver2_96k"]
     models = ["gps", "gps_energy", "corotational", "linear"]
     for kind in ["Force", "Step"]:
