@@ -14,7 +14,7 @@ mkdir -p "$root/bench/results"
 "$root/deploy/build.sh" "$root/build" >/dev/null
 export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 tmp="$(mktemp -d)"; pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 "$root/deploy/dds/make-test-pki.sh" "$tmp/pki" bench > /dev/null
 mkdir -p "$tmp/home/.pki/nssdb"

@@ -18,7 +18,7 @@ mkdir -p "$root/bench/results"
 export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 b="$root/build"
 tmp="$(mktemp -d)"; pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; [ -n "${KEEP:-}" ] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
 domain=$(( (RANDOM % 200) + 1 ))
 mkdir -p "$tmp/scenes" "$tmp/exercises"
 for scene in liver liver-nodule liver-nodule-12k; do

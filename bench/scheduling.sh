@@ -11,7 +11,7 @@ seconds="${1:-20}"; repeat="${REPEAT:-1}"; load="${LOAD:-$(nproc)}"; scene="${SC
 "$root/deploy/build.sh" "$root/build" >/dev/null
 export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 tmp="$(mktemp -d)"; busy=()
-trap 'kill "${busy[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${busy[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 for _ in $(seq "$load"); do (while :; do :; done) & busy+=($!); done
 echo "| start | late ticks | missed slots | ticks | round trip p50 / p99 / max [us] |"
 echo "|---|---|---|---|---|"

@@ -39,7 +39,7 @@ end=$(( $(date +%s) + ${minutes%.*} * 60 + $(python3 -c "print(int(($minutes % 1
 "$build/server/runtime/viscera-server" --scene "$tmp/soak.json" > "$tmp/server.log" 2>&1 &
 server=$!
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; kill -INT "$server" 2>/dev/null; wait 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; kill -INT "$server" 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$tmp"' EXIT
 sleep 3
 kill -0 "$server" 2>/dev/null || { echo "soak.sh: the server did not start:" >&2; cat "$tmp/server.log" >&2; exit 1; }
 hc="$build/tools/haptic-client/haptic-client"

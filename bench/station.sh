@@ -15,7 +15,7 @@ set -euo pipefail
 if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"; runs="${RUNS:-5}"; scene="${SCENE:-liver-12k}"
-[[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -ge 10 ] || { echo "station.sh: SECONDS: '$seconds' is not a whole number of at least 10" >&2; exit 2; }
+[[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -ge 20 ] || { echo "station.sh: SECONDS: '$seconds' is not a whole number of at least 20 (the CPU is read over all but 15 s of it)" >&2; exit 2; }
 [[ "$runs" =~ ^[0-9]+$ ]] && [ "$runs" -ge 1 ] || { echo "station.sh: RUNS: '$runs' is not a positive whole number" >&2; exit 2; }
 client_prio="${CLIENT_PRIO:-49}"
 [[ "$client_prio" =~ ^[0-9]+$ ]] && [ "$client_prio" -ge 1 ] && [ "$client_prio" -le 99 ] || { echo "station.sh: CLIENT_PRIO: '$client_prio' is not a FIFO priority (1-99)" >&2; exit 2; }
@@ -30,7 +30,7 @@ mkdir -p "$root/bench/results"
 export CYCLONEDDS_URI="file://$root/deploy/dds/loopback.xml"
 b="$root/build"
 tmp="$(mktemp -d)"; pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; [ -n "${KEEP:-}" ] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
 openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 wait_for() {  # PATTERN FILE TENTHS
   for _ in $(seq "$3"); do grep -q "$1" "$2" && return 0; sleep 0.1; done

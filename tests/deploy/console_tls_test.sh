@@ -10,7 +10,7 @@ set -u
 build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 console="$build/tools/viscera-console/viscera-console"
 command -v certutil >/dev/null || { echo "FAIL certutil is not installed (deploy/install-deps.sh installs libnss3-tools)"; exit 1; }
 [ -d "$src/tests/node/node_modules/playwright-core" ] || { echo "FAIL playwright-core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }

@@ -17,7 +17,7 @@ build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
 server=; holder=
 recorder=
-trap 'kill $server $holder $recorder 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill $server $holder $recorder 2>/dev/null || true; rm -rf "$tmp"' EXIT
 hc="$build/tools/haptic-client/haptic-client"; ctl="$build/tools/viscera-control/viscera-control"
 rec="$build/tools/viscera-record/viscera-record"; hostile="$build/tests/integration/hostile_publisher"
 

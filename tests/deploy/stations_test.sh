@@ -10,7 +10,7 @@ set -u
 build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 server="$build/server/runtime/viscera-server"; hc="$build/tools/haptic-client/haptic-client"
 for b in 1 2 3; do
   "$server" --scene "$scene" --station "bay-$b" > "$tmp/server-$b.log" 2>&1 &

@@ -14,7 +14,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/console-test/; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/console-test/; rm -rf "$tmp"' EXIT
 console="$build/tools/viscera-console/viscera-console"
 node_dir="$src/tests/node"
 [ -d "$node_dir/node_modules/playwright-core" ] || { echo "FAIL playwright-core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }

@@ -10,7 +10,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 hc="$build/tools/haptic-client/haptic-client"
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 & server=$!; pids+=($server)
 "$build/tools/viscera-record/viscera-record" --out "$tmp/cut.mcap" --domain "$domain" --compression none > "$tmp/rec.log" 2>&1 & recorder=$!; pids+=($recorder)

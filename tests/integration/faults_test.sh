@@ -16,7 +16,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 server=""
-trap 'kill -KILL $server 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill -KILL $server 2>/dev/null || true; rm -rf "$tmp"' EXIT
 bin_server="$build/server/runtime/viscera-server"
 hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"

@@ -7,7 +7,7 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "$server" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
 "$build/tools/viscera-control/viscera-control" health --domain "$domain" --client-id 903 --duration 4.5 > "$tmp/health.log" 2>&1 &

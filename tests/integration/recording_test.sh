@@ -14,7 +14,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/rt2/; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/rt2/; rm -rf "$tmp"' EXIT
 rec="$build/tools/viscera-record/viscera-record"
 replay="$build/tools/viscera-replay/viscera-replay"
 hc="$build/tools/haptic-client/haptic-client"

@@ -10,7 +10,7 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" "$presser" "$watcher" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "$server" "$presser" "$watcher" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 presser=; watcher=
 hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"

@@ -8,7 +8,7 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" "$victim" "$watcher" 2>/dev/null; rm -rf "$tmp"' EXIT
+trap 'kill "$server" "$victim" "$watcher" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 watcher=
 hc="$build/tools/haptic-client/haptic-client"
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
