@@ -19,10 +19,12 @@ bridge="vb$tag"; hosts=(s h r l)  # server, haptic client, recorder, haptic clie
 net="198.18.$(( RANDOM % 250 + 1 ))"
 pids=(); relays=()
 cleanup() {
-  kill "${relays[@]}" 2>/dev/null; wait "${relays[@]}" 2>/dev/null
-  kill "${pids[@]}" 2>/dev/null; wait "${pids[@]}" 2>/dev/null
-  for h in "${hosts[@]}"; do ip netns del "v$tag$h" 2>/dev/null; done
-  ip netns del "$bridge" 2>/dev/null
+  # Each step may fail (a process gone, a namespace never made); under set -e that must not stop
+  # the rest (tests/lint/exit_traps.py).
+  kill "${relays[@]}" 2>/dev/null || true; wait "${relays[@]}" 2>/dev/null || true
+  kill "${pids[@]}" 2>/dev/null || true; wait "${pids[@]}" 2>/dev/null || true
+  for h in "${hosts[@]}"; do ip netns del "v$tag$h" 2>/dev/null || true; done
+  ip netns del "$bridge" 2>/dev/null || true
   rm -rf "$tmp"
 }
 trap cleanup EXIT
