@@ -4,15 +4,16 @@
 # and viscera-console with one page open in headless Chromium. RUNS runs of SECONDS each (the
 # haptic client's time; the measures are taken over it): slots missed (1 ms slots without a tick)
 # and late ticks from the server's per-second lines, the client's pose -> force round trip, and
-# where the two cores went, process by process and the server's threads. Nothing is pinned and
-# nothing polls. The server and the haptic client run as a station deploys them (docs/DEPLOY.md):
+# where the two cores went, process by process and the server's threads; the client's longest wait
+# for a new force, and whether it lost the server or its instrument (and so ended early). Nothing
+# is pinned and nothing polls. The server and the haptic client run as a station deploys them (docs/DEPLOY.md):
 # real-time FIFO priority 50 and 49 (chrt; REALTIME=0 starts them plainly). Prints a markdown
 # table and writes bench/results/station.json.
 # MESH_HZ sets the scene's surface frames per second (default: the scene's, 60).
 # CLIENT_PRIO sets the haptic client's FIFO priority (default 49, one below the server's 50).
 # Usage: [RUNS=5] [SCENE=liver-12k] [REALTIME=1] [MESH_HZ=N] [CLIENT_PRIO=49] bench/station.sh [SECONDS]   (default 60 s)
 set -euo pipefail
-if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"; runs="${RUNS:-5}"; scene="${SCENE:-liver-12k}"
 [[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -ge 20 ] || { echo "station.sh: SECONDS: '$seconds' is not a whole number of at least 20 (the CPU is read over all but 15 s of it)" >&2; exit 2; }
@@ -23,7 +24,7 @@ client_prio="${CLIENT_PRIO:-49}"
 rt_server=(); rt_client=(); rt_probe=()
 if [ "${REALTIME:-1}" != 0 ]; then
   chrt -f 50 true 2>/dev/null || { echo "station.sh: real-time priority is not allowed here (chrt -f 50 failed); REALTIME=0 runs without it" >&2; exit 2; }
-  rt_server=(chrt -f 50); rt_client=(chrt -f "$client_prio"); rt_probe=(chrt -f 60)
+  rt_server=(chrt -f 50); rt_client=(chrt -f "$client_prio"); rt_probe=(chrt -f 1)
 fi
 mkdir -p "$root/bench/results"
 "$root/deploy/build.sh" "$root/build" >/dev/null
@@ -37,8 +38,11 @@ wait_for() {  # PATTERN FILE TENTHS
   echo "station.sh: '$1' never appeared in $2:" >&2; tail -5 "$2" >&2; return 1
 }
 # CPU clock ticks of every thread of the station's processes and of the page's (its Node driver
-# and the Chromium processes under it), read at once by one process: pid tid comm ticks. Above the
-# station's priorities where they are real-time, so that the reading is not held off.
+# and the Chromium processes under it), read at once by one process: pid tid comm ticks. At FIFO 1,
+# below the server and the client, above the rest: at FIFO 60 this reading (a Python process
+# walking /proc, about 0.2 s) stopped the physics and the client twice a run (the client's longest
+# wait for a force, 100-113 ms in every run, ended inside it); at normal priority it was held off
+# for seconds. The clock readings on both sides of it bound the error.
 snapshot() {
   "${rt_probe[@]}" python3 - "$@" <<'PY'
 import os, sys
@@ -137,7 +141,8 @@ for p, t, name, j in (l.split() for l in open(f"{d}/after")):
     if who == "viscera-server": threads[name] = threads.get(name, 0.0) + share
 row = {"seconds": span, "cpu_seconds": c1 - c0, "slots": round(span * 1000), "missed_slots": missed, "missed_pct": 100.0 * missed / (span * 1000), "late_ticks": late,
        "rate_hz_median": sorted(l[1] for l in inside)[len(inside) // 2], "step_p99_us_worst": max(l[3] for l in inside),
-       "round_trip_us": rt, "physics_resets": resets, "page_frames": page["frames"], "page_delay_ms": page["delay_ms"], "drill": score,
+       "round_trip_us": rt, "client_longest_wait_ms": 1e3 * rep.get("longest_silence_s", 0.0),
+       "client_server_lost_t_s": rep["server_lost_t_s"], "client_instrument_lost_t_s": rep["instrument_lost_t_s"], "physics_resets": resets, "page_frames": page["frames"], "page_delay_ms": page["delay_ms"], "drill": score,
        "cpu_pct_of_one_core": procs, "server_threads_pct": threads}
 open(jsonl, "a").write(json.dumps(row) + "\n")
 PY
@@ -150,14 +155,18 @@ json.dump({"date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "machine"
            "realtime": sys.argv[4] != "0", "runs": rows},
           open(sys.argv[2], "w"), indent=1)
 print(f"Station on {sys.argv[3]}, server and client {'at real-time priority' if sys.argv[4] != '0' else 'started plainly'}: {cpu}, {os.cpu_count()} CPUs, {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC\n")
-print("| run | window [s] | missed slots | late ticks | physics [Hz] | step p99 worst [us] | round trip p50 / p99 / max [us] | page frames | drill | CPU: server / client / trainer / record / console / page (Chromium) [% of a core] |")
-print("|---|---|---|---|---|---|---|---|---|---|")
+print("| run | window [s] | missed slots | late ticks | physics [Hz] | step p99 worst [us] | round trip p50 / p99 / max [us] | client's longest wait for a force [ms] | page frames | drill | CPU: server / client / trainer / record / console / page (Chromium) [% of a core] |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
 for i, r in enumerate(rows, 1):
     c = r["cpu_pct_of_one_core"]
     cpu_cells = " / ".join(f"{c.get(k, 0.0):.0f}" for k in ("viscera-server", "haptic-client", "viscera-trainer", "viscera-record", "viscera-console", "page"))
     rt = r["round_trip_us"]
     print(f"| {i} | {r['seconds']:.0f} | {r['missed_slots']} ({r['missed_pct']:.2f}%) | {r['late_ticks']} | {r['rate_hz_median']} | {r['step_p99_us_worst']} | "
-          f"{rt['p50']:.0f} / {rt['p99']:.0f} / {rt['max']:.0f} | {r['page_frames']} | {r['drill']} | {cpu_cells} |")
+          f"{rt['p50']:.0f} / {rt['p99']:.0f} / {rt['max']:.0f} | {r['client_longest_wait_ms']:.1f} | {r['page_frames']} | {r['drill']} | {cpu_cells} |")
+for i, r in enumerate(rows, 1):  # the client ended early: it lost the server (a silence of 0.5 s) or its instrument
+    if r["client_server_lost_t_s"] >= 0 or r["client_instrument_lost_t_s"] >= 0:
+        print(f"run {i}: the haptic client lost " + (f"the server at t = {r['client_server_lost_t_s']:.2f} s" if r["client_server_lost_t_s"] >= 0
+                                                      else f"its instrument at t = {r['client_instrument_lost_t_s']:.2f} s") + " and ended early")
 pct = [r["missed_pct"] for r in rows]
 print(f"\nmissed slots: median {statistics.median(pct):.2f}%, worst {max(pct):.2f}% of {len(rows)} runs (target: at most 0.1% in every run)")
 print("server threads [% of a core], median of the runs: " + ", ".join(

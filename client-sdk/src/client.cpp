@@ -38,7 +38,6 @@ struct Client::Impl {
   }
   proto::TypedReader<proto::Stream::force_feedback> forces;
   proto::TypedReader<proto::Stream::scene_state> scene;
-  std::optional<proto::Scene> last_scene;
   std::set<std::uint32_t> claimed;  // instruments this client claimed (another process may run under its id)
   std::unique_ptr<proto::TypedReader<proto::Stream::surface_topology>> topology;  // created on first use
   std::unique_ptr<proto::TypedReader<proto::Stream::mesh_frame>> frames;
@@ -55,32 +54,75 @@ struct Client::Impl {
     return sessions_settled;
   }
   proto::SurfaceAssembler surfaces;  // whole surfaces from whole ones and patches (schema 16)
-  // The server's liveliness, as its scene-state writer's: set by a DDS listener thread.
+  // The server's presence, from the DDS liveliness of its writers that this client reads: the
+  // scene state (written only on a change) and the forces (1 kHz while an instrument is driven).
+  // A server silent for the lease loses the liveliness of all of them; when it speaks again, DDS
+  // gives it back writer by writer, as each one writes: its forces at once, its scene state only
+  // at the next change. So either one alive means the server is there. Set by DDS listener threads.
+  std::atomic<int> scene_writers{0}, force_writers{0};
   std::atomic<ServerState> server{ServerState::waiting};
   std::atomic<std::int64_t> lost_ns{0};
-  std::atomic<bool> scene_stale{false};  // the server was lost: its last scene state no longer holds
+  std::atomic<bool> server_was_lost{false};  // set on a loss, taken by take_scene()
   std::mutex callback_mutex;
   std::function<void(ServerState)> callback;
   Impl(std::uint32_t domain, const std::string& partition)
       : participant(domain, partition), sessions(participant, proto::Stream::session_request), forces(participant), scene(participant) {
-    scene.raw().on_alive_writers_changed([this](int alive) { liveliness(alive); });
-    liveliness(scene.alive_writers());  // a server discovered before the listener was set
+    scene.raw().on_alive_writers_changed([this](int alive) {
+      scene_writers = alive;
+      liveliness();
+    });
+    forces.raw().on_alive_writers_changed([this](int alive) {
+      force_writers = alive;
+      liveliness();
+    });
+    scene_writers = scene.alive_writers();  // a server discovered before the listeners were set
+    force_writers = forces.alive_writers();
+    liveliness();
   }
-  void liveliness(int alive) {
+  void liveliness() {
     std::lock_guard lock(callback_mutex);
+    const bool alive = scene_writers.load() + force_writers.load() > 0;
     const ServerState before = server.load();
-    const ServerState now = alive > 0 ? ServerState::alive : before == ServerState::waiting ? ServerState::waiting : ServerState::lost;
+    const ServerState now = alive ? ServerState::alive : before == ServerState::waiting ? ServerState::waiting : ServerState::lost;
     if (now == before) return;
     if (now == ServerState::lost) {
       lost_ns = proto::now_ns();
-      scene_stale = true;
+      server_was_lost = true;
     }
     server = now;
     if (callback) callback(now);
   }
+
+  // The newest scene state, and the participant that wrote it. After a loss it is held back until
+  // it is shown to hold: a newer one arrives (a restarted server publishes its own), or a force
+  // arrives from the participant that wrote it (the same server, back from a stall, whose scene
+  // state has not changed and so is not written again).
+  std::optional<proto::Scene> last_scene;
+  std::uint64_t scene_from = 0;
+  bool scene_unconfirmed = false;
+  std::int64_t unconfirmed_since_ns = 0;
+  // The newest force from the server (any client's): its sender and its stamp (the sender's clock).
+  std::uint64_t force_from = 0;
+  std::int64_t force_stamp_ns = 0;
   void take_scene() {
-    if (scene_stale.exchange(false)) last_scene.reset();  // a restarted server publishes its own
-    scene.take([&](proto::Scene s, const proto::Received&) { last_scene = std::move(s); }, rejections);
+    if (server_was_lost.exchange(false)) {
+      scene_unconfirmed = true;
+      unconfirmed_since_ns = lost_ns.load();
+    }
+    scene.take(
+        [&](proto::Scene s, const proto::Received& r) {
+          last_scene = std::move(s);
+          scene_from = r.participant;
+          scene_unconfirmed = false;
+        },
+        rejections);
+    if (scene_unconfirmed && server.load() == ServerState::alive && force_from != 0 && force_from == scene_from &&
+        force_stamp_ns > unconfirmed_since_ns)
+      scene_unconfirmed = false;
+  }
+  const std::optional<proto::Scene>& current_scene() const {
+    static const std::optional<proto::Scene> none;
+    return scene_unconfirmed ? none : last_scene;
   }
 };
 
@@ -92,16 +134,12 @@ std::optional<proto::Scene> Client::wait_for_scene(std::chrono::milliseconds tim
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
     impl_->scene.wait(std::chrono::milliseconds(50));
-    impl_->take_scene();
-    if (impl_->last_scene) return impl_->last_scene;
+    if (const auto& s = fresh_scene()) return s;
   }
   return std::nullopt;
 }
 
-std::optional<proto::Scene> Client::scene() {
-  impl_->take_scene();
-  return impl_->last_scene;
-}
+std::optional<proto::Scene> Client::scene() { return fresh_scene(); }
 
 ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
@@ -112,8 +150,7 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
   bool another_owner_seen = impl_->claimed.count(instrument_id) > 0;
   impl_->command_writer();  // discovered by the server's reader while the claim goes through
   while (std::chrono::steady_clock::now() < end) {
-    impl_->take_scene();
-    if (const auto& s = impl_->last_scene) {
+    if (const auto& s = fresh_scene()) {
       // The scene state lists the instruments and their owners.
       const auto it = std::find_if(s->instruments.begin(), s->instruments.end(), [&](const auto& i) { return i.instrument_id == instrument_id; });
       if (it == s->instruments.end()) {
@@ -158,8 +195,7 @@ bool Client::control(proto::Action action, std::chrono::milliseconds timeout) {
     // A reset shows in no state: it is done once the server acknowledged the request.
     if (action == proto::Action::reset) return impl_->sessions.wait_for_acks(timeout);
     impl_->scene.wait(std::chrono::milliseconds(100));
-    impl_->take_scene();
-    if (impl_->last_scene && impl_->last_scene->paused == (action == proto::Action::pause)) return true;
+    if (const auto& s = fresh_scene(); s && s->paused == (action == proto::Action::pause)) return true;
   } while (std::chrono::steady_clock::now() < end);
   return false;
 }
@@ -174,9 +210,8 @@ std::optional<proto::RequestOutcome> Client::request(proto::SessionRequest r, st
   impl_->sessions.write(client_id_, proto::encode(r));
   while (std::chrono::steady_clock::now() < end) {
     impl_->scene.wait(std::chrono::milliseconds(100));
-    impl_->take_scene();
-    if (impl_->last_scene)
-      for (const auto& o : impl_->last_scene->recent_requests)
+    if (const auto& s = fresh_scene())
+      for (const auto& o : s->recent_requests)
         if (o.client_id == client_id_ && o.request_seq == r.request_seq) return o;
   }
   return std::nullopt;
@@ -238,10 +273,14 @@ void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, do
   impl_->command_writer().write(instrument_id, proto::encode(c));
 }
 
-std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
+void Client::take_forces() {
   const std::int64_t now = proto::now_ns();
   impl_->forces.take(
-      [&](const proto::Force& f, const proto::Received&) {
+      [&](const proto::Force& f, const proto::Received& r) {
+        if (r.stamp_ns >= impl_->force_stamp_ns) {  // any client's force: the server answers
+          impl_->force_from = r.participant;
+          impl_->force_stamp_ns = r.stamp_ns;
+        }
         if (f.client_id != client_id_) return;
         if (f.step_time_ns > 0) {  // published after a tick (the immediate answers carry 0)
           auto& end = tick_end_ns_[f.instrument_id];
@@ -254,9 +293,19 @@ std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
         }
       },
       impl_->rejections);
+}
+
+std::optional<proto::Force> Client::poll_force(std::uint32_t instrument_id) {
+  take_forces();
   const auto it = latest_.find(instrument_id);
   if (it == latest_.end()) return std::nullopt;
   return it->second;
+}
+
+const std::optional<proto::Scene>& Client::fresh_scene() {
+  take_forces();  // a force from the scene state's writer confirms it after a loss
+  impl_->take_scene();
+  return impl_->current_scene();
 }
 
 std::optional<std::int64_t> Client::last_tick_end_ns(std::uint32_t instrument_id) const {

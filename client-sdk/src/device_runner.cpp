@@ -44,6 +44,7 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
   const auto rate_matches = [&](const protocol::Scene& s) { return std::abs(s.physics_rate_hz - o.rate_hz) <= 0.01 * o.rate_hz; };
   bool in_phase_possible = true;
   protocol::Vector3 last_tip{};
+  double last_model_t = -1;  // when the newest model came, while driving (-1: not driving)
   const auto render_only = [&](double t) { device.render(loop.renderer().render(last_tip, t).force, false); };
   for (;;) {
     const double t = std::chrono::duration<double>(clock::now() - start).count();
@@ -56,6 +57,7 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
     }
     const DeviceLoop::Step step = loop.next(t, client.server_state(), scene);
     note(step.note);
+    if (step.action == DeviceLoop::Action::render_only) last_model_t = -1;  // nothing sent: no answer is awaited
     if (step.action == DeviceLoop::Action::end) break;
     if (step.action == DeviceLoop::Action::claim_again) {
       const auto again = client.claim(o.loop.instrument, std::chrono::seconds(5));
@@ -85,6 +87,11 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
         if (const Sent& it = sent[f->command_seq % sent.size()]; it.seq == f->command_seq && it.seq != 0) {
           loop.renderer().update(*f, it.tip, t);
           model_seq = f->command_seq;
+          if (last_model_t >= 0 && t - last_model_t > run.longest_silence_s) {
+            run.longest_silence_s = t - last_model_t;
+            run.longest_silence_end_t_s = t;
+          }
+          last_model_t = t;
         }
       const auto rendered = loop.renderer().render(in.tip_m, t);
       device.render(rendered.force, f->in_contact);

@@ -122,6 +122,12 @@ std::vector<Ownership> InstrumentTable::release_silent(std::int64_t now_ns, std:
   return released;
 }
 
+void InstrumentTable::excuse_stall(std::int64_t stalled_ns) {
+  std::lock_guard lock(mutex_);
+  for (auto& [id, e] : entries_)
+    if (e.owner != 0) e.last_heard_ns += stalled_ns;
+}
+
 std::optional<std::uint32_t> InstrumentTable::owner(std::uint32_t instrument_id) const {
   std::lock_guard lock(mutex_);
   const auto it = entries_.find(instrument_id);

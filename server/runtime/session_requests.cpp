@@ -213,9 +213,16 @@ void SimulationServer::Impl::conclude(const proto::SessionRequest& req, bool acc
 }
 
 /// A client that died or went silent for longer than the lease loses its instrument, which is
-/// released safely (no force on the tissue from it any more).
+/// released safely (no force on the tissue from it any more). Checked every tick; a gap of more
+/// than kServerStall between two checks is the server's own stall (stopped, swapped out, a paused
+/// VM: the commands that came meanwhile wait in its socket, unread), not its clients' silence. A
+/// client that died during it is released one lease after the server runs again.
 void SimulationServer::Impl::release_silent(const Status& status) {
-  const auto released = instruments.release_silent(proto::now_ns(), std::chrono::nanoseconds(proto::kLivelinessLease).count());
+  constexpr std::int64_t kServerStall = 100'000'000;  // [ns]: 100 ticks at 1 kHz, the default tick budget
+  const std::int64_t now = proto::now_ns();
+  if (last_silence_check_ns != 0 && now - last_silence_check_ns > kServerStall) instruments.excuse_stall(now - last_silence_check_ns);
+  last_silence_check_ns = now;
+  const auto released = instruments.release_silent(now, std::chrono::nanoseconds(proto::kLivelinessLease).count());
   for (const auto& o : released) {
     const std::string id = "instrument " + std::to_string(o.instrument_id);
     if (o.handed_back_to != 0) {

@@ -202,6 +202,7 @@ struct SimulationServer::Impl {
   /// A client that died or went silent for longer than the lease loses its instrument, which is
   /// released safely (no force on the tissue from it any more).
   void release_silent(const Status& status);
+  std::int64_t last_silence_check_ns = 0;  // release_silent's previous check (DDS time [ns]; 0: none yet)
 
   // --- One tick (physics thread)
   /// Session requests, a finished build, the lease; then the organ stepped by 1/rate with each

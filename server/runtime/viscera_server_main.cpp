@@ -74,7 +74,9 @@ int main(int argc, char** argv) {
   }
   std::shared_ptr<spdlog::logger> log;
   try {
-    log = viscera::common::program_log("viscera-server", cl.text("log-file"), {scene});
+    // Lines go out on a thread of their own: the physics thread, which reports once a second, never
+    // waits for a slow disk or a full pipe (docs/FAULTS.md, "Output that blocks").
+    log = viscera::common::program_log("viscera-server", cl.text("log-file"), {scene}, viscera::common::LogDelivery::background);
   } catch (const viscera::common::InputError& e) {
     std::fprintf(stderr, "viscera-server: %s\n", e.what());
     return 2;
@@ -102,10 +104,12 @@ int main(int argc, char** argv) {
         stats.ticks, stats.late_ticks, stats.missed_slots, stats.physics_resets, stats.forces_sent, stats.rejected, stats.rejected_malformed,
         stats.rejected_not_owner, stats.rejected_unknown_instrument, stats.rejected_other_participant, stats.mesh_frames, stats.cut_changes,
         stats.cut_energy_rises, stats.cut_energy_change_max_j);
+    if (const std::size_t dropped = viscera::common::log_lines_dropped(); dropped > 0)
+      log->warn("{} log lines were dropped: standard output or the log file did not keep up", dropped);
     server.reset();  // leaves the DDS domain: clients see the server gone at once
     if (viscera::runtime::SimulationServer::abandoned_work() > 0) {
       // An organ still being built in the background is not waited for.
-      log->flush();
+      log.reset();  // writes the queued lines
       std::quick_exit(0);
     }
     return 0;

@@ -4,7 +4,10 @@
 # - The server killed (SIGKILL) and stopped (SIGTERM) under a pressing haptic client and a console
 #   watching its health: each client notices within 0.6 s, exits with status 4, and the haptic
 #   client's rendered force fades to zero without a step.
-# - --reconnect: the client waits, and claims its instrument again from a restarted server.
+# - --reconnect: the client waits, and claims its instrument again from a restarted server, and
+#   from the same server stalled (SIGSTOP) for longer than the liveliness lease; its force returns.
+# - A server whose standard output is a full pipe nobody reads keeps its physics rate, and writes
+#   its lines once the pipe is read; a haptic client's device loop the same.
 # - SIGTERM ends the server within 100 ms with ticks of 40 ms and more, during a background scene
 #   build, and while it is still building its first organ.
 # - A scene folder with an overflowing, a binary and a fractional-rate sibling: listed as
@@ -93,6 +96,85 @@ check "--reconnect: the client waited for a server to come back" "grep -q 'waiti
 check "--reconnect: it claimed its instrument again" "grep -q 'a server is back: instrument 1 claimed again' '$tmp/hc-r.log'"
 check "--reconnect: it ran to the end (rc $rc_client)" "[ $rc_client -eq 0 ]"
 check "--reconnect: the new server saw its commands" "grep -q 'instruments in use, |F|' '$tmp/server-r2.log' && grep -q '1 instruments in use' '$tmp/server-r2.log'"
+
+# --- A server stalled (SIGSTOP) for 0.8 s, longer than the liveliness lease, then going on. ---
+# DDS takes the liveliness of all its writers away; when it speaks again it gives it back writer by
+# writer as each writes: the forces at once, the scene state only at its next change. A --reconnect
+# client must see the same server back (not only a restarted one), claim again and feel its force;
+# the server must not count its own stall as the client's silence and release the instrument.
+start_server "$scene" "$tmp/server-stall.log"
+"$hc" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.02 --duration 9 --quiet --reconnect \
+  --report "$tmp/stall.json" > "$tmp/hc-stall.log" 2>&1 &
+client=$!
+wait_for "$tmp/hc-stall.log" "contact at"
+sleep 2.5
+stopped_at=$(now)
+kill -STOP "$server"; sleep 0.8; kill -CONT "$server"
+wait "$client"; rc_client=$?
+kill -INT "$server"; wait "$server"
+cat "$tmp/hc-stall.log"
+check "stall: the client saw the server gone" "grep -q 'the server is gone' '$tmp/hc-stall.log'"
+check "stall: the same server back, the instrument claimed again" "grep -q 'a server is back: instrument 1 claimed again' '$tmp/hc-stall.log'"
+check "stall: the client ran to the end (rc $rc_client)" "[ $rc_client -eq 0 ]"
+check "stall: the server kept the instrument (its own stall is not the client's silence)" "! grep -q 'released: client 1 silent' '$tmp/server-stall.log'"
+pycheck "$tmp/stall.json" "$stopped_at" <<'PY'
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+stopped = float(sys.argv[2]) - r["start_epoch_s"]
+assert r["server_returns"] == 1, f"server_returns {r['server_returns']}"
+# The client's own measure of the silence: the stall, give or take a period and the scheduler.
+assert 0.75 < r["longest_silence_s"] < 1.2 and stopped < r["longest_silence_end_t_s"] < stopped + 1.5, \
+    f"longest silence {r['longest_silence_s']:.3f} s ending at {r['longest_silence_end_t_s']:.2f} s; stopped at {stopped:.2f} s for 0.8 s"
+norm = lambda v: math.sqrt(sum(c * c for c in v))
+# The press goes 2 cm deep until 4.5 s, then back: deeper after the stall than before it.
+before = [norm(s["rendered_force_n"]) for s in r["samples"] if stopped - 0.3 < s["t_s"] < stopped]
+after = [norm(s["rendered_force_n"]) for s in r["samples"] if stopped + 1.5 < s["t_s"] < stopped + 2.0]
+assert before and min(before) > 0.2, f"no press before the stall: {min(before, default=0):.3f} N"
+assert after and min(after) > max(before), f"the press after the stall: weakest {min(after, default=0):.3f} N, {max(before):.3f} N before"
+print(f"[ figure ] a 0.8 s server stall: the press at {max(before):.2f} N before it, {min(after):.2f}-{max(after):.2f} N 1.5-2 s after it; "
+      f"the client's longest wait for a force {1e3 * r['longest_silence_s']:.0f} ms")
+PY
+
+# --- Standard output that nobody reads (a full pipe): the physics keeps its rate. ---
+# Before the log had a writer thread of its own, the physics thread's once-a-second line (and the
+# first line, before the domain was even joined) waited on the pipe for as long as it stayed full.
+python3 "$src/tests/integration/full_pipe.py" --read-after 6 --interrupt -- "$bin_server" --scene "$scene" \
+  > "$tmp/fullpipe.log" 2> "$tmp/fullpipe-err.log" &
+piped=$!
+"$ctl" health --domain "$domain" --duration 3 > "$tmp/fullpipe-health.log" 2>&1
+wait "$piped"
+python3 - "$tmp/fullpipe-health.log" >> "$tmp/fullpipe.log" <<'PY'
+import re, sys
+if m := re.search(r"^over ([0-9.]+) s: ([0-9]+) ticks", open(sys.argv[1]).read(), re.M):
+    rate = int(m[2]) / float(m[1])
+    print(f"[ figure ] standard output a full pipe: {rate:.0f} ticks per second over {m[1]} s")
+    if rate >= 500:  # before: none at all (the server never joined the domain)
+        print("physics held its rate")
+PY
+cat "$tmp/fullpipe-health.log" "$tmp/fullpipe.log"
+check "full stdout pipe: the physics ran at its rate meanwhile (at least 500 ticks/s)" "grep -q '^physics held its rate' '$tmp/fullpipe.log'"
+check "full stdout pipe: the server stopped cleanly once read" "grep -q '^exit status 0' '$tmp/fullpipe.log'"
+check "full stdout pipe: no line lost (the last says it stopped)" "grep -q 'the last: .*stopped after' '$tmp/fullpipe.log'"
+# The haptic client likewise (a terminal stopped with Ctrl-S blocks the same way): its device loop
+# runs its whole hold while its output waits, and its lines come out once the pipe is read.
+start_server "$scene" "$tmp/server-fullpipe.log"
+python3 "$src/tests/integration/full_pipe.py" --read-after 7 -- "$hc" --domain "$domain" --client-id 3 --instrument 1 --script hold \
+  --force 1.0 --duration 4 --report "$tmp/fullpipe.json" > "$tmp/hc-fullpipe.log" 2>&1  # the hold runs 4 s after its claim
+python3 - "$tmp/fullpipe.json" "$tmp/hc-fullpipe.log" >> "$tmp/hc-fullpipe.log" <<'PY'
+import json, math, re, sys
+rep = json.load(open(sys.argv[1]))
+read_at = float(re.search(r"^read at ([0-9.]+)", open(sys.argv[2]).read(), re.M)[1])
+samples = rep["samples"]
+end = rep["start_epoch_s"] + samples[-1]["t_s"]
+held = min(math.sqrt(sum(c * c for c in s["rendered_force_n"])) for s in samples if s["t_s"] > samples[-1]["t_s"] - 1)
+print(f"{len(samples)} periods over {samples[-1]['t_s']:.2f} s, ended {read_at - end:.2f} s before the pipe was read; hold {held:.2f} N")
+if end < read_at and samples[-1]["t_s"] > 3.5 and held > 0.7:
+    print("the loop ran while its output waited")
+PY
+kill -INT "$server"; wait "$server"
+cat "$tmp/hc-fullpipe.log"
+check "full stdout pipe: the haptic client's loop ran its whole hold meanwhile" "grep -q '^the loop ran while its output waited' '$tmp/hc-fullpipe.log'"
+check "full stdout pipe: the client ended cleanly, its summary out once read" "grep -q '^exit status 0' '$tmp/hc-fullpipe.log' && grep -q 'the last: haptic-client: ' '$tmp/hc-fullpipe.log'"
 
 # --- SIGTERM within 100 ms, whatever the server is doing. ---
 # Ticks of 40 ms and more: the liver at E = 3e8 Pa (about 1,900 sub-steps per tick), allowed by a

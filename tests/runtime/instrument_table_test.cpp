@@ -70,6 +70,20 @@ TEST(InstrumentTable, ASilentOwnerLosesItsInstrumentWhenTheLeaseRunsOut) {
   EXPECT_EQ(t.command(command(1, 11, 2), 901 * kMs), CommandResult::not_owner);
 }
 
+// The server stopped for 800 ms (SIGSTOP, a paused VM): its owners' commands waited unread, so the
+// stall is not their silence. A client that did die meanwhile is released one lease after.
+TEST(InstrumentTable, TheServersOwnStallIsNotItsOwnersSilence) {
+  InstrumentTable t = table();
+  t.claim(1, 11, 0);
+  t.command(command(1, 11, 1), 100 * kMs);  // heard last at 100 ms; the server stalls from 150 to 950 ms
+  t.excuse_stall(800 * kMs);
+  EXPECT_TRUE(t.release_silent(950 * kMs, kLease).empty());
+  EXPECT_TRUE(t.release_silent(1400 * kMs, kLease).empty());  // 100 + 800 + 500 ms: exactly the lease
+  EXPECT_EQ(t.release_silent(1400 * kMs + 1, kLease), (std::vector<Ownership>{{1, 11}}));
+  t.excuse_stall(800 * kMs);  // nobody to excuse: a free instrument stays free
+  EXPECT_EQ(t.owner(1), 0u);
+}
+
 TEST(InstrumentTable, HandOverMovesOwnershipWithNoMomentWithoutAnOwner) {
   InstrumentTable t = table();
   t.claim(1, 11, 0);

@@ -26,11 +26,13 @@
 #include "viscera/protocol/dds.hpp"
 
 #include "palpating_device.hpp"
+#include "say.hpp"
 #include "scripted_device.hpp"
 #include "trajectory_device.hpp"
 
 namespace {
 
+using viscera::haptic::say;
 using viscera::protocol::Vector3;
 
 /// Surface frames as a viewer sees them: how many, how often, how far the surface moved.
@@ -179,10 +181,9 @@ struct RunResult : viscera::client::DeviceRunResult {
 void print_live(const Options& o, viscera::client::Client& client, double t, const Vector3& tip, const viscera::protocol::Force& f,
                 std::size_t frames) {
   const auto rtt = client.round_trip();
-  std::printf("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s\n", t, tip[2], f.force[0], f.force[1],
-              f.force[2], f.in_contact ? "  contact" : "         ", rtt.p50_us, rtt.p99_us,
-              o.watch_mesh ? ("  mesh frames " + std::to_string(frames)).c_str() : "");
-  std::fflush(stdout);
+  say("t = %5.2f s  tip z %.4f m  force (%6.3f, %6.3f, %6.3f) N%s  round trip p50 %.0f us p99 %.0f us%s", t, tip[2], f.force[0], f.force[1],
+      f.force[2], f.in_contact ? "  contact" : "         ", rtt.p50_us, rtt.p99_us,
+      o.watch_mesh ? ("  mesh frames " + std::to_string(frames)).c_str() : "");
 }
 
 /// The SDK's device loop (device_runner.hpp), with this program's live lines, report samples and
@@ -199,10 +200,7 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
   options.tick_phase_us = o.tick_phase_us;
   double last_print = -1;
   viscera::client::DeviceRunHooks hooks;
-  hooks.note = [](const std::string& line) {
-    std::printf("%s\n", line.c_str());
-    std::fflush(stdout);
-  };
+  hooks.note = [](const std::string& line) { say("%s", line.c_str()); };
   hooks.period = [&](const viscera::client::DevicePeriod& p) {
     const auto& f = p.force;
     if (!o.report.empty()) {
@@ -239,6 +237,8 @@ void write_report(const Options& o, const std::string& scene, const std::string&
                    {"instrument_lost_t_s", run.instrument_lost_t_s},
                    {"faded_t_s", run.faded_t_s},
                    {"server_returns", run.server_returns},
+                   {"longest_silence_s", run.longest_silence_s},
+                   {"longest_silence_end_t_s", run.longest_silence_end_t_s},
                    {"samples", to_json(run.samples)}};
   if (o.watch_mesh)
     r["mesh"] = {{"frames", run.mesh.frames},
@@ -311,23 +311,29 @@ int main(int argc, char** argv) {
       return 3;
     }
     const auto device = make_device(o, *scene);
-    std::printf("haptic-client: scene %s, instrument %u claimed; device: %s, %.0f Hz for %.1f s\n", scene->name.c_str(), o.instrument,
-                device->name().c_str(), o.rate_hz, o.duration_s);
-    std::fflush(stdout);
+    viscera::haptic::start_saying();  // from here the device loop runs: it never waits for the output
+    struct StopSaying {
+      ~StopSaying() { viscera::haptic::stop_saying(); }  // the queued lines out before the exit status
+    } stop_saying;
+    say("haptic-client: scene %s, instrument %u claimed; device: %s, %.0f Hz for %.1f s", scene->name.c_str(), o.instrument, device->name().c_str(),
+        o.rate_hz, o.duration_s);
     const double start_epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
     const RunResult run = run_device(o, client, *device, scene->generation);
     if (!run.lost && run.instrument_lost_t_s < 0) client.release(o.instrument);
     const auto rtt = client.round_trip();
-    std::printf(
-        "haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N\n",
+    say("haptic-client: %zu round trips: p50 %.0f us, p99 %.0f us, max %.0f us; %llu payloads rejected; %llu rendered forces clamped to %.1f N",
         rtt.samples, rtt.p50_us, rtt.p99_us, rtt.max_us, static_cast<unsigned long long>(client.rejected()),
         static_cast<unsigned long long>(run.clamps), o.max_force_n);
+    if (run.longest_silence_end_t_s >= 0)
+      say("haptic-client: the longest wait for a new force while driving: %.1f ms, ending at t = %.2f s", 1e3 * run.longest_silence_s,
+          run.longest_silence_end_t_s);
     if (o.watch_mesh)
-      std::printf("haptic-client: %zu surface frames at %.1f Hz; surface generation %u, %zu vertices\n", run.mesh.frames, run.mesh.rate_hz(),
-                  run.mesh.generation, run.mesh.rest.size() / 3);
+      say("haptic-client: %zu surface frames at %.1f Hz; surface generation %u, %zu vertices", run.mesh.frames, run.mesh.rate_hz(),
+          run.mesh.generation, run.mesh.rest.size() / 3);
     if (run.phased > 0)
-      std::printf("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us\n", o.tick_phase_us,
-                  static_cast<unsigned long long>(run.phased), 100.0 * static_cast<double>(run.near_phase) / static_cast<double>(run.phased));
+      say("haptic-client: commands timed %.0f us after the server's ticks in %llu periods, %.1f%% of them within 50 us", o.tick_phase_us,
+          static_cast<unsigned long long>(run.phased), 100.0 * static_cast<double>(run.near_phase) / static_cast<double>(run.phased));
+    viscera::haptic::stop_saying();  // before the lines on standard error
     if (!o.report.empty()) write_report(o, scene->name, device->name(), start_epoch_s, rtt, run);
     if (run.lost) {
       std::fprintf(stderr, "haptic-client: the server went away at t = %.2f s; the force had faded to zero at t = %.2f s\n", run.server_lost_t_s,

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include "say.hpp"
 
 namespace viscera::haptic {
 
@@ -64,9 +65,8 @@ void PalpatingDevice::next_point() {
   }
   if (!refined_) {
     refined_ = true;
-    std::printf("palpate: %zu points 2 cm apart, stiffest at (%.3f, %.3f) m with %.3f N; 1 cm around it next\n", probes_.size(), best->x, best->y,
-                best->force_n);
-    std::fflush(stdout);
+    say("palpate: %zu points 2 cm apart, stiffest at (%.3f, %.3f) m with %.3f N; 1 cm around it next", probes_.size(), best->x, best->y,
+        best->force_n);
     const double bx = best->x, by = best->y;
     add_neighbours(bx, by, kFine);
     return;
@@ -74,9 +74,8 @@ void PalpatingDevice::next_point() {
   if (!marking_) {
     marking_ = true;
     const auto [x, y] = stiff_centre(*best);
-    std::printf("palpate: stiffest of %zu points at (%.3f, %.3f) m with %.3f N; the stiff area's centre at (%.3f, %.3f) m: marking it\n",
-                probes_.size(), best->x, best->y, best->force_n, x, y);
-    std::fflush(stdout);
+    say("palpate: stiffest of %zu points at (%.3f, %.3f) m with %.3f N; the stiff area's centre at (%.3f, %.3f) m: marking it", probes_.size(),
+        best->x, best->y, best->force_n, x, y);
     probes_.push_back({x, y});
     return;
   }
@@ -151,12 +150,11 @@ void PalpatingDevice::press(Probe& p, double t, double dt) {
     // and the point is left out.
     p.force_n = p.settled && p.half_vertical ? p.half_force_n : -1.0;
     if (verbose_) {
-      std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.1f mm, stopped at %.3f N before %.0f mm%s\n", p.x, p.y, contact_z_,
-                  p.half_force_n, 1e3 * std::min(contact_z_ - z_, 0.5 * depth_), magnitude(force_), 1000 * depth_,
-                  !p.settled      ? " (before half way: left out)"
-                  : p.force_n < 0 ? " (steep: left out)"
-                                  : "");
-      std::fflush(stdout);
+      say("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.1f mm, stopped at %.3f N before %.0f mm%s", p.x, p.y, contact_z_, p.half_force_n,
+          1e3 * std::min(contact_z_ - z_, 0.5 * depth_), magnitude(force_), 1000 * depth_,
+          !p.settled      ? " (before half way: left out)"
+          : p.force_n < 0 ? " (steep: left out)"
+                          : "");
     }
     phase_ = Phase::lift;
     return;
@@ -202,9 +200,8 @@ void PalpatingDevice::hold(Probe& p, double t) {
   // sideways off a stiff spot and the force stops growing.
   p.force_n = p.half_vertical ? p.half_force_n + F : -1.0;
   if (verbose_ && !mark) {
-    std::printf("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s\n", p.x, p.y, contact_z_, p.half_force_n,
-                500 * depth_, F, 1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
-    std::fflush(stdout);
+    say("palpate: (%.3f, %.3f) m, contact at z %.4f m: %.3f N at %.0f mm, %.3f N at %.0f mm%s", p.x, p.y, contact_z_, p.half_force_n, 500 * depth_, F,
+        1000 * depth_, p.force_n < 0 ? " (steep: left out)" : "");
   }
   buttons_ = 0;
   phase_ = Phase::lift;

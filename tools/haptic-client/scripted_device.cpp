@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include "say.hpp"
 
 namespace viscera::haptic {
 
@@ -73,8 +74,7 @@ void ScriptedDevice::render(const protocol::Vector3& force_n, bool in_contact) {
   if (std::isnan(contact_z_) && in_contact) {
     contact_z_ = z_;
     contact_t_ = t_;
-    std::printf("t = %5.2f s  contact at tip z %.4f m\n", t_, z_);
-    std::fflush(stdout);
+    say("t = %5.2f s  contact at tip z %.4f m", t_, z_);
   }
 }
 

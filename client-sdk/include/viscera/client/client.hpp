@@ -18,8 +18,9 @@
 
 namespace viscera::client {
 
-/// Whether a server is there: none seen yet; its writers alive; or gone (stopped, killed, or its
-/// host cut off: its DDS liveliness lease of 500 ms ran out, or it left the domain).
+/// Whether a server is there: none seen yet; its writers alive; or gone (stopped, killed, stalled,
+/// or its host cut off: its DDS liveliness lease of 500 ms ran out, or it left the domain). A
+/// stalled server that speaks again is alive again.
 enum class ServerState { waiting, alive, lost };
 const char* to_string(ServerState s);
 
@@ -123,7 +124,9 @@ class Client {
   /// acknowledgements, so a client that exits right after still delivers it.
   void annotate(const std::string& text);
   std::uint32_t id() const { return client_id_; }
-  /// Whether the server is there (from the DDS liveliness of its scene-state writer).
+  /// Whether the server is there: the DDS liveliness of its writers this client reads (the scene
+  /// state and the forces). A server silent for the lease (500 ms) is lost; when it speaks again
+  /// it is alive again, and its last scene state holds once a force of its own confirms it.
   ServerState server_state() const;
   /// When the server was last seen going (now_ns clock), if it was.
   std::optional<std::int64_t> server_lost_ns() const;
@@ -139,6 +142,10 @@ class Client {
   std::unique_ptr<Impl> impl_;
   std::uint32_t client_id_;
   std::optional<protocol::RequestOutcome> request(protocol::SessionRequest r, std::chrono::milliseconds timeout);
+  /// Takes the forces that arrived (every client's: each one is a sign of the server).
+  void take_forces();
+  /// The newest scene state that is known to hold (none after a loss until it is confirmed).
+  const std::optional<protocol::Scene>& fresh_scene();
 
   std::uint64_t seq_ = 0, mesh_frames_ = 0;
   std::uint64_t request_seq_ = 0;  // starts at the clock: a restarted client never matches its old outcomes

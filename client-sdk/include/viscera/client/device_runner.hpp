@@ -44,6 +44,10 @@ struct DeviceRunResult {
   double server_lost_t_s = -1, faded_t_s = -1, instrument_lost_t_s = -1;
   int server_returns = 0, taken_over = 0;
   bool lost = false;  ///< ended because the server was gone
+  /// The longest time without a new model while the loop sent commands [s] (a server that was
+  /// gone and came back included), and when it ended (-1: none): a server or network that fell
+  /// silent (the liveliness lease runs out at 0.5 s).
+  double longest_silence_s = 0, longest_silence_end_t_s = -1;
 };
 
 /// Runs the loop; `generation` is that of the scene in which the instrument was claimed.

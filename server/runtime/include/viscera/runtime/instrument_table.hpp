@@ -68,6 +68,9 @@ class InstrumentTable {
   /// instruments; returns them. An instrument a silent owner had taken over goes back to the client
   /// it was taken from (whose lease starts again), as a hand-back would; any other is freed.
   std::vector<Ownership> release_silent(std::int64_t now_ns, std::int64_t lease_ns);
+  /// The server itself did not run for `stalled_ns` (stopped, swapped out, a paused VM): its
+  /// owners could not be heard meanwhile, so that time is not counted as their silence.
+  void excuse_stall(std::int64_t stalled_ns);
 
   /// The owner (0: none), or nullopt for an instrument the scene does not have.
   std::optional<std::uint32_t> owner(std::uint32_t instrument_id) const;
