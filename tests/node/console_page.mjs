@@ -109,6 +109,9 @@ try {
   const back = await until(page, () => !window.viscera.held.includes(1), null, 10000);
   const ownerAfter = owner(ctl('show'));
   check('Hand back returns it to the trainee', back && ownerAfter === trainee, `owner after: ${ownerAfter}`);
+  // The events come on their own stream: the hand-back's may reach the page after the scene state
+  // that viscera-control read (CI, the server at 700 Hz under the parallel tests, saw only the first).
+  await until(page, (n) => window.viscera.events.slice(n).some((e) => e.instrument_id === 1 && /handed back to client/.test(e.text)), eventsAtTakeover, 5000);
   const handover = await page.evaluate((n) => window.viscera.events.slice(n).filter((e) => e.instrument_id === 1 && /instrument_/.test(e.kind)).map((e) => `${e.kind} client ${e.client_id}: ${e.text}`), eventsAtTakeover);
   check('no moment without an owner: claims with names, no release in between',
         handover.length === 2 && handover.every((e) => e.startsWith('instrument_claimed')) && /taken over from client 1/.test(handover[0]) && /handed back to client 1/.test(handover[1]),
