@@ -131,6 +131,10 @@ rt = rep["round_trip_us"]
 page = json.load(open(f"{d}/page.json")) if open(f"{d}/page.json").read().strip() else {"frames": 0, "delay_ms": {"p50": None, "p99": None}}
 trainer_out = open(f"{d}/trainer.log").read()
 score = {"0": "passed", "1": "failed"}.get(open(f"{d}/drill").read().strip(), "no score")
+try:
+    report = json.load(open(f"{d}/report/force-drill.json"))
+except (OSError, ValueError):
+    report = {"failures": [], "metrics": {}}
 start = {(p, t): int(j) for p, t, _, j in (l.split() for l in open(f"{d}/before"))}
 procs, threads = {}, {}
 for p, t, name, j in (l.split() for l in open(f"{d}/after")):
@@ -143,6 +147,7 @@ row = {"seconds": span, "cpu_seconds": c1 - c0, "slots": round(span * 1000), "mi
        "rate_hz_median": sorted(l[1] for l in inside)[len(inside) // 2], "step_p99_us_worst": max(l[3] for l in inside),
        "round_trip_us": rt, "client_longest_wait_ms": 1e3 * rep.get("longest_silence_s", 0.0),
        "client_server_lost_t_s": rep["server_lost_t_s"], "client_instrument_lost_t_s": rep["instrument_lost_t_s"], "physics_resets": resets, "page_frames": page["frames"], "page_delay_ms": page["delay_ms"], "drill": score,
+       "drill_failures": report["failures"], "drill_tip_strain": report["metrics"].get("max_tip_strain"), "drill_edge_strain": report["metrics"].get("max_edge_strain"),
        "cpu_pct_of_one_core": procs, "server_threads_pct": threads}
 open(jsonl, "a").write(json.dumps(row) + "\n")
 PY
@@ -167,6 +172,9 @@ for i, r in enumerate(rows, 1):  # the client ended early: it lost the server (a
     if r["client_server_lost_t_s"] >= 0 or r["client_instrument_lost_t_s"] >= 0:
         print(f"run {i}: the haptic client lost " + (f"the server at t = {r['client_server_lost_t_s']:.2f} s" if r["client_server_lost_t_s"] >= 0
                                                       else f"its instrument at t = {r['client_instrument_lost_t_s']:.2f} s") + " and ended early")
+for i, r in enumerate(rows, 1):  # why the drill failed (the scripted client's hold, not the station's timing, as a rule)
+    if r.get("drill_failures"):
+        print(f"run {i}: the drill failed: " + "; ".join(r["drill_failures"]))
 pct = [r["missed_pct"] for r in rows]
 print(f"\nmissed slots: median {statistics.median(pct):.2f}%, worst {max(pct):.2f}% of {len(rows)} runs (target: at most 0.1% in every run)")
 print("server threads [% of a core], median of the runs: " + ", ".join(

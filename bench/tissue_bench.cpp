@@ -1,12 +1,14 @@
 // Force evaluation and a full explicit step for liver2 at three refinement levels, for every model,
 // in one run; plus the machine's streaming read bandwidth for the same working-set sizes, so the
 // distance to the memory limit is visible (docs/PERFORMANCE.md). Run: bench/run.sh
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <numeric>
 
 #include <benchmark/benchmark.h>
 
+#include "viscera/tissue/element/ball_strain.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
@@ -98,6 +100,25 @@ void step(benchmark::State& st, const std::string& model_name, const Level* leve
   st.counters["dt_s"] = integrator.dt_s();
 }
 
+// The strain at an instrument (the server computes it after every tick for each instrument in
+// contact): averaged over the scene's default 2 cm about the organ's highest node, on the deformed
+// configuration.
+void tip_strain(benchmark::State& st, const Level* level) {
+  const BallStrain ball(level->mesh, 0.02);
+  const auto x = deformed(*level->mesh);
+  const auto& nodes = level->mesh->nodes;
+  const Vec3 top = *std::max_element(nodes.begin(), nodes.end(), [](const Vec3& a, const Vec3& b) { return a.z() < b.z(); });
+  std::size_t elements = 0;
+  for (auto _ : st) {
+    const auto r = ball.at(x, top);
+    elements = r.elements;
+    benchmark::DoNotOptimize(r.strain);
+  }
+  st.counters["elements"] = static_cast<double>(elements);
+  st.counters["ns_per_element"] = benchmark::Counter(static_cast<double>(elements) * static_cast<double>(st.iterations()),
+                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // Streaming read of `bytes` (a sum over doubles): the bandwidth a force loop can reach when its
 // per-element data have that size.
 void read_bandwidth(benchmark::State& st, std::size_t bytes) {
@@ -125,6 +146,7 @@ int main(int argc, char** argv) {
       benchmark::RegisterBenchmark(("Force/" + m + "/" + level.name).c_str(), force, m, &level)->Unit(benchmark::kMicrosecond);
     for (const std::string m : {"gps", "gps_energy", "corotational", "linear", "gps_visco3", "scene"})
       benchmark::RegisterBenchmark(("Step/" + m + "/" + level.name).c_str(), step, m, &level)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("TipStrain/" + level.name).c_str(), tip_strain, &level)->Unit(benchmark::kMicrosecond);
   }
   for (const auto& [name, bytes] : std::vector<std::pair<std::string, std::size_t>>{
            {"liver2_1.5k", 1493 * 280}, {"liver2_12k", 11944 * 280}, {"liver2_96k", 95552 * 280}, {"256MiB", 256u << 20}})

@@ -96,6 +96,7 @@ void row_of(Row& r, const protocol::Force& f) {
   r.put("max_edge_strain", f.max_edge_strain);
   r.put("cutting", f.cutting);
   r.put("cut_edge_strain", f.cut_edge_strain);
+  r.put("tip_strain", f.tip_strain);
 }
 
 void row_of(Row& r, const protocol::SessionRequest& q) {

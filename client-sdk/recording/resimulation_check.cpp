@@ -25,8 +25,9 @@ bool same_bits(const Range& a, const Range& b) {
 }
 
 /// The first field of two forces that differs, or nullopt: (name, recorded, recomputed).
-std::optional<std::tuple<std::string, std::string, std::string>> force_difference(const ExpectedForce& e, const proto::Force& f, bool compare_strain,
-                                                                                  bool compare_cutting) {
+std::optional<std::tuple<std::string, std::string, std::string>> force_difference(const ExpectedForce& e, const proto::Force& f,
+                                                                                  const LockstepPlan& plan) {
+  const bool compare_strain = plan.strain_recorded, compare_cutting = plan.cutting_recorded;
   if (e.in_contact != f.in_contact) return std::make_tuple("in_contact", e.in_contact ? "true" : "false", f.in_contact ? "true" : "false");
   if (compare_cutting && e.cutting != f.cutting) return std::make_tuple("cutting", e.cutting ? "true" : "false", f.cutting ? "true" : "false");
   if (compare_cutting && !same_bits(e.cut_edge_strain, f.cut_edge_strain))
@@ -46,6 +47,8 @@ std::optional<std::tuple<std::string, std::string, std::string>> force_differenc
     return std::make_tuple("penetration_m", exact_number(e.penetration_m), exact_number(f.penetration_m));
   if (compare_strain && !same_bits(e.max_edge_strain, f.max_edge_strain))
     return std::make_tuple("max_edge_strain", exact_number(e.max_edge_strain), exact_number(f.max_edge_strain));
+  if (plan.tip_strain_recorded && !same_bits(e.tip_strain, f.tip_strain))
+    return std::make_tuple("tip_strain", exact_number(e.tip_strain), exact_number(f.tip_strain));
   return std::nullopt;
 }
 
@@ -84,7 +87,7 @@ void ResimulationCheck::check_forces(const proto::LockstepResult& r) {
         continue;
       }
       ++matched;
-      if (const auto d = force_difference(e, it->second, plan_.strain_recorded, plan_.cutting_recorded)) {
+      if (const auto d = force_difference(e, it->second, plan_)) {
         diverged({r.tick, "force_feedback", describe(e.instrument_id, e.command_seq, e.stepped), std::get<0>(*d), std::get<1>(*d), std::get<2>(*d)});
       } else {
         ++counts_.forces_identical;

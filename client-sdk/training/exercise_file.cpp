@@ -47,9 +47,13 @@ Exercise read(const nlohmann::json& j, const std::string& source) {
   e.time_limit_s = top.number("time_limit_s", 1, 3600, 120);
   if (top.has("limits")) {
     const JsonObject l = top.object("limits");
-    l.require_known({"peak_force_n", "edge_strain"});
+    l.require_known({"peak_force_n", "edge_strain", "tip_strain"});
     e.peak_force_limit_n = l.number("peak_force_n", 0.01, 100, e.peak_force_limit_n);
-    e.edge_strain_limit = l.number("edge_strain", 0.001, 5, e.edge_strain_limit);
+    // A file that sets one strain limit is scored on that one; one that sets none, on the strain
+    // at the instrument.
+    if (l.has("edge_strain") || l.has("tip_strain")) e.tip_strain_limit.reset();
+    if (l.has("edge_strain")) e.edge_strain_limit = l.number("edge_strain", 0.001, 5, 0.5);
+    if (l.has("tip_strain")) e.tip_strain_limit = l.number("tip_strain", 0.001, 5, 0.4);
   }
   // The kind's own block, and no other kind's.
   for (const char* other : {"palpation", "retraction", "force_drill", "incision"})

@@ -159,6 +159,8 @@ void ExerciseScorer::process_force(const proto::Force& f, const std::optional<pr
   ++r_.samples;
   r_.peak_force_n = std::max(r_.peak_force_n, F);
   r_.max_edge_strain = std::max(r_.max_edge_strain, f.max_edge_strain);
+  r_.max_tip_strain = std::max(r_.max_tip_strain, f.tip_strain);
+  tip_strain_samples_ += f.in_contact && f.tip_strain > 0;
   r_.incision_cut_strain = std::max(r_.incision_cut_strain, f.cut_edge_strain);
   if (f.in_contact) {
     contact_force_sum_ += F;
@@ -172,9 +174,13 @@ void ExerciseScorer::process_force(const proto::Force& f, const std::optional<pr
     if (!warned_force_) say(format("force %.2f N above the safe limit of %.2f N", F, exercise_.peak_force_limit_n));
     warned_force_ = true;
   }
-  if (f.max_edge_strain > exercise_.edge_strain_limit && !warned_strain_) {
-    say(format("tissue strain %.2f above the safe limit of %.2f", f.max_edge_strain, exercise_.edge_strain_limit));
+  if (exercise_.edge_strain_limit && f.max_edge_strain > *exercise_.edge_strain_limit && !warned_strain_) {
+    say(format("largest edge strain %.2f above the safe limit of %.2f", f.max_edge_strain, *exercise_.edge_strain_limit));
     warned_strain_ = true;
+  }
+  if (exercise_.tip_strain_limit && f.tip_strain > *exercise_.tip_strain_limit && !warned_tip_strain_) {
+    say(format("tissue strain at the instrument %.2f above the safe limit of %.2f", f.tip_strain, *exercise_.tip_strain_limit));
+    warned_tip_strain_ = true;
   }
   if (has_tip) walk_commands(*c, f);
   if (ended_) return;
@@ -331,8 +337,9 @@ ScoreReport ExerciseScorer::report() const {
       add("length error", dl, exercise_.length_tolerance_m, "m", dl <= exercise_.length_tolerance_m,
           format("%.1f mm long, %.1f mm asked", 1e3 * *r.incision_length_m, 1e3 * target) +
               format(" (within %.1f mm)", 1e3 * exercise_.length_tolerance_m));
-      add("strain at the cut", r.incision_cut_strain, exercise_.edge_strain_limit, "", r.incision_cut_strain <= exercise_.edge_strain_limit,
-          format("the tissue was torn where the blade cut: strain %.3f there (at most %.3f)", r.incision_cut_strain, exercise_.edge_strain_limit));
+      const double cut_limit = exercise_.cut_strain_limit();
+      add("strain at the cut", r.incision_cut_strain, cut_limit, "", r.incision_cut_strain <= cut_limit,
+          format("the tissue was torn where the blade cut: strain %.3f there (at most %.3f)", r.incision_cut_strain, cut_limit));
     }
   }
   if (exercise_.kind == ExerciseKind::retraction)
@@ -348,8 +355,18 @@ ScoreReport ExerciseScorer::report() const {
   add("peak force", r.peak_force_n, exercise_.peak_force_limit_n, "N", r.peak_force_n <= exercise_.peak_force_limit_n,
       format("too much force: %.2f N at the peak (at most %.2f N); %.2f s above the limit", r.peak_force_n, exercise_.peak_force_limit_n,
              r.time_above_force_limit_s));
-  add("tissue strain", r.max_edge_strain, exercise_.edge_strain_limit, "", r.max_edge_strain <= exercise_.edge_strain_limit,
-      format("the tissue was strained too far: %.3f at the most (at most %.3f)", r.max_edge_strain, exercise_.edge_strain_limit));
+  if (const auto limit = exercise_.tip_strain_limit) {
+    // Forces in contact that all carry 0 come from a server that does not measure it: not a pass.
+    if (contact_samples_ > 0 && tip_strain_samples_ == 0)
+      add("strain at the instrument", 0, *limit, "", false,
+          "the strain at the instrument was not measured: no force in contact carried it (a server older than protocol schema 18)");
+    else
+      add("strain at the instrument", r.max_tip_strain, *limit, "", r.max_tip_strain <= *limit,
+          format("the tissue was strained too far at the instrument: %.3f at the most (at most %.3f)", r.max_tip_strain, *limit));
+  }
+  if (const auto limit = exercise_.edge_strain_limit)
+    add("largest edge strain", r.max_edge_strain, *limit, "", r.max_edge_strain <= *limit,
+        format("the tissue was strained too far: largest edge strain %.3f (at most %.3f)", r.max_edge_strain, *limit));
   add("time", r.time_s, exercise_.time_limit_s, "s", r.completed && r.time_s <= exercise_.time_limit_s,
       r.completed ? format("too slow: %.1f s (at most %.0f s)", r.time_s, exercise_.time_limit_s) : "not completed: " + r.ending);
   r.passed = r.failures.empty();

@@ -35,6 +35,7 @@ nlohmann::json to_json(const ScoreReport& r) {
             {"mean_contact_force_n", r.mean_contact_force_n},
             {"time_above_force_limit_s", r.time_above_force_limit_s},
             {"max_edge_strain", r.max_edge_strain},
+            {"max_tip_strain", r.max_tip_strain},
             {"longest_hold_s", r.longest_hold_s},
             {"drops", r.drops},
             {"mark_m", point(r.mark_m)},
@@ -67,9 +68,10 @@ std::string to_markdown(const ScoreReport& r) {
     s += b;
   }
   std::snprintf(b, sizeof b,
-                "\nPath length %.3f m; peak force %.2f N, mean force in contact %.2f N, %.2f s above the force limit; largest tissue strain "
-                "%.3f; longest hold %.1f s.\n",
-                r.path_length_m, r.peak_force_n, r.mean_contact_force_n, r.time_above_force_limit_s, r.max_edge_strain, r.longest_hold_s);
+                "\nPath length %.3f m; peak force %.2f N, mean force in contact %.2f N, %.2f s above the force limit; largest strain at the "
+                "instrument %.3f, largest edge strain %.3f; longest hold %.1f s.\n",
+                r.path_length_m, r.peak_force_n, r.mean_contact_force_n, r.time_above_force_limit_s, r.max_tip_strain, r.max_edge_strain,
+                r.longest_hold_s);
   s += b;
   if (r.incision_length_m) {
     std::snprintf(b, sizeof b,

@@ -51,8 +51,9 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const auto& k = f.stiffness;
   const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
-  return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force,
-                                           &torque, model, f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting, f.cut_edge_strain));
+  return finish(
+      b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force, &torque, model,
+                                 f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting, f.cut_edge_strain, f.tip_strain));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -185,6 +186,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   f.max_edge_strain = m->max_edge_strain();
   f.cutting = m->cutting();
   f.cut_edge_strain = m->cut_edge_strain();
+  f.tip_strain = m->tip_strain();
   if (const auto* lm = m->local_model()) {
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());
@@ -193,7 +195,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   }
   if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point) || !std::isfinite(f.penetration_m) ||
       std::abs(f.penetration_m) > kMaxPositionM || !(f.max_edge_strain >= 0 && f.max_edge_strain <= kMaxEdgeStrain) ||
-      !(f.cut_edge_strain >= 0 && f.cut_edge_strain <= kMaxEdgeStrain)) {
+      !(f.cut_edge_strain >= 0 && f.cut_edge_strain <= kMaxEdgeStrain) || !(f.tip_strain >= 0 && f.tip_strain <= kMaxEdgeStrain)) {
     *why = "force, torque, contact point, penetration or edge strain not finite or out of range";
     return std::nullopt;
   }

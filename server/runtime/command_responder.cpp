@@ -1,5 +1,8 @@
 #include "viscera/runtime/command_responder.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Geometry>
 
 namespace viscera::runtime {
@@ -44,6 +47,8 @@ protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, 
   f.stiffness = stiffness;
   f.penetration_m = r.depth_m;
   f.cutting = r.cutting;
+  // At most what a decoder accepts (an average of stretches beyond 10 is an organ past saving).
+  f.tip_strain = std::isfinite(r.tip_strain) ? std::min(r.tip_strain, 10.0) : 10.0;
   return f;
 }
 
@@ -83,6 +88,8 @@ ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protoc
     const Eigen::Quaterniond q = Eigen::Quaterniond(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]).normalized();
     add_grasp(result, g->second.query(tip, q, snap->x));
   }
+  // The strain the last tick left at the instrument, while the commanded pose still touches.
+  if (const auto s = snap->tip_strain.find(instrument_id); result.in_contact && s != snap->tip_strain.end()) result.tip_strain = s->second;
   return result;
 }
 

@@ -99,6 +99,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   // it is done, so a scalpel cuts from the first tick, live and re-simulated alike.
   if (organ.cutter) organ.compliance->wait_settled();
   organ.contact_surface = make_contact_surface(organ.boundary.triangles, organ.mesh->nodes);
+  organ.strain = std::make_unique<BallStrain>(organ.mesh, organ.scene.strain_radius_m);
 }
 
 }  // namespace

@@ -72,6 +72,7 @@ SweepOutcome cut_organ(Organ& organ, const BladeSweep& sweep, State& state, std:
   gps->follow_edit(edit, state.memory);
   out.added_mass_kg = organ.integrator->follow_edit(edit, state);
   organ.parallel_forces->follow_model();
+  organ.strain->follow_edit(edit);
   const auto child = [&](std::size_t e) {
     const Tet& t = gps->element(e);
     out.energy_after_j += gps->element_energy(state.x, e, t);

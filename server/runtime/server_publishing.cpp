@@ -70,6 +70,7 @@ void SimulationServer::Impl::publish_snapshot(std::uint64_t tick) {
   for (const auto& [id, t] : tools) {
     if (!t.tool.held().empty()) snap->grasped[id] = t.tool.held();
     if (t.tool.pressed_through()) snap->pressed_through.insert(id);
+    if (t.result.in_contact) snap->tip_strain[id] = t.result.tip_strain;
   }
   responder.publish(std::move(snap));
 }

@@ -124,6 +124,25 @@ void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEv
   }
 }
 
+/// After the step: the tissue's strain about each instrument that touches it, averaged over the
+/// scene's strain radius around the point it touches in the rest shape (the deepest contact's, or
+/// the grasped nodes' mean), over 20 ms windows (TipStrainWindow).
+void SimulationServer::Impl::measure_tip_strain() {
+  const auto& rest = organ->mesh->nodes;
+  const std::size_t window = tip_strain_window_ticks(scene.physics_rate_hz);
+  for (auto& [id, t] : tools) {
+    ContactResult& r = t.result;
+    std::optional<Vec3> at;
+    if (r.in_contact && r.deepest_triangle[0] >= 0) {
+      at = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) *at += r.deepest_weights[k] * rest[static_cast<std::size_t>(r.deepest_triangle[static_cast<std::size_t>(k)])];
+    } else if (r.in_contact && !t.tool.held().empty()) {
+      at = t.tool.held().mean_of(rest);
+    }
+    r.tip_strain = t.tip_strain.after_tick(*organ->strain, state.x, at, window);
+  }
+}
+
 /// The boundary surface with its vertices numbered in the order of boundary.nodes.
 proto::SurfaceTopology SimulationServer::Impl::surface_topology(const BoundarySurface& boundary) const {
   return whole_surface(generation, organ->topology_generation, scene.name, *organ->mesh, boundary);
@@ -156,6 +175,7 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
       organ->integrator->advance(state, dt);
       sim_time_s += dt;
       cut_with_scalpels(status);
+      measure_tip_strain();
     } catch (const SimulationError& e) {
       // Keep serving, but never stay stuck: the same input would fail again from the rolled-back
       // state, so the organ goes back to rest (memory variables relaxed) and graspers let go.

@@ -26,6 +26,7 @@
 #include "viscera/runtime/session_control.hpp"
 #include "viscera/runtime/simulated_tool.hpp"
 #include "viscera/runtime/simulation_server.hpp"
+#include "viscera/runtime/tip_strain_window.hpp"
 #include "viscera/tissue/integrator/boundary_conditions.hpp"
 #include "viscera/tissue/integrator/state.hpp"
 #include "viscera/tissue/mesh/boundary_surface.hpp"
@@ -77,6 +78,7 @@ struct SimulationServer::Impl {
     ContactResult result;
     Stroke stroke;
     double cut_edge_strain = 0;  // the largest edge strain of what its blade cut this tick
+    TipStrainWindow tip_strain;  // the strain at it, over 20 ms windows
   };
   std::map<std::uint32_t, Tool> tools;
   std::int32_t strokes = 0;  // physics thread: strokes begun on this organ (the next one's id)
@@ -115,6 +117,9 @@ struct SimulationServer::Impl {
   /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
   /// contact of each active tool, and the springs holding grasped nodes to the jaws.
   void apply_instruments(const tissue::BoundaryConditions::FieldEvaluation& e);
+
+  /// After the step: the tissue's strain at each instrument that touches it (ContactResult::tip_strain).
+  void measure_tip_strain();
 
   /// The boundary surface with its vertices numbered in the order of boundary.nodes.
   proto::SurfaceTopology surface_topology(const tissue::BoundarySurface& boundary) const;

@@ -39,10 +39,12 @@ TEST(Messages, RoundTripsEveryMessage) {
   f.max_edge_strain = 0.137;
   f.cutting = true;
   f.cut_edge_strain = 0.31;
+  f.tip_strain = 0.12;
   const auto fd = decode_force(encode(f), &why);
   ASSERT_TRUE(fd) << why;
   EXPECT_TRUE(fd->cutting);
   EXPECT_EQ(fd->cut_edge_strain, 0.31);
+  EXPECT_EQ(fd->tip_strain, 0.12);
   EXPECT_EQ(fd->force[2], 3.0);
   EXPECT_TRUE(fd->in_contact);
   EXPECT_EQ(fd->stiffness[4], 200);
@@ -55,6 +57,9 @@ TEST(Messages, RoundTripsEveryMessage) {
     Force h = f;
     h.cut_edge_strain = bad;
     EXPECT_FALSE(decode_force(encode(h), &why)) << bad;
+    Force t = f;
+    t.tip_strain = bad;
+    EXPECT_FALSE(decode_force(encode(t), &why)) << bad;
   }
   const auto s = decode_session_request(encode(SessionRequest{7, Action::release_instrument, 2}), &why);
   ASSERT_TRUE(s) << why;

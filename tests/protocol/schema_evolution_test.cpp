@@ -28,6 +28,7 @@ TEST(SchemaEvolution, OldReaderReadsNewForceFeedback) {
   f.tick = 987654321;
   f.max_edge_strain = 0.25;  // schema 8
   f.cutting = true;  // schema 17
+  f.tip_strain = 0.2;  // schema 18
   const auto bytes = encode(f);
   flatbuffers::Verifier verifier(bytes.data(), bytes.size());
   ASSERT_TRUE(v1::VerifyForceFeedbackBuffer(verifier));
@@ -59,6 +60,7 @@ TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
   EXPECT_EQ(f->tick, 0u);  // an older server stamps no tick: a recording of it cannot be re-simulated
   EXPECT_EQ(f->max_edge_strain, 0.0);  // nor the organ's strain (schema 8)
   EXPECT_FALSE(f->cutting);  // nor a blade cutting (schema 17)
+  EXPECT_EQ(f->tip_strain, 0.0);  // nor the strain at the instrument (schema 18)
 
   flatbuffers::FlatBufferBuilder c;
   const v1::Vec3 tip(0.0, 0.01, 0.05);

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <thread>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -122,7 +123,8 @@ std::string first_difference(const LockstepRun& a, const LockstepRun& b) {
           (f->step_time_ns > 0) != (g->step_time_ns > 0) || f->in_contact != g->in_contact || f->cutting != g->cutting ||
           !same_bits(f->force, g->force) || !same_bits(f->torque, g->torque) || !same_bits(f->contact_point, g->contact_point) ||
           !same_bits(f->contact_normal, g->contact_normal) || !same_bits(f->stiffness, g->stiffness) ||
-          !same_bits(f->penetration_m, g->penetration_m) || !same_bits(f->cut_edge_strain, g->cut_edge_strain))
+          !same_bits(f->penetration_m, g->penetration_m) || !same_bits(f->cut_edge_strain, g->cut_edge_strain) ||
+          !same_bits(f->tip_strain, g->tip_strain))
         return at + "force " + std::to_string(k);
     }
     if (x.events.size() != y.events.size()) return at + "event counts";
@@ -458,6 +460,69 @@ TEST(Lockstep, EveryForceCarriesTheOrgansLargestEdgeStrainOfItsTick) {
     last += in_contact[in_contact.size() - 1 - k] / static_cast<double>(fifth);
   }
   EXPECT_GT(last, 2 * first) << "first fifth of the press " << first << ", last " << last;
+}
+
+/// The stepped forces of a run's press: tick -> (max_edge_strain, tip_strain, in contact), and the
+/// answered-at-once forces' tip strains by the tick whose state answered them.
+struct PressStrains {
+  std::map<std::uint64_t, std::tuple<double, double, bool>> stepped;
+  std::map<std::uint64_t, double> answered;
+};
+PressStrains press_strains(const LockstepRun& r) {
+  PressStrains out;
+  std::string why;
+  for (const auto& result : r.results)
+    for (const auto& payload : result.forces) {
+      const auto f = proto::decode_force(payload, &why);
+      EXPECT_TRUE(f) << why;
+      if (!f) continue;
+      if (f->step_time_ns > 0)
+        out.stepped[f->tick] = {f->max_edge_strain, f->tip_strain, f->in_contact};
+      else if (f->in_contact)
+        out.answered[f->tick] = f->tip_strain;
+    }
+  return out;
+}
+
+TEST(Lockstep, TheStrainAtTheInstrumentStaysAsTheMeshIsRefinedWhereTheLargestEdgeStrainGrows) {
+  // The same press (18 mm into the top of the liver, 6 mm tip), on the liver's mesh and on the
+  // same mesh refined once (eight times the tetrahedra, half the edge length).
+  // The scene's strain radius, 2 cm: 1.5 edges of the coarse mesh (over 1 cm, which the coarse mesh
+  // cannot resolve, the two differed by 32%).
+  const PressStrains coarse = press_strains(run(1));
+  const PressStrains fine = press_strains(run(2, 0, {}, [](SceneSpec& s) { s.refine = 1; }));
+  for (const PressStrains* p : {&coarse, &fine}) {
+    bool touched = false;
+    for (const auto& [tick, v] : p->stepped) {
+      const auto [edge, tip, contact] = v;
+      if (!contact) {
+        EXPECT_EQ(tip, 0.0) << "tick " << tick << ": out of contact";
+        continue;
+      }
+      touched = true;
+      EXPECT_GT(tip, 0.0) << "tick " << tick;
+      EXPECT_LT(tip, 1.0) << "tick " << tick;
+    }
+    EXPECT_TRUE(touched);
+    // A force answered at once on the state after tick T carries tick T's strain at the instrument.
+    for (const auto& [tick, tip] : p->answered)
+      if (const auto s = p->stepped.find(tick); s != p->stepped.end() && std::get<2>(s->second))
+        EXPECT_EQ(tip, std::get<1>(s->second)) << "tick " << tick;
+  }
+  // The deepest press: the last tick in contact on both meshes.
+  std::uint64_t last = 0;
+  for (const auto& [tick, v] : coarse.stepped)
+    if (std::get<2>(v) && fine.stepped.count(tick) && std::get<2>(fine.stepped.at(tick))) last = tick;
+  ASSERT_GT(last, 0u);
+  const auto [edge_coarse, tip_coarse, c1] = coarse.stepped.at(last);
+  const auto [edge_fine, tip_fine, c2] = fine.stepped.at(last);
+  const double edge_ratio = edge_fine / edge_coarse, tip_ratio = tip_fine / tip_coarse;
+  std::cout << "[ figure ] tick +" << last - kFirstTick << ": largest edge strain " << edge_coarse << " (coarse) and " << edge_fine
+            << " (refined), ratio " << edge_ratio << "; strain at the instrument " << tip_coarse << " and " << tip_fine << ", ratio " << tip_ratio
+            << "\n";
+  EXPECT_GT(edge_ratio, 1.3);  // the edge strain resolves the peak under the tip as the mesh is refined
+  EXPECT_LT(std::abs(tip_ratio - 1.0), 0.15);  // the averaged strain stays within 15%
+  EXPECT_LT(std::abs(tip_ratio - 1.0), 0.5 * (edge_ratio - 1.0));
 }
 
 }  // namespace viscera::runtime

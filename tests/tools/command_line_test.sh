@@ -57,6 +57,8 @@ echo '{"organ": {"mesh": "x.msh", "material": "m.json", "physics_threads": 1.5},
 expect server-bad-threads 2 "threads_scene.json: organ.physics_threads: 1.5 is not a whole number" -- "$server" --scene "$tmp/threads_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json", "contact_damping_s_per_m": -1}, "instruments": [{"id": 1}]}' >"$tmp/damping_scene.json"
 expect server-bad-damping 2 "damping_scene.json: organ.contact_damping_s_per_m: -1 is outside" -- "$server" --scene "$tmp/damping_scene.json"
+echo '{"organ": {"mesh": "x.msh", "material": "m.json", "strain_radius_m": 2}, "instruments": [{"id": 1}]}' >"$tmp/radius_scene.json"
+expect server-bad-strain-radius 2 "radius_scene.json: organ.strain_radius_m: 2 is outside" -- "$server" --scene "$tmp/radius_scene.json"
 echo '{"physics_threads": 2, "organ": {"mesh": "x.msh", "material": "m.json"}, "instruments": [{"id": 1}]}' >"$tmp/misplaced_scene.json"
 expect server-unknown-field 2 "misplaced_scene.json: physics_threads: unknown field (known here: name, " -- "$server" --scene "$tmp/misplaced_scene.json"
 echo '{"organ": {"mesh": "x.msh", "material": "m.json"}, "instruments": [{"id": 1, "tip_radius": 0.01}]}' >"$tmp/typo_scene.json"

@@ -47,6 +47,7 @@ struct Session {
     e.text = std::move(text);
     payloads.push_back({proto::Stream::event, proto::encode(e)});
   }
+  double tip_strain = 0.05;  ///< every force in contact carries it (Force.tip_strain)
   /// `cutting`: the server says the scalpel's blade cuts (its button held, or pressed through).
   /// `cut_strain`: the strain where the blade cut that tick (Force.cut_edge_strain).
   void step(std::uint64_t tick, const proto::Vector3& tip, double force_n, double strain = 0.1, std::uint32_t buttons = 0, bool cutting = false,
@@ -67,6 +68,7 @@ struct Session {
     f.contact_point = {tip[0], tip[1], tip[2] - kTipRadius};  // the tool's sphere touches the tissue below its centre
     f.tick = tick;
     f.max_edge_strain = strain;
+    f.tip_strain = f.in_contact ? tip_strain : 0.0;
     f.cutting = cutting;
     f.cut_edge_strain = cut_strain;
     payloads.push_back({proto::Stream::force_feedback, proto::encode(f)});
@@ -235,6 +237,8 @@ TEST(ExerciseFile, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(message(head + R"("kind": "suturing"})").find("ex.json: kind"), std::string::npos);
   EXPECT_NE(message(head + R"("kind": "force_drill", "time_limit_s": -3})").find("ex.json: time_limit_s"), std::string::npos);
   EXPECT_NE(message(head + R"("kind": "force_drill", "limits": {"peak_force_n": 1e9}})").find("ex.json: limits.peak_force_n"), std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "limits": {"tip_strain": 9}})").find("ex.json: limits.tip_strain"), std::string::npos);
+  EXPECT_NE(message(head + R"("kind": "force_drill", "limits": {"tip_strain": "high"}})").find("ex.json: limits.tip_strain"), std::string::npos);
   EXPECT_NE(message(head + R"("kind": "force_drill", "palpation": {}})").find("ex.json: palpation: belongs to a palpation exercise"),
             std::string::npos);
   EXPECT_NE(message(head + R"("kind": "force_drill", "force_drill": {"force_n": 1, "tolerance_n": 2}})").find("ex.json: force_drill.tolerance_n"),
@@ -251,8 +255,48 @@ TEST(ExerciseFile, ErrorsNameTheFileAndTheField) {
   EXPECT_NE(message("{\"name\": \"\\u001b[2J\", \"kind\": \"palpation\", \"scene\": \"liver\"}").find("ex.json: name: '\\x1B[2J'"),
             std::string::npos);
   EXPECT_NE(message(std::string(100000, '[') + std::string(100000, ']')).find("nested deeper than 64 levels"), std::string::npos);
-  for (const char* f : {"palpation.json", "retraction.json", "force-drill.json"})
+  for (const char* f : {"palpation.json", "palpation-12k.json", "retraction.json", "force-drill.json", "incision.json"})
     EXPECT_NO_THROW(read_exercise_file(std::string(VISCERA_DATA_DIR) + "/exercises/" + f)) << f;
+}
+
+// The strain limits: a file that sets none is scored on the strain at the instrument (the forces'
+// tip_strain) against 0.4, and not on the organ's largest edge strain, which grows as a mesh is
+// refined; a file that sets edge_strain only is scored on that, as before. Forces in contact that
+// carry no strain at the instrument (a server older than schema 18) fail the criterion, naming why.
+TEST(ExerciseScorer, TheStrainAtTheInstrumentIsScoredUnlessTheFileAsksForTheEdgeStrainOnly) {
+  const std::string drill_body = R"("force_drill": {"force_n": 1.0, "tolerance_n": 0.1, "hold_s": 2}})";
+  const std::string head = R"({"name": "drill", "kind": "force_drill", "scene": "liver", "time_limit_s": 60, )";
+  const Exercise plain = parse_exercise(head + drill_body, "plain.json");
+  const Exercise edge_only = parse_exercise(head + R"("limits": {"edge_strain": 0.5}, )" + drill_body, "edge.json");
+  const Exercise both = parse_exercise(head + R"("limits": {"edge_strain": 0.5, "tip_strain": 0.2}, )" + drill_body, "both.json");
+  const auto hold = [](double edge, double tip) {
+    Session s("liver");
+    s.tip_strain = tip;
+    for (std::uint64_t k = 0; k <= 4000; ++k) s.step(100 + k, {0, 0, 0}, 1.0, edge);
+    return s;
+  };
+  const auto has_criterion = [](const ScoreReport& r, const std::string& name) {
+    return std::any_of(r.criteria.begin(), r.criteria.end(), [&](const Criterion& c) { return c.name == name; });
+  };
+  // A fine mesh's edge strain of 0.9 under a regional strain of 0.1: passes the plain file.
+  const ScoreReport fine = hold(0.9, 0.1).score(plain);
+  EXPECT_TRUE(fine.passed) << (fine.failures.empty() ? "" : fine.failures[0]);
+  EXPECT_TRUE(has_criterion(fine, "strain at the instrument"));
+  EXPECT_FALSE(has_criterion(fine, "largest edge strain"));
+  EXPECT_DOUBLE_EQ(fine.max_tip_strain, 0.1);
+  const ScoreReport strained = hold(0.2, 0.45).score(plain);
+  EXPECT_TRUE(has_failure(strained, "strained too far at the instrument: 0.450 at the most (at most 0.400)")) << to_markdown(strained);
+  const ScoreReport unmeasured = hold(0.2, 0.0).score(plain);
+  EXPECT_TRUE(has_failure(unmeasured, "not measured")) << to_markdown(unmeasured);
+  // The edge strain only: the strain at the instrument is neither scored nor missed.
+  const ScoreReport edge = hold(0.9, 0.0).score(edge_only);
+  EXPECT_FALSE(has_criterion(edge, "strain at the instrument"));
+  EXPECT_TRUE(has_failure(edge, "largest edge strain 0.900")) << to_markdown(edge);
+  EXPECT_TRUE(hold(0.3, 0.0).score(edge_only).passed);
+  // Both: each against its own limit.
+  EXPECT_TRUE(hold(0.3, 0.15).score(both).passed);
+  EXPECT_TRUE(has_failure(hold(0.3, 0.21).score(both), "at the instrument"));
+  EXPECT_TRUE(has_failure(hold(0.6, 0.15).score(both), "largest edge strain"));
 }
 
 // An incision along the line from (-25, 0) to (25, 0) mm off the top's centre, 10 mm deep: the

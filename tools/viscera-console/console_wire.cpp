@@ -106,7 +106,8 @@ nlohmann::json forces_json(const std::vector<ForceSummary>& f, const std::vector
                         {"force", s.force},
                         {"contact", s.in_contact},
                         {"contact_point", s.contact_point},
-                        {"max_edge_strain", s.max_edge_strain}};
+                        {"max_edge_strain", s.max_edge_strain},
+                        {"tip_strain", s.tip_strain}};
     for (const auto& [id, tip] : tips)
       if (id == s.instrument_id) i["tip"] = tip;
     list.push_back(std::move(i));

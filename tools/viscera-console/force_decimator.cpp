@@ -15,6 +15,7 @@ void ForceDecimator::add(const protocol::Force& f) {
   const double magnitude = std::hypot(f.force[0], f.force[1], f.force[2]);
   w.s.peak_n = std::max(w.s.peak_n, magnitude);
   w.s.max_edge_strain = std::max(w.s.max_edge_strain, f.max_edge_strain);
+  w.s.tip_strain = std::max(w.s.tip_strain, f.tip_strain);
   w.s.t_s = 1e-9 * static_cast<double>(f.server_stamp_ns);
   w.s.force = f.force;
   w.s.contact_point = f.contact_point;

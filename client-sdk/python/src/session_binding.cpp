@@ -89,7 +89,10 @@ void bind_session(py::module_& m) {
       .def_readonly("cutting", &protocol::Force::cutting,
                     "a scalpel's blade cutting: its button held, or pressed through above the scene's cut force")
       .def_readonly("cut_edge_strain", &protocol::Force::cut_edge_strain,
-                    "a cutting scalpel's: the largest edge strain of the tetrahedra it cut that tick, just after it cut them [-]");
+                    "a cutting scalpel's: the largest edge strain of the tetrahedra it cut that tick, just after it cut them [-]")
+      .def_readonly("tip_strain", &protocol::Force::tip_strain,
+                    "the tissue's strain at the instrument after that tick: principal stretch strain |lambda - 1| averaged within the "
+                    "scene's strain radius of where it touches (0 out of contact) [-]");
   py::class_<protocol::Event>(m, "Event", "A session event (server) or an annotation (client).")
       .def_property_readonly(
           "kind", [](const protocol::Event& e) { return std::string(protocol::event_name(e.kind)); },

@@ -44,6 +44,10 @@ struct Force {
   /// schema 17: for a cutting scalpel, the largest edge strain of the tetrahedra its blade cut in
   /// that tick, just after it cut them (0 when it cut none); 0 from older servers
   double cut_edge_strain = 0;
+  /// schema 18: the tissue's strain at the instrument after that tick: the tetrahedra's largest
+  /// principal stretch strain |lambda - 1| averaged within the scene's strain radius of where it
+  /// touches (0 out of contact; 0 from older servers)
+  double tip_strain = 0;
 };
 
 enum class Action : std::int8_t {
@@ -265,7 +269,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 17;
+inline constexpr int kSchemaVersion = 18;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -39,6 +39,7 @@ struct ExpectedForce {
   std::uint64_t log_time_ns = 0;
   bool cutting = false;  ///< a scalpel's blade cutting (schema 17)
   double cut_edge_strain = 0;  ///< the largest edge strain of what it cut that tick (schema 17)
+  double tip_strain = 0;  ///< the tissue's strain at the instrument (schema 18)
 };
 
 struct ExpectedEvent {
@@ -70,6 +71,7 @@ struct LockstepPlan {
   std::vector<std::string> notes;  ///< what could not be reproduced, and why
   bool strain_recorded = true;  ///< forces carry the organ's edge strain (recorded with schema 8 or later)
   bool cutting_recorded = true;  ///< forces say whether a blade cut (recorded with schema 17 or later)
+  bool tip_strain_recorded = true;  ///< forces carry the strain at the instrument (recorded with schema 18 or later)
   /// The step of `tick` (an empty one where nothing happens).
   protocol::LockstepStep step(std::uint64_t tick) const;
 };

@@ -4,6 +4,7 @@
 // names the file and the field.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace viscera::training {
@@ -20,7 +21,16 @@ struct Exercise {
   std::uint32_t instrument = 1;  ///< the trainee's instrument
   double time_limit_s = 120;  ///< from the scene's loading to completion
   double peak_force_limit_n = 4.0;  ///< the largest force on the tissue a safe performance stays under
-  double edge_strain_limit = 0.5;  ///< the largest edge strain |L - L0| / L0 of the organ (tissue damage)
+  /// The tissue's strain at the instrument (the forces' tip_strain: principal stretch strain averaged
+  /// within the scene's strain radius of where it touches) a safe performance stays under. Scored
+  /// when the file sets it, or sets no strain limit at all (then 0.4).
+  std::optional<double> tip_strain_limit = 0.4;
+  /// The organ's largest edge strain |L - L0| / L0 a safe performance stays under (the forces'
+  /// max_edge_strain): scored only when the file sets it. It grows as the mesh is refined.
+  std::optional<double> edge_strain_limit;
+  /// An incision's strain where the blade cut (the forces' cut_edge_strain): the file's
+  /// edge_strain, or 0.5.
+  double cut_strain_limit() const { return edge_strain_limit.value_or(0.5); }
 
   // palpation: find the region by touch and mark it (button 1 of the instrument's device)
   std::string target_region = "nodule";

@@ -77,12 +77,13 @@ class ExerciseScorer {
   std::optional<protocol::Vector3> last_tip_;  ///< of the newest command walked
   std::optional<std::pair<std::uint32_t, std::uint64_t>> walked_;  ///< client and seq of the newest command walked
   std::uint64_t last_tick_ = 0, last_above_tick_ = 0, contact_samples_ = 0;
+  std::uint64_t tip_strain_samples_ = 0;  // forces in contact that carried a strain at the instrument (schema 18)
   double contact_force_sum_ = 0;
   std::optional<std::uint64_t> hold_start_;
   bool grasped_ = false;
   std::optional<double> grasp_z_;
   double announced_hold_s_ = 0;
-  bool warned_force_ = false, warned_strain_ = false;
+  bool warned_force_ = false, warned_strain_ = false, warned_tip_strain_ = false;
   // incision
   void walk_incision(const protocol::Command& k, const protocol::Force& f);
   std::optional<protocol::Vector3> top_;  ///< centre of the top of the organ's box (scene state)

@@ -31,6 +31,8 @@ struct ScoreReport {
   std::uint64_t samples_without_command = 0;  ///< of them, forces whose command was not seen (no tip position)
   std::uint64_t undecodable = 0;  ///< payloads that did not decode (skipped)
   double path_length_m = 0, peak_force_n = 0, mean_contact_force_n = 0, time_above_force_limit_s = 0, max_edge_strain = 0;
+  /// The largest strain at the instrument the forces carried (tip_strain, schema 18)
+  double max_tip_strain = 0;
   double longest_hold_s = 0;  ///< retraction, force drill
   std::uint32_t drops = 0;  ///< retraction: let go before the hold was complete
   std::optional<protocol::Vector3> mark_m, target_m;  ///< palpation

@@ -28,6 +28,8 @@ struct Snapshot {
   std::map<std::uint32_t, GraspHold> grasped;
   /// The scalpels pressed through the tissue (above the scene's cut force) and cutting
   std::set<std::uint32_t> pressed_through;
+  /// Per instrument in contact: the tissue's strain at it after the tick (ContactResult::tip_strain)
+  std::map<std::uint32_t, double> tip_strain;
 };
 
 /// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.

@@ -27,6 +27,12 @@ class GraspHold {
 
   bool empty() const { return held_.empty(); }
   std::size_t size() const { return held_.size(); }
+  /// The held nodes' mean position in `rest` (the organ's rest shape); needs a node held.
+  Vec3 mean_of(std::span<const Vec3> rest) const {
+    Vec3 sum = Vec3::Zero();
+    for (const auto& [node, anchor] : held_) sum += rest[static_cast<std::size_t>(node)];
+    return sum / static_cast<double>(held_.size());
+  }
 
   struct Reaction {
     Vec3 force_on_tool = Vec3::Zero();  ///< [N]

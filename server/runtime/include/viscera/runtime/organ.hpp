@@ -13,6 +13,7 @@
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/runtime/tick_budget.hpp"
 #include "viscera/tissue/cutting/mesh_cutter.hpp"
+#include "viscera/tissue/element/ball_strain.hpp"
 #include "viscera/tissue/gps/gps_mechanisms.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/material_file.hpp"
@@ -32,6 +33,8 @@ struct Organ {
   tissue::BoundarySurface boundary;
   /// The boundary triangles as the contacts see them (shared by every instrument's contact).
   std::shared_ptr<const ContactSurface> contact_surface;
+  /// The tissue's strain within the scene's strain radius of a point (the instruments' tip_strain).
+  std::unique_ptr<tissue::BallStrain> strain;
   /// Cuts the mesh in place (organ_cutting.hpp); null when the model cannot follow a cut.
   std::unique_ptr<tissue::MeshCutter> cutter;
   /// Changes of the boundary surface since the organ was built (SurfaceTopology's generation).

@@ -43,6 +43,9 @@ struct ContactResult {
   Vec3 deepest_weights = Vec3::Zero();  ///< its barycentric weights
   /// A scalpel's blade cutting: it passes through the tissue, and touches nothing.
   bool cutting = false;
+  /// The tissue's strain within the scene's strain radius of where the instrument touches, after
+  /// the tick (tissue::BallStrain; the server sets it, 0 out of contact).
+  double tip_strain = 0;
 };
 
 /// The boundary triangles a contact looks at, with each one's longest rest edge for the broad

@@ -65,6 +65,9 @@ struct SceneSpec {
   double contact_stiffness_n_per_m = 200.0;
   double contact_damping_s_per_m = 0.0;  ///< probe contact's Hunt-Crossley dashpot alpha (0: none)
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
+  /// The radius over which the strain at an instrument is averaged (Force.tip_strain) [m]; a
+  /// measure that does not depend on the mesh needs it at least 1.5 element edges (docs/TRAINING.md)
+  double strain_radius_m = 0.02;
   double max_tool_speed_m_s = 0.5;  ///< simulated tools follow commands at most this fast (simulated time)
   std::string fix_axis = "z", fix_side = "max";
   double fix_fraction = 0.2;

@@ -18,6 +18,7 @@ struct ForceSummary {
   protocol::Vector3 contact_point{};  ///< [m]
   bool in_contact = false;  ///< in contact at the last sample
   double max_edge_strain = 0;  ///< the largest in the period
+  double tip_strain = 0;  ///< the largest strain at the instrument in the period (schema 18)
   std::uint32_t samples = 0;
 };
 
