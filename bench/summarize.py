@@ -60,6 +60,14 @@ def main(path):
         limit = GPS_BYTES_PER_TET / gbs
         gns = g["ns_per_tet"] * 1e9 if g["ns_per_tet"] < 1e-3 else g["ns_per_tet"]
         print(f"| {m} | {gbs:.1f} GB/s | {limit:.1f} | {gns:.1f} | {gns/limit:.1f}x |")
+    print("\nThe strain at an instrument, one 2 cm ball (the server spreads it over a 20 ms window):\n")
+    print("| mesh | tetrahedra in the ball | one ball | per tetrahedron |")
+    print("|---|---|---|---|")
+    for m in meshes:
+        t = med.get(f"TipStrain/{m}")
+        if t:
+            per = t["ns_per_element"] * 1e9 if t["ns_per_element"] < 1e-3 else t["ns_per_element"]
+            print(f"| {m} | {int(t['elements'])} | {t['real_time']:.1f} us | {per:.0f} ns |")
     bw = med.get("ReadBandwidth/256MiB")
     if bw:
         print(f"\nDRAM streaming read (256 MiB): {bw['bytes_per_second']/1e9:.1f} GB/s")
