@@ -2,12 +2,13 @@
 // the whole ball's average computed at once (tissue::BallStrain::at): on positions that do not
 // change, the window's strain is the ball's; it holds between windows, fixes its ball where the
 // window began, and says 0 out of contact.
-#include <gtest/gtest.h>
+#include "viscera/runtime/tip_strain_window.hpp"
 
 #include <cmath>
 #include <memory>
 
-#include "viscera/runtime/tip_strain_window.hpp"
+#include <gtest/gtest.h>
+
 #include "viscera/tissue/mesh/box_mesh.hpp"
 
 namespace viscera::runtime {
@@ -16,8 +17,7 @@ namespace {
 using tissue::Vec3;
 
 struct Organ {
-  std::shared_ptr<tissue::TetMesh> mesh =
-      std::make_shared<tissue::TetMesh>(tissue::make_box_mesh(Vec3(0, 0, 0), Vec3(0.08, 0.08, 0.04), 16, 16, 8));
+  std::shared_ptr<tissue::TetMesh> mesh = std::make_shared<tissue::TetMesh>(tissue::make_box_mesh(Vec3(0, 0, 0), Vec3(0.08, 0.08, 0.04), 16, 16, 8));
   tissue::BallStrain ball{mesh, 0.02};
   /// A dent under (cx, cy) on the top, `depth` deep.
   std::vector<Vec3> dented(double cx, double cy, double depth) const {

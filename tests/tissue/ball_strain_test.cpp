@@ -2,17 +2,18 @@
 // a uniform deformation, whose strain every mesh must give exactly; the ball's elements against a
 // search over all of them; a smooth local dent against the ball average of its analytic strain,
 // computed by quadrature, on three meshes of a box.
-#include <gtest/gtest.h>
+#include "viscera/tissue/element/ball_strain.hpp"
 
 #include <cmath>
 #include <random>
 
-#include "test_support.hpp"
-#include "viscera/tissue/element/ball_strain.hpp"
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
 #include "viscera/tissue/mesh/box_mesh.hpp"
 #include "viscera/tissue/mesh/refinement.hpp"
 
-#include <Eigen/Eigenvalues>
+#include "test_support.hpp"
 
 namespace viscera::tissue {
 namespace {

@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
-
 #include <numbers>
+#include <stdexcept>
 
 namespace viscera::tissue {
 
@@ -136,9 +135,9 @@ void BallStrain::visit_near(const Vec3& p, Visit&& visit) const {
   for (int z = from[2]; z <= to[2]; ++z)
     for (int y = from[1]; y <= to[1]; ++y)
       for (int x = from[0]; x <= to[0]; ++x) {
-        const std::size_t c = (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_[1]) + static_cast<std::size_t>(y)) *
-                                  static_cast<std::size_t>(dims_[0]) +
-                              static_cast<std::size_t>(x);
+        const std::size_t c =
+            (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_[1]) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(dims_[0]) +
+            static_cast<std::size_t>(x);
         for (std::uint32_t k = grid_start_[c]; k < grid_start_[c + 1]; ++k) {
           const std::uint32_t e = grid_elements_[k];
           if (!moved_[e] && (centroid_[e] - p).squaredNorm() <= r2) visit(static_cast<std::size_t>(e));

@@ -33,7 +33,8 @@ std::string encode_frame(const protocol::MeshFrame& m, double server_wall_ms);
 nlohmann::json to_json(const protocol::Scene& s);
 nlohmann::json to_json(const protocol::TelemetryReport& t);
 nlohmann::json to_json(const protocol::Event& e);
-/// {"type": "forces", "station": ..., "instruments": [{"id", "t_s", "peak_n", "force", "contact", "contact_point", "tip", "max_edge_strain", "tip_strain"}]}
+/// {"type": "forces", "station": ..., "instruments": [{"id", "t_s", "peak_n", "force", "contact", "contact_point", "tip", "max_edge_strain",
+/// "tip_strain"}]}
 nlohmann::json forces_json(const std::vector<ForceSummary>& f, const std::vector<std::pair<std::uint32_t, protocol::Vector3>>& tips);
 
 }  // namespace viscera::console
