@@ -31,9 +31,6 @@ namespace viscera::tissue {
 /// eigenvalue below -1/2, which no deformation gives, counts as a stretch of 0).
 double principal_stretch_strain(const Mat3& green);
 
-/// Green-Lagrange strain of element e of `rest` at positions x, from G = (u_i - u_0) Dm^-1.
-Mat3 element_green_strain(const TetMesh& rest, std::span<const Vec3> x, std::size_t e);
-
 class BallStrain {
  public:
   /// `rest`: the mesh the positions belong to (read at each query: a cut grows it in place).
