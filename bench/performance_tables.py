@@ -27,16 +27,27 @@ def tissue(path):
 def tick(path):
     data = json.load(open(path))
     ctx = data["context"]
-    rows = ["| scene | tets | sub-steps per tick | tick on 1 thread [us] | tick on 2 threads [us] | budget [us] |", "|---|---|---|---|---|---|"]
+    rows = ["| scene | tets | nodes | sub-steps per tick | tick on 1 thread [us] | tick on 2 threads [us] | budget [us] "
+            "| element loop, one evaluation on 1 thread [us] | the tick without it, 1 / 2 threads [us] | serial share |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
     med = {b["run_name"].removesuffix("/real_time"): b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
-    scenes = sorted({n.split("/")[1] for n in med})
+    scenes = sorted({n.split("/")[1] for n in med if n.startswith("Tick/")})
     for s in scenes:
         one, two = med.get(f"Tick/{s}/threads:1"), med.get(f"Tick/{s}/threads:2")
         ref = one or two
         if not ref:
             continue
         us = lambda b: f"{b['real_time']:.0f}" if b else "-"
-        rows.append(f"| {s} | {int(ref['tets'])} | {int(ref['sub_steps'])} | {us(one)} | {us(two)} | {ref['tick_budget_us']:.0f} |")
+        elements, rest1, rest2 = med.get(f"Elements/{s}"), med.get(f"NodesOnly/{s}/threads:1"), med.get(f"NodesOnly/{s}/threads:2")
+        nodes = f"{int(rest1['nodes'])}" if rest1 else "-"
+        # What a tick on one thread spends outside the element loop: the tick less its sub-steps'
+        # element loops (includes the chunks' reduction and hand-over), and the node work alone.
+        share = "-"
+        if one and elements and rest1:
+            outside = 1 - ref["sub_steps"] * elements["real_time"] / one["real_time"]
+            share = f"{100 * outside:.1f}% ({100 * rest1['real_time'] / one['real_time']:.1f}% node work)"
+        rows.append(f"| {s} | {int(ref['tets'])} | {nodes} | {int(ref['sub_steps'])} | {us(one)} | {us(two)} | {ref['tick_budget_us']:.0f} "
+                    f"| {us(elements)} | {us(rest1)} / {us(rest2)} | {share} |")
     return f"Run of {ctx.get('date', '?')[:16]} (`bench/tick.sh`), {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, medians of 3:\n\n" + "\n".join(rows) + "\n"
 
 

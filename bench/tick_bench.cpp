@@ -33,6 +33,21 @@ void run_ticks(benchmark::State& st, const runtime::Organ& organ, double rate_hz
   for (auto _ : st) sub_steps = organ.integrator->advance(state, 1.0 / rate_hz);
   st.counters["sub_steps"] = static_cast<double>(sub_steps);
   st.counters["tets"] = static_cast<double>(organ.mesh->tet_count());
+  st.counters["nodes"] = static_cast<double>(organ.mesh->node_count());
+}
+
+/// The element loop of `scene`'s organ alone: one evaluation of its internal forces over every
+/// element on one thread, memory advanced, at the rest shape stretched by 0.1%. A tick on one
+/// thread is its sub-steps times this plus what is serial (the tick's serial share).
+void elements(benchmark::State& st, const std::string& scene_name) {
+  const auto organ = runtime::build_organ(runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json"));
+  if (organ->mesh->node_count() > 0) organ->compliance->wait_node(0);
+  std::vector<tissue::Vec3> x = organ->mesh->nodes, f(x.size(), tissue::Vec3::Zero());
+  for (auto& p : x) p *= 1.001;
+  std::vector<double> memory(organ->model->memory_size(), 0.0);
+  for (auto _ : st) organ->model->add_forces(x, f, tissue::MemoryUpdate{memory, memory, 1e-3});
+  benchmark::DoNotOptimize(f.data());
+  st.counters["tets"] = static_cast<double>(organ->mesh->tet_count());
 }
 
 void tick(benchmark::State& st, const std::string& scene_name, int threads) {
@@ -40,6 +55,18 @@ void tick(benchmark::State& st, const std::string& scene_name, int threads) {
   scene.physics_threads = threads;
   run_ticks(st, *runtime::build_organ(scene), scene.physics_rate_hz, 1.0);
   st.counters["tick_budget_us"] = 1e6 / scene.physics_rate_hz;
+}
+
+/// The tick of `scene` on `threads` without its element loop: the integrator's force evaluation
+/// replaced by one that adds nothing, so what is timed is the rest of the sub-steps (the forces'
+/// initial values, the nodes' update and what the step keeps for its roll-back).
+void nodes_only(benchmark::State& st, const std::string& scene_name, int threads) {
+  runtime::SceneSpec scene = runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
+  scene.physics_threads = threads;
+  const auto organ = runtime::build_organ(scene);
+  organ->integrator->set_force_evaluation(
+      [](std::span<const tissue::Vec3>, std::span<tissue::Vec3>, const tissue::MemoryUpdate&) { return tissue::ForceStats{}; });
+  run_ticks(st, *organ, scene.physics_rate_hz, 1.0);
 }
 
 /// The tick of `scene` with its organ switched to another material (as viscera-control material
@@ -91,11 +118,17 @@ void tick_with_material(benchmark::State& st, const std::string& scene_name, con
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  for (const std::string scene : {"liver", "liver-12k", "liver-96k"})
+  for (const std::string scene : {"liver", "liver-12k", "liver-96k"}) {
+    benchmark::RegisterBenchmark(("Elements/" + scene).c_str(), elements, scene)->Unit(benchmark::kMicrosecond)->UseRealTime();
+    for (const int threads : {1, 2})
+      benchmark::RegisterBenchmark(("NodesOnly/" + scene + "/threads:" + std::to_string(threads)).c_str(), nodes_only, scene, threads)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
     for (const int threads : {1, 2})
       benchmark::RegisterBenchmark(("Tick/" + scene + "/threads:" + std::to_string(threads)).c_str(), tick, scene, threads)
           ->Unit(benchmark::kMicrosecond)
           ->UseRealTime();
+  }
   for (const std::string scene : {"liver", "liver-12k"})
     for (const MaterialVariant& v : material_variants())
       benchmark::RegisterBenchmark(("Material/" + std::string(v.name) + "/" + scene).c_str(), tick_with_material, scene, v)

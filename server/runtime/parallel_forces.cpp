@@ -51,13 +51,30 @@ void ParallelForces::take_chunks(std::uint64_t generation) {
   for (;;) {
     if ((v >> 32) != generation || (v & 0xffffffffu) >= chunks_) return;
     if (!next_.compare_exchange_weak(v, v + 1, std::memory_order_acq_rel)) continue;
-    const std::size_t c = v & 0xffffffffu;
-    auto& buffer = buffers_[c - 1];
-    std::fill(buffer.begin() + static_cast<long>(ranges_[c].first), buffer.begin() + static_cast<long>(ranges_[c].second), Vec3::Zero());
-    stats_[c] = model_.add_forces(x_, buffer, memory_, ElementPart{c, chunks_});
+    (*job_)(v & 0xffffffffu);
     finished_.fetch_add(1, std::memory_order_acq_rel);
     finished_.notify_one();
     v = next_.load(std::memory_order_acquire);
+  }
+}
+
+void ParallelForces::run(const std::function<void(std::size_t chunk)>& job) {
+  job_ = &job;
+  finished_.store(0, std::memory_order_relaxed);
+  const std::uint64_t g = ++generation_;
+  next_.store(g << 32 | 1u, std::memory_order_release);
+  go_.store(g, std::memory_order_release);
+  go_.notify_all();
+  job(0);
+  take_chunks(g);
+  // The remaining chunks are being computed by helpers: wait for them, spinning for up to 0.3 ms,
+  // then asleep. A caller that only spins keeps its core busy, so a lowest-priority helper that
+  // another thread holds off its own core is not moved over (96k tets with the haptic client on
+  // the other core: ticks of up to 90-200 ms in 2 runs against 35-56 ms with the sleep).
+  const auto spin_until = std::chrono::steady_clock::now() + std::chrono::microseconds(300);
+  for (std::size_t done = finished_.load(std::memory_order_acquire); done < chunks_ - 1; done = finished_.load(std::memory_order_acquire)) {
+    if (std::chrono::steady_clock::now() < spin_until) continue;
+    finished_.wait(done, std::memory_order_acquire);
   }
 }
 
@@ -93,27 +110,18 @@ void ParallelForces::helper() {
 }
 
 ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
-  x_ = x;
-  memory_ = memory;
   // The model's mesh is not read here: a material being built on another thread may share it. A
   // cut is reported (follow_model); forces for more nodes than the buffers hold follow it too.
   if (!buffers_.empty() && buffers_[0].size() != f.size()) follow_model();
-  finished_.store(0, std::memory_order_relaxed);
-  const std::uint64_t g = ++generation_;
-  next_.store(g << 32 | 1u, std::memory_order_release);
-  go_.store(g, std::memory_order_release);
-  go_.notify_all();
-  stats_[0] = model_.add_forces(x, f, memory, ElementPart{0, chunks_});
-  take_chunks(g);
-  // The remaining chunks are being computed by helpers: wait for them, spinning for up to 0.3 ms,
-  // then asleep. A caller that only spins keeps its core busy, so a lowest-priority helper that
-  // another thread holds off its own core is not moved over (96k tets with the haptic client on
-  // the other core: ticks of up to 90-200 ms in 2 runs against 35-56 ms with the sleep).
-  const auto spin_until = std::chrono::steady_clock::now() + std::chrono::microseconds(300);
-  for (std::size_t done = finished_.load(std::memory_order_acquire); done < chunks_ - 1; done = finished_.load(std::memory_order_acquire)) {
-    if (std::chrono::steady_clock::now() < spin_until) continue;
-    finished_.wait(done, std::memory_order_acquire);
-  }
+  run([&](std::size_t c) {
+    if (c == 0) {
+      stats_[0] = model_.add_forces(x, f, memory, ElementPart{0, chunks_});
+      return;
+    }
+    auto& buffer = buffers_[c - 1];
+    std::fill(buffer.begin() + static_cast<long>(ranges_[c].first), buffer.begin() + static_cast<long>(ranges_[c].second), Vec3::Zero());
+    stats_[c] = model_.add_forces(x, buffer, memory, ElementPart{c, chunks_});
+  });
   double worst = stats_[0].max_edge_strain;
   for (std::size_t c = 1; c < chunks_; ++c) {
     const auto& b = buffers_[c - 1];
@@ -122,6 +130,14 @@ ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f
     worst = std::isnan(s) || std::isnan(worst) ? std::numeric_limits<double>::quiet_NaN() : std::max(worst, s);
   }
   return {worst};
+}
+
+void ParallelForces::for_ranges(std::size_t n, const std::function<void(std::size_t first, std::size_t last)>& body) {
+  if (helpers_.empty() || n < kParallelNodesFrom) {
+    body(0, n);
+    return;
+  }
+  run([&](std::size_t c) { body(n * c / chunks_, n * (c + 1) / chunks_); });
 }
 
 }  // namespace viscera::runtime

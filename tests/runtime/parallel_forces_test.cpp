@@ -4,7 +4,9 @@
 // (corotational FE) still whole. An explicit run on two threads follows the one-thread run.
 #include "viscera/runtime/parallel_forces.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -128,6 +130,64 @@ TEST(ParallelForces, AnExplicitRunOnTwoThreadsFollowsTheOneThreadRun) {
   for (std::size_t i = 0; i < a.x.size(); ++i) d = std::max(d, (a.x[i] - b.x[i]).norm());
   EXPECT_GT(sag, 1e-3);
   EXPECT_LT(d, 1e-10 * sag);
+}
+
+// The integrator's node update split over the threads (an organ of more than kParallelNodesFrom
+// nodes) gives the same bits as the update in one piece: each node's update reads that node alone.
+// With a contact-like field on some nodes (their implicit springs and dashpots) and without.
+TEST(ParallelForces, TheNodeUpdateSplitOverThreadsGivesTheSameBits) {
+  const auto mesh = std::make_shared<TetMesh>(ordered_for_locality(make_box_mesh(Vec3(0, 0, 0), Vec3(0.12, 0.05, 0.04), 36, 16, 14)));
+  ASSERT_GE(mesh->node_count(), kParallelNodesFrom);
+  const Mat6 D = elasticity_matrix(IsotropicElasticity{5e3, 0.45});
+  const ViscoelasticSetup ve = make_viscoelastic(D, ViscoelasticSpec{});
+  const auto model = make_force_model("gps_energy", mesh, {ve.unrelaxed_elasticity}, 0.5, ve.gps);
+  BoundaryConditions bc;
+  Box slab = bounding_box(*mesh);
+  slab.hi.z() = slab.lo.z() + 0.1 * (slab.hi.z() - slab.lo.z());
+  bc.fixed_nodes = surface_nodes_in_box(*mesh, slab);
+  bc.gravity_m_s2 = Vec3(0, 0, -9.81);
+  for (const bool field : {false, true}) {
+    if (field)  // springs towards the rest shape on every 7th node, a dashpot on every 5th
+      bc.force_field = [&](const BoundaryConditions::FieldEvaluation& e) {
+        for (std::size_t i = 0; i < e.x.size(); i += 7) {
+          e.f[i] += 50.0 * (mesh->nodes[i] - e.x[i]);
+          e.stiffness[i] += 50.0;
+        }
+        for (std::size_t i = 0; i < e.x.size(); i += 5) e.damping[i] += 0.2;
+      };
+    const std::vector<double> rho(mesh->tet_count(), 1060.0);
+    ExplicitIntegrator whole(*model, rho, bc), split(*model, rho, bc);
+    ParallelForces parallel(*model, 3, 3);
+    const auto forces = [&](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return parallel(x, f, m); };
+    whole.set_force_evaluation(forces);
+    split.set_force_evaluation(forces);
+    std::vector<std::pair<std::size_t, std::size_t>> ranges;
+    split.set_node_loop([&](std::size_t n, const std::function<void(std::size_t, std::size_t)>& update) {
+      std::mutex m;
+      parallel.for_ranges(n, [&](std::size_t first, std::size_t last) {
+        {
+          const std::lock_guard lock(m);
+          ranges.emplace_back(first, last);
+        }
+        update(first, last);
+      });
+    });
+    State a = State::at_rest(*mesh), b = a;
+    const long steps = whole.advance(a, 0.01);
+    ASSERT_EQ(split.advance(b, 0.01), steps);
+    double sag = 0;
+    for (std::size_t i = 0; i < a.x.size(); ++i) sag = std::max(sag, (a.x[i] - mesh->nodes[i]).norm());
+    EXPECT_GT(sag, 1e-5) << "the bar sags";
+    EXPECT_EQ(a.x, b.x) << (field ? "with the field" : "without");
+    EXPECT_EQ(a.v, b.v) << (field ? "with the field" : "without");
+    EXPECT_EQ(a.memory, b.memory);
+    // Every sub-step split [0, n) into three ranges that cover it.
+    ASSERT_EQ(ranges.size(), 3 * static_cast<std::size_t>(steps));
+    std::sort(ranges.begin(), ranges.end());
+    for (std::size_t k = 0; k < ranges.size(); k += static_cast<std::size_t>(steps)) EXPECT_LT(ranges[k].first, ranges[k].second);
+    EXPECT_EQ(ranges.front().first, 0u);
+    EXPECT_EQ(ranges.back().second, mesh->node_count());
+  }
 }
 
 // Each chunk's buffer is cleared and added only over the nodes its elements name. A cut changes

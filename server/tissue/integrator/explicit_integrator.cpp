@@ -49,7 +49,12 @@ void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
 
 void ExplicitIntegrator::step_with(State& state, double dt) {
   const std::size_t n = mass_.size();
-  for (std::size_t i = 0; i < n; ++i) force_[i] = gravity_[i] + bc_.nodal_force(i, state.time_s);
+  if (bc_.nodal_forces.empty()) {
+    std::copy(gravity_.begin(), gravity_.end(), force_.begin());
+  } else {
+    const double amplitude = bc_.force_amplitude ? bc_.force_amplitude(state.time_s) : 1.0;
+    for (std::size_t i = 0; i < n; ++i) force_[i] = gravity_[i] + (bc_.force_amplitude ? Vec3(amplitude * bc_.nodal_forces[i]) : bc_.nodal_forces[i]);
+  }
   // Memory variables advance in place from their last evaluation to this one (a second buffer
   // would cost a third memory stream; see docs/PERFORMANCE.md). If the step then fails the
   // instability check, positions and velocities roll back but the memory stays advanced (the
@@ -58,13 +63,11 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   if (state.memory.size() != nm) state.memory.assign(nm, 0.0);
   const MemoryUpdate memory{state.memory, state.memory, state.time_s - state.memory_time_s};
   const ForceStats stats = evaluate_ ? evaluate_(state.x, force_, memory) : model_.add_forces(state.x, force_, memory);
-  bool stiff_field = false;
-  if (bc_.force_field) {
+  const bool field = static_cast<bool>(bc_.force_field);
+  if (field) {
     std::fill(field_stiffness_.begin(), field_stiffness_.end(), 0.0);
     std::fill(field_damping_.begin(), field_damping_.end(), 0.0);
     bc_.force_field({state.x, state.v, force_, field_stiffness_, field_damping_, dt});
-    stiff_field = std::any_of(field_stiffness_.begin(), field_stiffness_.end(), [](double k) { return k > 0; }) ||
-                  std::any_of(field_damping_.begin(), field_damping_.end(), [](double c) { return c > 0; });
   }
   if (!(stats.max_edge_strain <= options_.max_edge_strain)) {
     const std::size_t e = find_max_strain_element(model_, state.x);
@@ -81,23 +84,42 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   }
   max_edge_strain_ = std::max(max_edge_strain_, stats.max_edge_strain);
   last_edge_strain_ = stats.max_edge_strain;
-  x_prev_ = state.x;
-  v_prev_ = state.v;
   t_prev_ = state.time_s;
   state.memory_time_s = state.time_s;
+  x_prev_.resize(n);
+  v_prev_.resize(n);
   const double damping = std::exp(-options_.mass_damping_per_s * dt);
-  for (std::size_t i = 0; i < n; ++i) {
-    // A node under the field's springs moves with the mass m + dt^2 k (the springs taken
-    // implicitly): by Weyl's inequality dt^2 omega^2 <= dt^2 omega_model^2 + 1 <= 4 while
-    // dt <= sqrt(3) / omega_model, so stiff instrument springs on light nodes never destabilise.
-    // A dashpot c adds dt c (backward Euler in the velocity: a heavy dashpot stops the node, it
-    // never reverses it).
-    const double scale = stiff_field ? mass_[i] / (mass_[i] + dt * field_damping_[i] + dt * dt * field_stiffness_[i]) : 1.0;
-    state.v[i] = (state.v[i] + (scale * dt) * inv_mass_[i].cwiseProduct(force_[i])) * damping;
-    for (int k = 0; k < 3; ++k)
-      if (inv_mass_[i][k] == 0.0) state.v[i][k] = 0.0;
-    state.x[i] += dt * state.v[i];
-  }
+  // One pass over the nodes: the state this step starts from is kept (the roll-back's), then moved.
+  const auto update = [&](std::size_t first, std::size_t last) {
+    Vec3* x = state.x.data();
+    Vec3* v = state.v.data();
+    const Vec3 *f = force_.data(), *inv_mass = inv_mass_.data();
+    const double* mass = mass_.data();
+    const double* stiffness = field ? field_stiffness_.data() : nullptr;
+    const double* dashpot = field_damping_.data();
+    // Copied ahead of the loop, not in it: a loop of fewer streams (4 us less a tick on the 12k liver).
+    std::copy(x + first, x + last, x_prev_.data() + first);
+    std::copy(v + first, v + last, v_prev_.data() + first);
+    for (std::size_t i = first; i < last; ++i) {
+      // A node under the field's springs moves with the mass m + dt^2 k (the springs taken
+      // implicitly): by Weyl's inequality dt^2 omega^2 <= dt^2 omega_model^2 + 1 <= 4 while
+      // dt <= sqrt(3) / omega_model, so stiff instrument springs on light nodes never destabilise.
+      // A dashpot c adds dt c (backward Euler in the velocity: a heavy dashpot stops the node, it
+      // never reverses it).
+      double scale = 1.0;
+      if (stiffness)
+        if (const double k = stiffness[i], c = dashpot[i]; k > 0 || c > 0) scale = mass[i] / (mass[i] + dt * c + dt * dt * k);
+      Vec3 vi = (v[i] + (scale * dt) * inv_mass[i].cwiseProduct(f[i])) * damping;
+      for (int a = 0; a < 3; ++a)
+        if (inv_mass[i][a] == 0.0) vi[a] = 0.0;
+      v[i] = vi;
+      x[i] += dt * vi;
+    }
+  };
+  if (for_nodes_)
+    for_nodes_(n, update);
+  else
+    update(0, n);
   const double t1 = state.time_s + dt;
   const auto& rest = model_.rest_mesh().nodes;
   for (const auto& p : bc_.prescribed)

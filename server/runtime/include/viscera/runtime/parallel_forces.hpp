@@ -14,8 +14,10 @@
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
 // calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
 // caller, waiting for a helper's chunk, spins briefly and then sleeps.
+// The same threads split the integrator's node update (for_ranges) on a large organ.
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -26,6 +28,11 @@ namespace viscera::runtime {
 
 /// The chunks the server cuts the elements into on one or two threads (more threads: one each).
 inline constexpr int kForceChunks = 2;
+/// Node loops (ParallelForces::for_ranges) shorter than this run on the calling thread alone. The
+/// integrator's node update on two threads (bench/tick_bench NodesOnly, Intel VM, 2026-11-28): on
+/// the 96k liver (19,535 nodes) 2.1 ns a node less, on the 12k liver (2,936 nodes) 13 us a sub-step
+/// more, the helper's wake-up; so a split pays from about 6,200 nodes.
+inline constexpr std::size_t kParallelNodesFrom = 8192;
 
 class ParallelForces {
  public:
@@ -37,6 +44,9 @@ class ParallelForces {
 
   /// f += the model's internal forces at x, memory advanced (as ForceModel::add_forces).
   tissue::ForceStats operator()(std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& memory);
+  /// body(first, last) over ranges that split [0, n) into one per chunk, on the calling thread and
+  /// the helpers; returns when all are done. Fewer than kParallelNodesFrom, or no helper: one call.
+  void for_ranges(std::size_t n, const std::function<void(std::size_t first, std::size_t last)>& body);
   /// After the model's mesh changed (a cut): the nodes each chunk writes to, found again.
   void follow_model();
 
@@ -44,12 +54,14 @@ class ParallelForces {
   void helper();
   /// Takes chunks of evaluation `generation` until none is left.
   void take_chunks(std::uint64_t generation);
+  /// job(0) on the calling thread; job(1 .. chunks-1) on whichever thread takes it first (the
+  /// caller too, once its own is done). Returns when every chunk is done.
+  void run(const std::function<void(std::size_t chunk)>& job);
 
   const tissue::ForceModel& model_;
   const std::size_t chunks_;
-  // The evaluation in progress: written by the calling thread before it publishes the generation.
-  std::span<const tissue::Vec3> x_;
-  tissue::MemoryUpdate memory_;
+  // The work in progress: written by the calling thread before it publishes the generation.
+  const std::function<void(std::size_t chunk)>* job_ = nullptr;
   std::vector<std::vector<tissue::Vec3>> buffers_;  // chunks 1 .. chunks-1, a force per node of the model
   // The nodes chunk c writes to, [first, second): only those of its buffer are cleared and added.
   std::vector<std::pair<std::size_t, std::size_t>> ranges_;

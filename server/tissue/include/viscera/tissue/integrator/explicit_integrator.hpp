@@ -62,6 +62,11 @@ class ExplicitIntegrator {
   /// forces to f (up to rounding) and advance the memory as add_forces does. Empty: the default.
   using ForceEvaluation = std::function<ForceStats(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory)>;
   void set_force_evaluation(ForceEvaluation evaluation) { evaluate_ = std::move(evaluation); }
+  /// How the nodes' update is run: by default on the calling thread; a caller may split [0, n) into
+  /// ranges on threads. It must call `update` on ranges that cover [0, n) once each and return when
+  /// all are done (each node's update depends on that node alone: the same bits for any split).
+  using NodeLoop = std::function<void(std::size_t n, const std::function<void(std::size_t first, std::size_t last)>& update)>;
+  void set_node_loop(NodeLoop loop) { for_nodes_ = std::move(loop); }
 
   /// The boundary conditions (their force field may be changed between steps).
   BoundaryConditions& boundary_conditions() { return bc_; }
@@ -99,6 +104,7 @@ class ExplicitIntegrator {
   std::vector<Vec3> inv_mass_;  // per coordinate; 0 where constrained
   std::vector<Vec3> gravity_;  // m g per node
   ForceEvaluation evaluate_;
+  NodeLoop for_nodes_;
   std::function<bool()> interrupted_;
   MassScaling scaling_;
   StableStep critical_{};
