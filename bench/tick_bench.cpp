@@ -2,6 +2,7 @@
 // scaling, fixed slab) advanced by one tick, 1 / physics_rate_hz, in the integrator's equal
 // sub-steps, with the internal forces on one thread and on the scene's threads. No DDS, no
 // instruments: what the tick costs before anything else shares the cores (docs/PERFORMANCE.md).
+// Elements/... and NodesOnly/...: the element loop alone, and the tick without it (the serial share).
 // Material/...: the same tick with the organ switched to each mechanism the lab can hand over.
 // Run: build/bench/tick_bench [--benchmark_filter=liver-12k]
 #include <cmath>

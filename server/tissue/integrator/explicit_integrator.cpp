@@ -89,7 +89,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
   x_prev_.resize(n);
   v_prev_.resize(n);
   const double damping = std::exp(-options_.mass_damping_per_s * dt);
-  // One pass over the nodes: the state this step starts from is kept (the roll-back's), then moved.
+  // Each range of nodes: the state this step starts from is kept (the roll-back's), then moved.
   const auto update = [&](std::size_t first, std::size_t last) {
     Vec3* x = state.x.data();
     Vec3* v = state.v.data();
