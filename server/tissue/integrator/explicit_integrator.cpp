@@ -49,12 +49,10 @@ void ExplicitIntegrator::step(State& state) { step_with(state, dt_); }
 
 void ExplicitIntegrator::step_with(State& state, double dt) {
   const std::size_t n = mass_.size();
-  if (bc_.nodal_forces.empty()) {
+  if (bc_.nodal_forces.empty())
     std::copy(gravity_.begin(), gravity_.end(), force_.begin());
-  } else {
-    const double amplitude = bc_.force_amplitude ? bc_.force_amplitude(state.time_s) : 1.0;
-    for (std::size_t i = 0; i < n; ++i) force_[i] = gravity_[i] + (bc_.force_amplitude ? Vec3(amplitude * bc_.nodal_forces[i]) : bc_.nodal_forces[i]);
-  }
+  else
+    for (std::size_t i = 0; i < n; ++i) force_[i] = gravity_[i] + bc_.nodal_force(i, state.time_s);
   // Memory variables advance in place from their last evaluation to this one (a second buffer
   // would cost a third memory stream; see docs/PERFORMANCE.md). If the step then fails the
   // instability check, positions and velocities roll back but the memory stays advanced (the
