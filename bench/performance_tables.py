@@ -32,23 +32,31 @@ def tick(path):
             "|---|---|---|---|---|---|---|---|---|---|"]
     med = {b["run_name"].removesuffix("/real_time"): b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
     scenes = sorted({n.split("/")[1] for n in med if n.startswith("Tick/")})
+    us = lambda b: f"{b['real_time']:.0f}" if b else "-"
     for s in scenes:
         one, two = med.get(f"Tick/{s}/threads:1"), med.get(f"Tick/{s}/threads:2")
         ref = one or two
         if not ref:
             continue
-        us = lambda b: f"{b['real_time']:.0f}" if b else "-"
-        elements, rest1, rest2 = med.get(f"Elements/{s}"), med.get(f"NodesOnly/{s}/threads:1"), med.get(f"NodesOnly/{s}/threads:2")
-        nodes = f"{int(rest1['nodes'])}" if rest1 else "-"
-        # What a tick on one thread spends outside the element loop: the tick less its sub-steps'
-        # element loops (includes the chunks' reduction and hand-over), and the node work alone.
+        elements, rest1, rest2 = med.get(f"Elements/{s}"), med.get(f"Serial/{s}/threads:1"), med.get(f"Serial/{s}/threads:2")
+        node_work = med.get(f"NodesOnly/{s}/threads:1")
+        nodes = f"{int(ref['nodes'])}" if "nodes" in ref else "-"
+        # What a tick on one thread spends outside its element loops, measured directly (Serial:
+        # the tick with a model that adds nothing), and of it the node work alone (NodesOnly).
         share = "-"
-        if one and elements and rest1:
-            outside = 1 - ref["sub_steps"] * elements["real_time"] / one["real_time"]
-            share = f"{100 * outside:.1f}% ({100 * rest1['real_time'] / one['real_time']:.1f}% node work)"
+        if one and rest1:
+            share = f"{100 * rest1['real_time'] / one['real_time']:.1f}%"
+            if node_work:
+                share += f" ({100 * node_work['real_time'] / one['real_time']:.1f}% node work)"
         rows.append(f"| {s} | {int(ref['tets'])} | {nodes} | {int(ref['sub_steps'])} | {us(one)} | {us(two)} | {ref['tick_budget_us']:.0f} "
                     f"| {us(elements)} | {us(rest1)} / {us(rest2)} | {share} |")
-    return f"Run of {ctx.get('date', '?')[:16]} (`bench/tick.sh`), {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, medians of 3:\n\n" + "\n".join(rows) + "\n"
+    text = f"Run of {ctx.get('date', '?')[:16]} (`bench/tick.sh`), {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz, medians of 3:\n\n" + "\n".join(rows) + "\n"
+    many = [med.get(f"{k}/liver-96k/chunks:16/threads:{t}") for k in ("Serial", "SerialSummedFirst") for t in (1, 2)]
+    if all(many):
+        text += (f"\nThe 96k tick without its element loop with 16 chunks (as on 16 threads), on 1 / 2 threads: {us(many[0])} / {us(many[1])} us "
+                 f"with the buffers summed in the node update's ranges (the server's way), {us(many[2])} / {us(many[3])} us summed "
+                 f"by the calling thread before it.\n")
+    return text
 
 
 def materials(path):

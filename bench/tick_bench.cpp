@@ -2,11 +2,15 @@
 // scaling, fixed slab) advanced by one tick, 1 / physics_rate_hz, in the integrator's equal
 // sub-steps, with the internal forces on one thread and on the scene's threads. No DDS, no
 // instruments: what the tick costs before anything else shares the cores (docs/PERFORMANCE.md).
-// Elements/... and NodesOnly/...: the element loop alone, and the tick without it (the serial share).
+// Elements/..., NodesOnly/... and Serial/...: the element loop alone, the tick without it, and the
+// tick without it but with the force threads' hand-over and buffers (the serial share).
 // Material/...: the same tick with the organ switched to each mechanism the lab can hand over.
 // Run: build/bench/tick_bench [--benchmark_filter=liver-12k]
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,6 +18,7 @@
 
 #include "viscera/common/json_input.hpp"
 #include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/parallel_forces.hpp"
 #include "viscera/runtime/scene_file.hpp"
 
 namespace {
@@ -67,6 +72,46 @@ void nodes_only(benchmark::State& st, const std::string& scene_name, int threads
   const auto organ = runtime::build_organ(scene);
   organ->integrator->set_force_evaluation(
       [](std::span<const tissue::Vec3>, std::span<tissue::Vec3>, const tissue::MemoryUpdate&) { return tissue::ForceStats{}; });
+  run_ticks(st, *organ, scene.physics_rate_hz, 1.0);
+}
+
+/// A model with the elements of `model` that adds nothing: ParallelForces over it does all it does
+/// for the real one (the chunks' hand-over, the clearing and the sum of their buffers) but the
+/// elements' work.
+class NoElementWork final : public tissue::ForceModel {
+ public:
+  NoElementWork(std::shared_ptr<const tissue::TetMesh> mesh, const tissue::ForceModel& model) : ForceModel(std::move(mesh)), model_(model) {}
+  std::string_view name() const override { return "no-element-work"; }
+  tissue::ForceStats add_forces(std::span<const tissue::Vec3>, std::span<tissue::Vec3>) const override { return {}; }
+  tissue::ForceStats add_forces(std::span<const tissue::Vec3>, std::span<tissue::Vec3>, const tissue::MemoryUpdate&,
+                                tissue::ElementPart) const override {
+    return {};
+  }
+  std::pair<std::size_t, std::size_t> part_elements(tissue::ElementPart part) const override { return model_.part_elements(part); }
+  double energy(std::span<const tissue::Vec3>) const override { return 0.0; }
+  tissue::Mat12 element_tangent(std::span<const tissue::Vec3>, std::size_t) const override { return tissue::Mat12::Zero(); }
+
+ private:
+  const tissue::ForceModel& model_;
+};
+
+/// The tick of `scene` on `threads` with the organ's force threads evaluating a model that adds
+/// nothing: all of the tick but its element loops, the force threads' hand-over, clearing and sum
+/// of their buffers included. On one thread, divided by the tick, the tick's serial share measured
+/// directly. `chunks`: as many as the server cuts on 16 threads, say; `summed_first`: the buffers
+/// summed by the calling thread before the node loop instead of in its ranges (as before 2026-11-29).
+void serial(benchmark::State& st, const std::string& scene_name, int threads, int chunks, bool summed_first) {
+  runtime::SceneSpec scene = runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
+  scene.physics_threads = threads;
+  const auto organ = runtime::build_organ(scene);
+  const NoElementWork none(organ->mesh, *organ->model);
+  runtime::ParallelForces forces(none, threads, chunks);
+  organ->integrator->set_force_evaluation(
+      [&forces, summed_first](std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& m) {
+        return summed_first ? forces(x, f, m) : forces.evaluate_leaving_sums(x, f, m);
+      });
+  organ->integrator->set_node_loop(
+      [&forces](std::size_t n, const std::function<void(std::size_t, std::size_t)>& update) { forces.for_ranges(n, update); });
   run_ticks(st, *organ, scene.physics_rate_hz, 1.0);
 }
 
@@ -126,10 +171,24 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMicrosecond)
           ->UseRealTime();
     for (const int threads : {1, 2})
+      benchmark::RegisterBenchmark(("Serial/" + scene + "/threads:" + std::to_string(threads)).c_str(), serial, scene, threads,
+                                   std::max(runtime::kForceChunks, threads), false)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
+    for (const int threads : {1, 2})
       benchmark::RegisterBenchmark(("Tick/" + scene + "/threads:" + std::to_string(threads)).c_str(), tick, scene, threads)
           ->Unit(benchmark::kMicrosecond)
           ->UseRealTime();
   }
+  // The hand-over and the buffers with the 16 chunks of 16 threads, on one and two: their sum in
+  // the node loop's ranges against on the calling thread before it.
+  for (const bool summed_first : {false, true})
+    for (const int threads : {1, 2})
+      benchmark::RegisterBenchmark(
+          ((summed_first ? "SerialSummedFirst" : "Serial") + std::string("/liver-96k/chunks:16/threads:") + std::to_string(threads)).c_str(), serial,
+          "liver-96k", threads, 16, summed_first)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
   for (const std::string scene : {"liver", "liver-12k"})
     for (const MaterialVariant& v : material_variants())
       benchmark::RegisterBenchmark(("Material/" + std::string(v.name) + "/" + scene).c_str(), tick_with_material, scene, v)

@@ -88,8 +88,9 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   check_tick_budget(organ.integrator->dt_s(), 0, rate_hz, budget, source, field);
   // The same chunks on any number of threads: the same bits (a session re-simulates on another).
   organ.parallel_forces = std::make_unique<ParallelForces>(*organ.model, s.physics_threads, std::max(kForceChunks, s.physics_threads));
-  organ.integrator->set_force_evaluation(
-      [p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return (*p)(x, f, m); });
+  organ.integrator->set_force_evaluation([p = organ.parallel_forces.get()](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) {
+    return p->evaluate_leaving_sums(x, f, m);
+  });
   organ.integrator->set_node_loop(
       [p = organ.parallel_forces.get()](std::size_t n, const std::function<void(std::size_t, std::size_t)>& update) { p->for_ranges(n, update); });
   // The compliance predicts the simulated response, so it sees the same inertia.

@@ -109,10 +109,11 @@ void ParallelForces::helper() {
   }
 }
 
-ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
+ForceStats ParallelForces::evaluate(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
   // The model's mesh is not read here: a material being built on another thread may share it. A
   // cut is reported (follow_model); forces for more nodes than the buffers hold follow it too.
   if (!buffers_.empty() && buffers_[0].size() != f.size()) follow_model();
+  unsummed_ = {};
   run([&](std::size_t c) {
     if (c == 0) {
       stats_[0] = model_.add_forces(x, f, memory, ElementPart{0, chunks_});
@@ -124,20 +125,44 @@ ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f
   });
   double worst = stats_[0].max_edge_strain;
   for (std::size_t c = 1; c < chunks_; ++c) {
-    const auto& b = buffers_[c - 1];
-    for (std::size_t i = ranges_[c].first; i < ranges_[c].second; ++i) f[i] += b[i];
     const double s = stats_[c].max_edge_strain;
     worst = std::isnan(s) || std::isnan(worst) ? std::numeric_limits<double>::quiet_NaN() : std::max(worst, s);
   }
   return {worst};
 }
 
+void ParallelForces::add_buffers(std::span<Vec3> f, std::size_t first, std::size_t last) const {
+  for (std::size_t c = 1; c < chunks_; ++c) {
+    const Vec3* b = buffers_[c - 1].data();
+    for (std::size_t i = std::max(first, ranges_[c].first), end = std::min(last, ranges_[c].second); i < end; ++i) f[i] += b[i];
+  }
+}
+
+ForceStats ParallelForces::operator()(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
+  const ForceStats stats = evaluate(x, f, memory);
+  add_buffers(f, 0, f.size());
+  return stats;
+}
+
+ForceStats ParallelForces::evaluate_leaving_sums(std::span<const Vec3> x, std::span<Vec3> f, const tissue::MemoryUpdate& memory) {
+  const ForceStats stats = evaluate(x, f, memory);
+  unsummed_ = f;
+  return stats;
+}
+
 void ParallelForces::for_ranges(std::size_t n, const std::function<void(std::size_t first, std::size_t last)>& body) {
+  const std::span<Vec3> f = unsummed_;
+  unsummed_ = {};
+  if (!f.empty() && f.size() != n) throw std::logic_error("ParallelForces::for_ranges: the node count is not that of the forces left to sum");
+  const auto sum_then_body = [&](std::size_t first, std::size_t last) {
+    if (!f.empty()) add_buffers(f, first, last);
+    body(first, last);
+  };
   if (helpers_.empty() || n < kParallelNodesFrom) {
-    body(0, n);
+    sum_then_body(0, n);
     return;
   }
-  run([&](std::size_t c) { body(n * c / chunks_, n * (c + 1) / chunks_); });
+  run([&](std::size_t c) { sum_then_body(n * c / chunks_, n * (c + 1) / chunks_); });
 }
 
 }  // namespace viscera::runtime

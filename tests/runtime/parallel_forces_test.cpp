@@ -133,7 +133,10 @@ TEST(ParallelForces, AnExplicitRunOnTwoThreadsFollowsTheOneThreadRun) {
 }
 
 // The integrator's node update split over the threads (an organ of more than kParallelNodesFrom
-// nodes) gives the same bits as the update in one piece: each node's update reads that node alone.
+// nodes), each range adding the chunks' buffers over its own nodes first (as the server runs it),
+// gives the same bits as one thread with the same chunks: each node's update reads that node alone
+// and its sum takes the chunks in one order. Against the buffers summed before the node loop (the
+// force field added after them instead of before): equal without the field, to rounding with it.
 // With a contact-like field on some nodes (their implicit springs and dashpots) and without.
 TEST(ParallelForces, TheNodeUpdateSplitOverThreadsGivesTheSameBits) {
   const auto mesh = std::make_shared<TetMesh>(ordered_for_locality(make_box_mesh(Vec3(0, 0, 0), Vec3(0.12, 0.05, 0.04), 36, 16, 14)));
@@ -156,11 +159,13 @@ TEST(ParallelForces, TheNodeUpdateSplitOverThreadsGivesTheSameBits) {
         for (std::size_t i = 0; i < e.x.size(); i += 5) e.damping[i] += 0.2;
       };
     const std::vector<double> rho(mesh->tet_count(), 1060.0);
-    ExplicitIntegrator whole(*model, rho, bc), split(*model, rho, bc);
-    ParallelForces parallel(*model, 3, 3);
-    const auto forces = [&](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return parallel(x, f, m); };
-    whole.set_force_evaluation(forces);
-    split.set_force_evaluation(forces);
+    ExplicitIntegrator whole(*model, rho, bc), split(*model, rho, bc), summed_first(*model, rho, bc);
+    ParallelForces one(*model, 1, 3), parallel(*model, 3, 3);
+    whole.set_force_evaluation([&](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return one.evaluate_leaving_sums(x, f, m); });
+    whole.set_node_loop([&](std::size_t n, const std::function<void(std::size_t, std::size_t)>& update) { one.for_ranges(n, update); });
+    split.set_force_evaluation(
+        [&](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return parallel.evaluate_leaving_sums(x, f, m); });
+    summed_first.set_force_evaluation([&](std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& m) { return parallel(x, f, m); });
     std::vector<std::pair<std::size_t, std::size_t>> ranges;
     split.set_node_loop([&](std::size_t n, const std::function<void(std::size_t, std::size_t)>& update) {
       std::mutex m;
@@ -172,15 +177,22 @@ TEST(ParallelForces, TheNodeUpdateSplitOverThreadsGivesTheSameBits) {
         update(first, last);
       });
     });
-    State a = State::at_rest(*mesh), b = a;
+    State a = State::at_rest(*mesh), b = a, c = a;
     const long steps = whole.advance(a, 0.01);
     ASSERT_EQ(split.advance(b, 0.01), steps);
+    ASSERT_EQ(summed_first.advance(c, 0.01), steps);
     double sag = 0;
     for (std::size_t i = 0; i < a.x.size(); ++i) sag = std::max(sag, (a.x[i] - mesh->nodes[i]).norm());
     EXPECT_GT(sag, 1e-5) << "the bar sags";
     EXPECT_EQ(a.x, b.x) << (field ? "with the field" : "without");
     EXPECT_EQ(a.v, b.v) << (field ? "with the field" : "without");
     EXPECT_EQ(a.memory, b.memory);
+    double d = 0;
+    for (std::size_t i = 0; i < a.x.size(); ++i) d = std::max(d, (a.x[i] - c.x[i]).norm());
+    if (field)
+      EXPECT_LT(d, 1e-10 * sag);
+    else
+      EXPECT_EQ(d, 0.0) << "the buffers summed in the node loop or before it: the same sums";
     // Every sub-step split [0, n) into three ranges that cover it.
     ASSERT_EQ(ranges.size(), 3 * static_cast<std::size_t>(steps));
     std::sort(ranges.begin(), ranges.end());

@@ -14,10 +14,14 @@
 // A helper that is late (the machine's other core busy) costs nothing but the buffers: the
 // calling thread then takes its chunks. Helpers sleep between evaluations (no spinning); the
 // caller, waiting for a helper's chunk, spins briefly and then sleeps.
-// The same threads split the integrator's node update (for_ranges) on a large organ.
+// The same threads split the integrator's node update (for_ranges) on a large organ. The server
+// leaves the buffers' sum to that loop (evaluate_leaving_sums): each range adds them over its own
+// nodes before it moves them, so the sum is split with the nodes instead of taking one thread a
+// pass per buffer; per node it adds the chunks in the same order, whatever the split.
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -44,8 +48,13 @@ class ParallelForces {
 
   /// f += the model's internal forces at x, memory advanced (as ForceModel::add_forces).
   tissue::ForceStats operator()(std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& memory);
+  /// The same, but the chunks' buffers are not yet added to f: the next for_ranges adds them,
+  /// range by range, before its body. Until then f holds only chunk 0's forces (and what the
+  /// caller adds).
+  tissue::ForceStats evaluate_leaving_sums(std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& memory);
   /// body(first, last) over ranges that split [0, n) into one per chunk, on the calling thread and
   /// the helpers; returns when all are done. Fewer than kParallelNodesFrom, or no helper: one call.
+  /// After evaluate_leaving_sums (n then the size of its f), each range first adds the buffers.
   void for_ranges(std::size_t n, const std::function<void(std::size_t first, std::size_t last)>& body);
   /// After the model's mesh changed (a cut): the nodes each chunk writes to, found again.
   void follow_model();
@@ -57,6 +66,10 @@ class ParallelForces {
   /// job(0) on the calling thread; job(1 .. chunks-1) on whichever thread takes it first (the
   /// caller too, once its own is done). Returns when every chunk is done.
   void run(const std::function<void(std::size_t chunk)>& job);
+  /// The chunks computed, chunk 0 into f, the others into their buffers; the stats combined.
+  tissue::ForceStats evaluate(std::span<const tissue::Vec3> x, std::span<tissue::Vec3> f, const tissue::MemoryUpdate& memory);
+  /// f[i] += every buffer's force at i, for i in [first, last), in chunk order.
+  void add_buffers(std::span<tissue::Vec3> f, std::size_t first, std::size_t last) const;
 
   const tissue::ForceModel& model_;
   const std::size_t chunks_;
@@ -66,6 +79,7 @@ class ParallelForces {
   // The nodes chunk c writes to, [first, second): only those of its buffer are cleared and added.
   std::vector<std::pair<std::size_t, std::size_t>> ranges_;
   std::vector<tissue::ForceStats> stats_;
+  std::span<tissue::Vec3> unsummed_;  // the f of evaluate_leaving_sums, until for_ranges adds its buffers
   // next_: generation in the high 32 bits, next chunk in the low 32; taken by compare-exchange so
   // a helper still in an old evaluation never takes a chunk of a new one.
   std::atomic<std::uint64_t> next_{0};

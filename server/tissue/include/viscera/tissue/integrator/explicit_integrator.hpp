@@ -59,12 +59,15 @@ class ExplicitIntegrator {
 
   /// How internal forces are evaluated: by default model.add_forces on the calling thread; a caller
   /// may split them over threads (server/runtime/parallel_forces.hpp). It must add the model's
-  /// forces to f (up to rounding) and advance the memory as add_forces does. Empty: the default.
+  /// forces to f (up to rounding) and advance the memory as add_forces does. It may leave parts of
+  /// the forces for the node loop below to add: between the two the integrator only adds to f (the
+  /// force field), and it reads f[i] only in node i's update. Empty: the default.
   using ForceEvaluation = std::function<ForceStats(std::span<const Vec3> x, std::span<Vec3> f, const MemoryUpdate& memory)>;
   void set_force_evaluation(ForceEvaluation evaluation) { evaluate_ = std::move(evaluation); }
   /// How the nodes' update is run: by default on the calling thread; a caller may split [0, n) into
   /// ranges on threads. It must call `update` on ranges that cover [0, n) once each and return when
   /// all are done (each node's update depends on that node alone: the same bits for any split).
+  /// Before it calls `update` on a range, it adds to f there what the force evaluation left.
   using NodeLoop = std::function<void(std::size_t n, const std::function<void(std::size_t first, std::size_t last)>& update)>;
   void set_node_loop(NodeLoop loop) { for_nodes_ = std::move(loop); }
 
