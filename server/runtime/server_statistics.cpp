@@ -40,18 +40,19 @@ protocol::TelemetryReport telemetry_report(const ServerStats& s, std::int64_t st
           s.rejected_other_participant};
 }
 
-std::string status_line(const ServerStats& s, bool paused, int instruments_in_use, double max_force_n) {
+std::string status_line(const ServerStats& s, bool paused, int instruments_in_use, double max_force_n, double max_tip_strain) {
   char line[500];
   using ull = unsigned long long;
   std::snprintf(line, sizeof line,
                 "%.0f Hz physics%s, step p50 %.0f us p99 %.0f us max %.0f us, jitter p99 %.0f us, late ticks %llu, missed slots %llu, "
-                "%d instruments in use, |F| %.3f N, rejected %llu (malformed %llu, not owner %llu, unknown instrument %llu, another participant's "
+                "%d instruments in use, |F| %.3f N, tip strain %.3f, rejected %llu (malformed %llu, not owner %llu, unknown instrument %llu, another "
+                "participant's "
                 "client id %llu), physics resets %llu, "
                 "mesh frames %llu (%llu skipped)",
                 s.rate_hz, paused ? " (paused)" : "", s.step_p50_us, s.step_p99_us, s.step_max_us, s.jitter_p99_us, ull(s.late_ticks),
-                ull(s.missed_slots), instruments_in_use, max_force_n, ull(s.rejected), ull(s.rejected_malformed), ull(s.rejected_not_owner),
-                ull(s.rejected_unknown_instrument), ull(s.rejected_other_participant), ull(s.physics_resets), ull(s.mesh_frames),
-                ull(s.mesh_frames_skipped));
+                ull(s.missed_slots), instruments_in_use, max_force_n, max_tip_strain, ull(s.rejected), ull(s.rejected_malformed),
+                ull(s.rejected_not_owner), ull(s.rejected_unknown_instrument), ull(s.rejected_other_participant), ull(s.physics_resets),
+                ull(s.mesh_frames), ull(s.mesh_frames_skipped));
   return line;
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <thread>
 
@@ -252,12 +253,13 @@ void SimulationServer::Impl::collect_counts() {
 
 std::string SimulationServer::Impl::status_now() const {
   int in_use = 0;
-  double fmax = 0;
+  double fmax = 0, strain = 0;
   for (const auto& [id, t] : tools) {
     in_use += t.tool.active();
     fmax = std::max(fmax, t.result.force_on_tool.norm());
+    if (t.result.in_contact && std::isfinite(t.result.tip_strain)) strain = std::max(strain, t.result.tip_strain);
   }
-  return status_line(stats, paused, in_use, fmax);
+  return status_line(stats, paused, in_use, fmax, strain);
 }
 
 SimulationServer::SimulationServer(const SceneSpec& scene, ServerEndpoints& endpoints, const std::string& scene_dir, const TickBudget& budget,

@@ -143,6 +143,21 @@ for live in sorted(glob.glob(f"{tmp}/live-*/*.json")):
         print(f"FAIL {name}: {a['metrics']['force_samples_without_command']} forces without their command")
 sys.exit(0 if ok else 1)
 PY
+# The server's status line carries the largest tissue strain at an instrument: 0 before any client
+# came, positive while one held the tissue, and never above what the trainers received, tick by
+# tick, in their forces (10% and a thousandth of slack: the lines sample the same measure; one
+# 2 s hold below has no report, at the drill's own force).
+pycheck "$tmp" <<'PY'
+import glob, json, re, sys
+tmp = sys.argv[1]
+lines = [float(m) for m in re.findall(r"Hz physics.*, tip strain ([0-9.]+), rejected", open(f"{tmp}/server.log").read())]
+received = max(json.load(open(f))["metrics"]["max_tip_strain"] for f in glob.glob(f"{tmp}/live-*/*.json"))
+assert len(lines) > 30, f"{len(lines)} status lines with a tip strain"
+assert lines[0] == 0.0, f"the first status line, before any client, gives tip strain {lines[0]}"
+assert max(lines) > 0.01, f"no status line shows the tissue strained (largest {max(lines)})"
+assert max(lines) <= 1.1 * received + 1e-3, f"a status line gives tip strain {max(lines)}, the trainers received at most {received}"
+print(f"[ figure ] status lines: tip strain up to {max(lines):.3f}, {sum(1 for x in lines if x > 0)} of {len(lines)} lines positive; trainers received up to {received:.3f}")
+PY
 check "server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
 
 # Bad exercise files: one line naming the file and the field, exit 2.

@@ -55,9 +55,10 @@ TEST(ServerStatistics, TelemetryAndStatusCarryTheCounts) {
   EXPECT_EQ(t.rejected_messages, 12u);
   EXPECT_EQ(t.rejected_other_participant, 4u);
   EXPECT_EQ(t.rejected_malformed + t.rejected_not_owner + t.rejected_unknown_instrument + t.rejected_other_participant, t.rejected_messages);
-  const std::string line = status_line(s, true, 2, 1.25);
+  const std::string line = status_line(s, true, 2, 1.25, 0.12);
   EXPECT_NE(line.find("999 Hz physics (paused)"), std::string::npos) << line;
-  EXPECT_NE(line.find("late ticks 7, missed slots 3, 2 instruments in use, |F| 1.250 N, rejected 12 (malformed 5, not owner 2, unknown instrument 1, "
+  EXPECT_NE(line.find("late ticks 7, missed slots 3, 2 instruments in use, |F| 1.250 N, tip strain 0.120, rejected 12 (malformed 5, not owner 2, "
+                      "unknown instrument 1, "
                       "another participant's client id 4)"),
             std::string::npos)
       << line;

@@ -42,7 +42,9 @@ class ServerStatistics {
 
 protocol::TelemetryReport telemetry_report(const ServerStats& s, std::int64_t stamp_ns);
 /// The status line: rate (and "paused"), step and jitter percentiles, late ticks and missed slots,
-/// instruments in use, the largest force on a tool [N], rejections by reason, resets, mesh frames.
-std::string status_line(const ServerStats& s, bool paused, int instruments_in_use, double max_force_n);
+/// instruments in use, the largest force on a tool [N] and the largest tissue strain at one (the
+/// strain a trainer scores, docs/TRAINING.md; 0 with none in contact), rejections by reason,
+/// resets, mesh frames.
+std::string status_line(const ServerStats& s, bool paused, int instruments_in_use, double max_force_n, double max_tip_strain);
 
 }  // namespace viscera::runtime
