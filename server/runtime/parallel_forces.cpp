@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -114,7 +115,7 @@ ForceStats ParallelForces::evaluate(std::span<const Vec3> x, std::span<Vec3> f, 
   // cut is reported (follow_model); forces for more nodes than the buffers hold follow it too.
   if (!buffers_.empty() && buffers_[0].size() != f.size()) follow_model();
   unsummed_ = {};
-  run([&](std::size_t c) {
+  const auto job = [&](std::size_t c) {
     if (c == 0) {
       stats_[0] = model_.add_forces(x, f, memory, ElementPart{0, chunks_});
       return;
@@ -122,7 +123,8 @@ ForceStats ParallelForces::evaluate(std::span<const Vec3> x, std::span<Vec3> f, 
     auto& buffer = buffers_[c - 1];
     std::fill(buffer.begin() + static_cast<long>(ranges_[c].first), buffer.begin() + static_cast<long>(ranges_[c].second), Vec3::Zero());
     stats_[c] = model_.add_forces(x, buffer, memory, ElementPart{c, chunks_});
-  });
+  };
+  run(std::cref(job));  // by reference: a std::function holding the closure itself would allocate every sub-step
   double worst = stats_[0].max_edge_strain;
   for (std::size_t c = 1; c < chunks_; ++c) {
     const double s = stats_[c].max_edge_strain;
@@ -162,7 +164,8 @@ void ParallelForces::for_ranges(std::size_t n, const std::function<void(std::siz
     sum_then_body(0, n);
     return;
   }
-  run([&](std::size_t c) { sum_then_body(n * c / chunks_, n * (c + 1) / chunks_); });
+  const auto job = [&](std::size_t c) { sum_then_body(n * c / chunks_, n * (c + 1) / chunks_); };
+  run(std::cref(job));
 }
 
 }  // namespace viscera::runtime

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 
@@ -115,7 +116,7 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
     }
   };
   if (for_nodes_)
-    for_nodes_(n, update);
+    for_nodes_(n, std::cref(update));  // by reference: no allocation a sub-step
   else
     update(0, n);
   const double t1 = state.time_s + dt;
