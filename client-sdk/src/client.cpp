@@ -42,7 +42,7 @@ struct Client::Impl {
   std::unique_ptr<proto::TypedReader<proto::Stream::surface_topology>> topology;  // created on first use
   std::unique_ptr<proto::TypedReader<proto::Stream::mesh_frame>> frames;
   std::unique_ptr<proto::TypedReader<proto::Stream::event>> events;
-  std::unique_ptr<proto::TypedReader<proto::Stream::telemetry>> telemetry;
+  std::unique_ptr<proto::TypedReader<proto::Stream::telemetry>> telemetry;  // created with the client: its liveliness counts
   proto::Rejections rejections;  // payloads of every stream that failed their decoder
   std::unique_ptr<proto::Writer> annotations;
   std::atomic<bool> sessions_settled{false};
@@ -55,11 +55,14 @@ struct Client::Impl {
   }
   proto::SurfaceAssembler surfaces;  // whole surfaces from whole ones and patches (schema 16)
   // The server's presence, from the DDS liveliness of its writers that this client reads: the
-  // scene state (written only on a change) and the forces (1 kHz while an instrument is driven).
-  // A server silent for the lease loses the liveliness of all of them; when it speaks again, DDS
-  // gives it back writer by writer, as each one writes: its forces at once, its scene state only
-  // at the next change. So either one alive means the server is there. Set by DDS listener threads.
-  std::atomic<int> scene_writers{0}, force_writers{0};
+  // scene state (written only on a change), the forces (1 kHz while an instrument is driven) and
+  // the telemetry (once a second, always). A server silent for the lease loses the liveliness of
+  // all of them; when it speaks again, DDS gives it back writer by writer, as each one writes: its
+  // forces at once if an instrument is driven, its telemetry within a second, its scene state only
+  // at the next change. So any one alive means the server is there. The telemetry is what brings
+  // it back when nothing is driven: after a stall of this client's own (the server heard nothing
+  // for its lease and freed the instrument, so no force comes). Set by DDS listener threads.
+  std::atomic<int> scene_writers{0}, force_writers{0}, telemetry_writers{0};
   std::atomic<ServerState> server{ServerState::waiting};
   std::atomic<std::int64_t> lost_ns{0};
   std::atomic<bool> server_was_lost{false};  // set on a loss, taken by take_scene()
@@ -75,13 +78,19 @@ struct Client::Impl {
       force_writers = alive;
       liveliness();
     });
+    telemetry = std::make_unique<proto::TypedReader<proto::Stream::telemetry>>(participant);
+    telemetry->raw().on_alive_writers_changed([this](int alive) {
+      telemetry_writers = alive;
+      liveliness();
+    });
     scene_writers = scene.alive_writers();  // a server discovered before the listeners were set
     force_writers = forces.alive_writers();
+    telemetry_writers = telemetry->alive_writers();
     liveliness();
   }
   void liveliness() {
     std::lock_guard lock(callback_mutex);
-    const bool alive = scene_writers.load() + force_writers.load() > 0;
+    const bool alive = scene_writers.load() + force_writers.load() + telemetry_writers.load() > 0;
     const ServerState before = server.load();
     const ServerState now = alive ? ServerState::alive : before == ServerState::waiting ? ServerState::waiting : ServerState::lost;
     if (now == before) return;
@@ -363,7 +372,6 @@ std::vector<proto::Event> Client::poll_events() {
 }
 
 std::vector<proto::TelemetryReport> Client::poll_telemetry() {
-  if (!impl_->telemetry) impl_->telemetry = std::make_unique<proto::TypedReader<proto::Stream::telemetry>>(impl_->participant);
   std::vector<proto::TelemetryReport> out;
   impl_->telemetry->take([&](proto::TelemetryReport t, const proto::Received&) { out.push_back(t); }, impl_->rejections);
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.server_stamp_ns < b.server_stamp_ns; });

@@ -1,6 +1,10 @@
 #include "viscera/client/device_loop.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
+
+#include "viscera/protocol/dds.hpp"
 
 namespace viscera::client {
 
@@ -12,6 +16,8 @@ std::string line(const char* format, A... a) {
   return b;
 }
 void add(std::string& note, const std::string& more) { note += note.empty() ? more : "\n" + more; }
+// [s] the liveliness lease, which is also the server's lease on a silent owner's instrument
+const double kLeaseS = std::chrono::duration<double>(viscera::protocol::kLivelinessLease).count();
 }  // namespace
 
 DeviceLoop::DeviceLoop(const DeviceLoopOptions& options, std::uint32_t generation)
@@ -21,10 +27,21 @@ bool DeviceLoop::scene_check_due(double t_s) const { return t_s - last_scene_che
 
 DeviceLoop::Step DeviceLoop::next(double t, ServerState server, const std::optional<InstrumentView>& scene) {
   Step s;
+  // A gap between two periods longer than the lease: this process did not run (stopped, starved,
+  // swapped out). The server heard nothing from it meanwhile and may have freed its instrument; and
+  // this process's DDS may call the server gone until it hears from it again.
+  if (last_t_ >= 0 && t - last_t_ > kLeaseS) {
+    stall_s_ = std::max(stall_s_, t - last_t_);
+    stall_end_t_ = t;
+    add(s.note, line("t = %5.2f s  this process did not run for %.2f s, longer than the server's %.1f s lease", t, t - last_t_, kLeaseS));
+  }
+  last_t_ = t;
   if (server == ServerState::lost && server_lost_t_ < 0) {
     server_lost_t_ = t;
     renderer_.server_lost(t);
-    add(s.note, line("t = %5.2f s  the server is gone (no DDS liveliness); the force fades to zero over %.2f s", t, o_.fade.fade_s));
+    const bool after_stall = stall_end_t_ >= 0 && t - stall_end_t_ < kLeaseS;
+    add(s.note, line("t = %5.2f s  the server is gone (no DDS liveliness%s); the force fades to zero over %.2f s", t,
+                     after_stall ? ", just after this process's own stall: it may be there still" : "", o_.fade.fade_s));
   }
   if (lost_) {  // the period after the force reached zero: it was rendered
     s.action = Action::end;
@@ -44,22 +61,30 @@ DeviceLoop::Step DeviceLoop::next(double t, ServerState server, const std::optio
     last_scene_check_ = t;
     if (scene->generation == generation_) {
       const bool taken = scene->owner != 0 && scene->owner != o_.client_id;
-      // Free, though this client claimed it and drove it: another process under this client id
-      // released it (or the server released it for silence). Commands would all be refused.
-      if (scene->owner == 0 && !standing_by_ && instrument_lost_t_ < 0) {
-        instrument_lost_t_ = t;
-        renderer_.server_lost(t);
-        add(s.note, line("t = %5.2f s  instrument %u is no longer this client's (the server shows it free: released by another client with "
-                         "client id %u?); the force fades to zero over %.2f s",
-                         t, o_.instrument, o_.client_id, o_.fade.fade_s));
-      }
       if (taken != standing_by_) {
         standing_by_ = taken;
-        taken_over_ += taken;
         if (taken) renderer_.server_lost(t);
-        add(s.note, line(taken ? "t = %5.2f s  instrument %u taken over by client %u: this device stands by until it is handed back"
-                               : "t = %5.2f s  instrument %u handed back (owner client %u): driving it again",
-                         t, o_.instrument, scene->owner));
+        if (taken && instrument_lost_t_ >= 0)  // it was free, and another client claimed it
+          add(s.note,
+              line("t = %5.2f s  instrument %u is held by client %u now: this device waits until it is free", t, o_.instrument, scene->owner));
+        else if (taken)
+          add(s.note, line("t = %5.2f s  instrument %u taken over by client %u: this device stands by until it is handed back", t, o_.instrument,
+                           scene->owner));
+        else if (scene->owner == o_.client_id)
+          add(s.note, line("t = %5.2f s  instrument %u handed back (owner client %u): driving it again", t, o_.instrument, scene->owner));
+        taken_over_ += taken && instrument_lost_t_ < 0;
+      }
+      // Free, though this client held it: the server heard nothing from it for longer than its
+      // lease (a stall of this process), or whoever held it released it (the console that had
+      // taken it over, another process under this client id). Commands would all be refused.
+      if (scene->owner == 0 && instrument_lost_t_ < 0) {
+        instrument_lost_t_ = t;
+        ++instrument_losses_;
+        renderer_.server_lost(t);
+        add(s.note, line("t = %5.2f s  instrument %u is no longer this client's: the server shows it free (it frees an instrument whose "
+                         "owner it has not heard from for its %.1f s lease, or whoever held it released it); the force fades to zero "
+                         "over %.2f s%s",
+                         t, o_.instrument, kLeaseS, o_.fade.fade_s, o_.reconnect ? ", then it is claimed again (--reconnect)" : ""));
       }
     } else {  // a scene loaded at run time releases every instrument
       generation_ = scene->generation;
@@ -69,11 +94,15 @@ DeviceLoop::Step DeviceLoop::next(double t, ServerState server, const std::optio
       return s;
     }
   }
-  if (instrument_lost_t_ >= 0) {  // nothing is sent; the force fades out, then the run ends
+  if (instrument_lost_t_ >= 0) {  // nothing is sent; the force fades out, then the run ends (or, reconnecting, claims again)
     s.action = Action::render_only;
-    if (renderer_.gain(t) == 0) {
+    if (renderer_.gain(t) > 0) return s;
+    if (!o_.reconnect) {
       faded_t_ = t;
       s.end_after = true;
+    } else if (t >= retry_t_ && !standing_by_) {  // not while another client holds it
+      pending_ = Claim::instrument_free;
+      s.action = Action::claim_again;
     }
     return s;
   }
@@ -82,9 +111,20 @@ DeviceLoop::Step DeviceLoop::next(double t, ServerState server, const std::optio
 }
 
 std::string DeviceLoop::claimed(double t, bool ok, const std::string& why, const InstrumentView& now) {
+  last_t_ = -1;  // the claim took its time: not a stall
   const Claim what = pending_;
   pending_ = Claim::none;
   generation_ = now.generation;
+  if (what == Claim::instrument_free) {
+    if (ok) {
+      instrument_lost_t_ = -1;
+      retry_t_ = 0;
+    } else {
+      retry_t_ = t + kRetryS;
+    }
+    return line("t = %5.2f s  instrument %u %s", t, o_.instrument,
+                ok ? "claimed again" : ("not claimed again: " + why + line("; trying again in %.0f s", kRetryS)).c_str());
+  }
   if (what == Claim::server_back) {
     server_lost_t_ = faded_t_ = -1;
     ++server_returns_;

@@ -114,6 +114,9 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
   run.instrument_lost_t_s = loop.instrument_lost_t_s();
   run.server_returns = loop.server_returns();
   run.taken_over = loop.taken_over();
+  run.instrument_losses = loop.instrument_losses();
+  run.stall_s = loop.stall_s();
+  run.stall_end_t_s = loop.stall_end_t_s();
   run.lost = loop.lost();
   return run;
 }

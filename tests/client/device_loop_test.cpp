@@ -122,6 +122,75 @@ TEST(DeviceLoop, AnInstrumentShownFreeUnderThisClientFadesOutAndEndsTheRun) {
   EXPECT_FALSE(loop.lost()) << "the server is still there";
 }
 
+TEST(DeviceLoop, WithReconnectAnInstrumentFreedUnderThisClientIsClaimedAgainOnceTheForceHasFaded) {
+  DeviceLoop loop(options(true), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const InstrumentView free{1, 0, "liver"};
+  const auto [t_free, noticed] = run(loop, 1.0, 2.0, ServerState::alive, free, Action::drive);
+  EXPECT_EQ(noticed.action, Action::render_only);
+  EXPECT_NE(noticed.note.find("then it is claimed again (--reconnect)"), std::string::npos) << noticed.note;
+  // Nothing is claimed while the force the hand feels still fades.
+  const auto [t_claim, claim] = run(loop, t_free + kPeriod, 3.0, ServerState::alive, free, Action::render_only);
+  ASSERT_EQ(claim.action, Action::claim_again) << claim.note;
+  EXPECT_FALSE(claim.end_after);
+  EXPECT_EQ(loop.renderer().gain(t_claim), 0.0);
+  EXPECT_NEAR(t_claim - t_free, 0.25, 1.5 * kPeriod);
+  // A refused claim is tried again a second later, not every period.
+  const std::string refused = loop.claimed(t_claim, false, "no answer within 5 s", free);
+  EXPECT_NE(refused.find("not claimed again: no answer within 5 s; trying again in 1 s"), std::string::npos) << refused;
+  const auto [t_retry, retry] = run(loop, t_claim + kPeriod, t_claim + 3.0, ServerState::alive, free, Action::render_only);
+  ASSERT_EQ(retry.action, Action::claim_again);
+  EXPECT_NEAR(t_retry - t_claim, 1.0, 1.5 * kPeriod);
+  const std::string held = loop.claimed(t_retry, true, "", {1, kMe, "liver"});
+  EXPECT_NE(held.find("instrument 1 claimed again"), std::string::npos) << held;
+  EXPECT_EQ(loop.instrument_lost_t_s(), -1);
+  EXPECT_EQ(loop.instrument_losses(), 1);
+  feed_model(loop, t_retry + 0.01);
+  const auto [t, s] = run(loop, t_retry + 0.01, t_retry + 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  EXPECT_NEAR(t, t_retry + 1.0, 1e-9) << "drives again: " << s.note;
+  EXPECT_EQ(loop.renderer().gain(t), 1.0) << "the force faded back in";
+}
+
+TEST(DeviceLoop, WithReconnectAFreedInstrumentAnotherClientTookIsNotClaimedWhileItHoldsIt) {
+  DeviceLoop loop(options(true), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const auto [t_free, noticed] = run(loop, 1.0, 2.0, ServerState::alive, InstrumentView{1, 0, "liver"}, Action::drive);
+  ASSERT_EQ(noticed.action, Action::render_only);
+  // Another client claims it before the fade ends: this one stands by and never claims.
+  const auto [t_other, other] = run(loop, t_free + kPeriod, t_free + 5.0, ServerState::alive, InstrumentView{1, 22, "liver"}, Action::render_only);
+  EXPECT_NEAR(t_other, t_free + 5.0, 1e-9) << "claimed while another held it: " << other.note;
+  EXPECT_TRUE(loop.standing_by());
+  // Free again: claimed.
+  const auto [t_again, again] = run(loop, t_free + 5.0, t_free + 7.0, ServerState::alive, InstrumentView{1, 0, "liver"}, Action::render_only);
+  EXPECT_EQ(again.action, Action::claim_again) << again.note;
+  EXPECT_LT(t_again, t_free + 5.0 + 0.1 + 2 * kPeriod);
+}
+
+TEST(DeviceLoop, AGapBetweenPeriodsLongerThanTheLeaseIsNamedAsThisProcesssOwnStall) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const auto short_gap = loop.next(1.4, ServerState::alive, std::nullopt);  // 0.4 s: within the lease
+  EXPECT_EQ(short_gap.note, "");
+  EXPECT_EQ(loop.stall_s(), 0);
+  const auto stalled = loop.next(2.2, ServerState::alive, std::nullopt);
+  EXPECT_NE(stalled.note.find("this process did not run for 0.80 s, longer than the server's 0.5 s lease"), std::string::npos) << stalled.note;
+  EXPECT_NEAR(loop.stall_s(), 0.8, 1e-9);
+  EXPECT_DOUBLE_EQ(loop.stall_end_t_s(), 2.2);
+  const auto lost = loop.next(2.201, ServerState::lost, std::nullopt);
+  EXPECT_NE(lost.note.find("just after this process's own stall"), std::string::npos) << lost.note;
+  // A claim that blocks for seconds is not a stall.
+  DeviceLoop again(options(true), 1);
+  again.next(0, ServerState::lost, std::nullopt);
+  run(again, 0.001, 1.0, ServerState::lost, std::nullopt, Action::drive);
+  ASSERT_EQ(again.next(1.0, ServerState::alive, std::nullopt).action, Action::claim_again);
+  again.claimed(1.0, true, "", {1, kMe, "liver"});
+  EXPECT_EQ(again.next(4.0, ServerState::alive, std::nullopt).note, "");
+  EXPECT_EQ(again.stall_s(), 0);
+}
+
 TEST(DeviceLoop, ANewSceneMeansClaimingAgainAndTheNewGenerationThen) {
   DeviceLoop loop(options(), 1);
   feed_model(loop, 0);

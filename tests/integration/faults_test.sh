@@ -6,6 +6,8 @@
 #   client's rendered force fades to zero without a step.
 # - --reconnect: the client waits, and claims its instrument again from a restarted server, and
 #   from the same server stalled (SIGSTOP) for longer than the liveliness lease; its force returns.
+# - A client stalled (SIGSTOP) for longer than the lease: the server frees its instrument; the
+#   client exits with status 5, or with --reconnect claims it again and its force returns.
 # - A server whose standard output is a full pipe nobody reads keeps its physics rate, and writes
 #   its lines once the pipe is read; a haptic client's device loop the same.
 # - SIGTERM ends the server within 100 ms with ticks of 40 ms and more, during a background scene
@@ -134,6 +136,55 @@ assert after and min(after) > max(before), f"the press after the stall: weakest 
 print(f"[ figure ] a 0.8 s server stall: the press at {max(before):.2f} N before it, {min(after):.2f}-{max(after):.2f} N 1.5-2 s after it; "
       f"the client's longest wait for a force {1e3 * r['longest_silence_s']:.0f} ms")
 PY
+
+# --- A client stalled (SIGSTOP) for 0.8 s, longer than the server's 500 ms lease. ---
+# The server hears nothing from it and frees its instrument (no force from a device nobody may be
+# holding). When the client runs again it names its own stall; its DDS may first call the server
+# gone (nothing heard for the lease) or show the instrument free. Either way it fades its force to
+# zero and exits, with status 4 saying the server may be there still, or 5; with --reconnect (how a
+# station runs it) it claims the instrument again and its force returns. Two faults found this way:
+# a CI run of integration.console lost a test to a client starved for 0.77 s that never took its
+# instrument back, and a --reconnect client that called the server gone after its own stall waited
+# for ever (with no instrument driven, nothing the client read was written again).
+for mode in plain reconnect; do
+  start_server "$scene" "$tmp/server-cstall-$mode.log"
+  flags=(); [ $mode = reconnect ] && flags=(--reconnect)
+  "$hc" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.02 --duration 7 --quiet "${flags[@]}" \
+    --report "$tmp/cstall-$mode.json" > "$tmp/hc-cstall-$mode.log" 2>&1 &
+  client=$!
+  wait_for "$tmp/hc-cstall-$mode.log" "contact at"
+  sleep 1.5
+  stopped_at=$(now)
+  kill -STOP "$client"; sleep 0.8; kill -CONT "$client"
+  wait "$client"; rc_client=$?
+  kill -INT "$server"; wait "$server"
+  cat "$tmp/hc-cstall-$mode.log"
+  check "client stall ($mode): the server freed the silent client's instrument" "grep -q 'instrument 1 released: client 1 silent for more than the lease' '$tmp/server-cstall-$mode.log'"
+  check "client stall ($mode): the client named its own stall" "grep -q 'this process did not run for 0\.[89][0-9] s, longer than the server' '$tmp/hc-cstall-$mode.log'"
+  if [ $mode = plain ]; then
+    check "client stall (plain): the client faded out and exited, saying why (rc $rc_client)" \
+      "{ [ $rc_client -eq 5 ] && grep -q 'instrument 1 is no longer this client' '$tmp/hc-cstall-$mode.log'; } || { [ $rc_client -eq 4 ] && grep -q 'just after this process did not run for 0\.[89]. s' '$tmp/hc-cstall-$mode.log'; }"
+  else
+    check "client stall (reconnect): it claimed the instrument again" "grep -q 'instrument 1 claimed again' '$tmp/hc-cstall-$mode.log'"
+    check "client stall (reconnect): it ran to the end (rc $rc_client)" "[ $rc_client -eq 0 ]"
+    check "client stall (reconnect): the server had the instrument in use again after freeing it" "sed -n '/instrument 1 released/,\$p' '$tmp/server-cstall-$mode.log' | grep -q ' 1 instruments in use'"
+    pycheck "$tmp/cstall-$mode.json" "$stopped_at" <<'PY'
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+stopped = float(sys.argv[2]) - r["start_epoch_s"]
+assert r["instrument_lost_t_s"] == -1 and r["instrument_losses"] + r["server_returns"] >= 1, \
+    f"instrument losses {r['instrument_losses']}, server returns {r['server_returns']}, lost at {r['instrument_lost_t_s']}"
+assert 0.75 < r["stall_s"] < 1.2 and stopped < r["stall_end_t_s"] < stopped + 1.5, f"stall {r['stall_s']:.3f} s ending at {r['stall_end_t_s']:.2f} s"
+norm = lambda v: math.sqrt(sum(c * c for c in v))
+# The press goes 2 cm deep until 3.5 s, then back: the force returns within 1.5 s of the stall's end.
+before = [norm(s["rendered_force_n"]) for s in r["samples"] if stopped - 0.3 < s["t_s"] < stopped]
+back = [s["t_s"] for s in r["samples"] if s["t_s"] > stopped + 0.8 and norm(s["rendered_force_n"]) > 0.9 * max(before)]
+assert before and min(before) > 0.1, f"no press before the stall: {min(before, default=0):.3f} N"
+assert back and back[0] < stopped + 0.8 + 1.5, f"the force came back at {back[0] if back else None} s; the stall ended at {stopped + 0.8:.2f} s"
+print(f"[ figure ] a 0.8 s client stall: {max(before):.2f} N before it, back to 90% of it {back[0] - stopped - 0.8:.2f} s after its end")
+PY
+  fi
+done
 
 # --- Standard output that nobody reads (a full pipe): the physics keeps its rate. ---
 # Before the log had a writer thread of its own, the physics thread's once-a-second line (and the

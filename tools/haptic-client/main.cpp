@@ -235,6 +235,9 @@ void write_report(const Options& o, const std::string& scene, const std::string&
                    {"server_lost_t_s", run.server_lost_t_s},
                    {"taken_over", run.taken_over},
                    {"instrument_lost_t_s", run.instrument_lost_t_s},
+                   {"instrument_losses", run.instrument_losses},
+                   {"stall_s", run.stall_s},
+                   {"stall_end_t_s", run.stall_end_t_s},
                    {"faded_t_s", run.faded_t_s},
                    {"server_returns", run.server_returns},
                    {"longest_silence_s", run.longest_silence_s},
@@ -269,10 +272,13 @@ int main(int argc, char** argv) {
       "Prints force and command-to-force round trip live; --report writes every sample as JSON.\n"
       "If the server goes away the rendered force fades to zero (--fade) and the client exits with status 4\n"
       "(--reconnect: it waits for a server to come back and claims the instrument again).\n"
+      "If the server shows the instrument free though this client held it (the server heard nothing from it for longer\n"
+      "than its 0.5 s lease, as in a stall of this process, or another process under this client id released it), the\n"
+      "force fades out and the client exits with status 5 (--reconnect: it claims the instrument again, every 1 s until it holds).\n"
       "While another client (an instructor's console) has taken the instrument over, the client sends nothing,\n"
       "its rendered force fades out and the device waits; it drives again once the instrument is handed back.\n"
       "Exit status: 0 done, 2 bad arguments, 3 no server or instrument not claimed, 4 the server went away, 5 the instrument was\n"
-      "released by another client (another process under this client id?), 1 other errors.");
+      "freed under this client (above), 1 other errors.");
   cl.flag("domain", "ID", "DDS domain", "0");
   cl.flag("station", "NAME", "the trainee station whose server to use: its DDS partition (viscera-server --station)", "");
   cl.flag("client-id", "N", "this client's id (non-zero, unique per client)", "1");
@@ -294,7 +300,9 @@ int main(int argc, char** argv) {
   cl.flag("stale-after", "S", "a local force model this old means the server is not answering: start the fade [s]", "0.25");
   cl.flag("tick-phase", "US", "send commands this long after each server tick [us] (at --rate = physics rate; negative: loop free)", "100");
   cl.option_switch("watch-mesh", "receive the organ's surface frames and report their rate and the surface's displacement");
-  cl.option_switch("reconnect", "when the server goes away, wait for one to come back and claim the instrument again");
+  cl.option_switch("reconnect",
+                   "when the server goes away, wait for one to come back and claim the instrument again; "
+                   "when the instrument is freed under this client, claim it again");
   cl.option_switch("quiet", "no live lines, only the summary");
   cl.flag("report", "FILE.json", "write samples and statistics here");
   try {
@@ -336,10 +344,20 @@ int main(int argc, char** argv) {
     viscera::haptic::stop_saying();  // before the lines on standard error
     if (!o.report.empty()) write_report(o, scene->name, device->name(), start_epoch_s, rtt, run);
     if (run.lost) {
-      std::fprintf(stderr, "haptic-client: the server went away at t = %.2f s; the force had faded to zero at t = %.2f s\n", run.server_lost_t_s,
-                   run.faded_t_s);
+      if (run.stall_end_t_s >= 0 && run.server_lost_t_s - run.stall_end_t_s < 0.5)
+        std::fprintf(stderr,
+                     "haptic-client: the server was not heard from at t = %.2f s, just after this process did not run for %.2f s (longer than "
+                     "the lease): the server may be there still and have freed the instrument (--reconnect rides through stalls); the force "
+                     "had faded to zero at t = %.2f s\n",
+                     run.server_lost_t_s, run.stall_s, run.faded_t_s);
+      else
+        std::fprintf(stderr, "haptic-client: the server went away at t = %.2f s; the force had faded to zero at t = %.2f s\n", run.server_lost_t_s,
+                     run.faded_t_s);
       return 4;
     }
+    if (run.instrument_losses > 0 && run.instrument_lost_t_s < 0)
+      std::fprintf(stderr, "haptic-client: instrument %u was freed under this client %d time(s) and claimed again (--reconnect)\n", o.instrument,
+                   run.instrument_losses);
     if (run.instrument_lost_t_s >= 0) {
       std::fprintf(stderr, "haptic-client: instrument %u was no longer this client's at t = %.2f s; the force had faded to zero at t = %.2f s\n",
                    o.instrument, run.instrument_lost_t_s, run.faded_t_s);

@@ -9,7 +9,9 @@
 //   driving ──server gone──▶ fading (commands still sent) ──force at 0──▶ end (exit 4)
 //                                                         └─ reconnect ─▶ waiting ──server back──▶ claim again ─▶ driving
 //   driving ──another client owns it──▶ standing by (nothing sent, force fades) ──handed back──▶ driving
-//   driving ──the scene shows it free (released under this client id)──▶ fading, nothing sent ──force at 0──▶ end (exit 5)
+//   driving ──the scene shows it free (released for silence, or under this client id)──▶ fading, nothing sent ──force at 0──▶ end (exit 5)
+//                                                                                                       └─ reconnect ─▶ claim again (every 1 s until
+//                                                                                                       it holds) ─▶ driving
 //   driving ──a new scene was loaded──▶ claim again ─▶ driving
 #include <cstdint>
 #include <optional>
@@ -24,7 +26,10 @@ struct DeviceLoopOptions {
   std::uint32_t client_id = 1, instrument = 1;
   double max_force_n = 15, blend_s = 0.003;
   FadePolicy fade;
-  bool reconnect = false;  ///< after the server is gone and the force has faded, wait for one to come back
+  /// After the server is gone and the force has faded, wait for one to come back; after the
+  /// instrument was freed under this client (the server's lease ran out during a stall of this
+  /// process), claim it again once the force has faded.
+  bool reconnect = false;
 };
 
 /// What the scene state says, when the loop looks (every 0.1 s while the server is there).
@@ -39,7 +44,7 @@ class DeviceLoop {
   enum class Action {
     drive,  ///< read the device, send the tip, render the newest model
     render_only,  ///< send nothing; render the fading force at the last tip
-    claim_again,  ///< claim the instrument again (a new scene, or a server back), then call claimed()
+    claim_again,  ///< claim the instrument again (a new scene, a server back, an instrument freed), then call claimed()
     end,  ///< the run is over (lost() or instrument_lost_t_s() say why)
   };
   struct Step {
@@ -61,19 +66,28 @@ class DeviceLoop {
   bool lost() const { return lost_; }  ///< ended because the server was gone
   double server_lost_t_s() const { return server_lost_t_; }  ///< -1: never
   double faded_t_s() const { return faded_t_; }  ///< when the force reached zero after a loss (-1: never)
-  double instrument_lost_t_s() const { return instrument_lost_t_; }  ///< the instrument shown free under this client (-1: never)
+  double instrument_lost_t_s() const {
+    return instrument_lost_t_;
+  }  ///< the instrument shown free under this client and not claimed again (-1: never)
+  int instrument_losses() const { return instrument_losses_; }  ///< how often the instrument was shown free under this client
+  /// The longest gap between two periods longer than the server's lease (this process did not
+  /// run), and when the last such gap ended (0 and -1: none).
+  double stall_s() const { return stall_s_; }
+  double stall_end_t_s() const { return stall_end_t_; }
   int server_returns() const { return server_returns_; }
   int taken_over() const { return taken_over_; }
 
  private:
-  enum class Claim { none, scene_loaded, server_back };
+  enum class Claim { none, scene_loaded, server_back, instrument_free };
+  static constexpr double kRetryS = 1.0;  ///< [s] between claims of an instrument freed under this client
   DeviceLoopOptions o_;
   LocalForceRenderer renderer_;
   std::uint32_t generation_;
   Claim pending_ = Claim::none;
   bool standing_by_ = false, lost_ = false;
-  double server_lost_t_ = -1, faded_t_ = -1, instrument_lost_t_ = -1, last_scene_check_ = 0;
-  int server_returns_ = 0, taken_over_ = 0;
+  double server_lost_t_ = -1, faded_t_ = -1, instrument_lost_t_ = -1, last_scene_check_ = 0, retry_t_ = 0;
+  double last_t_ = -1, stall_s_ = 0, stall_end_t_ = -1;
+  int server_returns_ = 0, taken_over_ = 0, instrument_losses_ = 0;
 };
 
 }  // namespace viscera::client

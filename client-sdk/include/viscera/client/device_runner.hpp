@@ -42,7 +42,8 @@ struct DeviceRunResult {
   std::uint64_t clamps = 0;  ///< periods whose force was limited to max_force_n
   std::uint64_t phased = 0, near_phase = 0;  ///< periods timed by the phase lock; of them within 50 us of the target
   double server_lost_t_s = -1, faded_t_s = -1, instrument_lost_t_s = -1;
-  int server_returns = 0, taken_over = 0;
+  int server_returns = 0, taken_over = 0, instrument_losses = 0;
+  double stall_s = 0, stall_end_t_s = -1;  ///< the longest time the loop did not run beyond the lease, and when the last such ended (DeviceLoop)
   bool lost = false;  ///< ended because the server was gone
   /// The longest time without a new model while the loop sent commands [s] (a server that was
   /// gone and came back included), and when it ended (-1: none): a server or network that fell
