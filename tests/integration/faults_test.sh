@@ -160,10 +160,10 @@ for mode in plain reconnect; do
   kill -INT "$server"; wait "$server"
   cat "$tmp/hc-cstall-$mode.log"
   check "client stall ($mode): the server freed the silent client's instrument" "grep -q 'instrument 1 released: client 1 silent for more than the lease' '$tmp/server-cstall-$mode.log'"
-  check "client stall ($mode): the client named its own stall" "grep -q 'this process did not run for 0\.[89][0-9] s, longer than the server' '$tmp/hc-cstall-$mode.log'"
+  check "client stall ($mode): the client named its own stall" "grep -Eq 'this process did not run for (0\.[89]|1\.[0-4])[0-9] s, longer than the server' '$tmp/hc-cstall-$mode.log'"
   if [ $mode = plain ]; then
     check "client stall (plain): the client faded out and exited, saying why (rc $rc_client)" \
-      "{ [ $rc_client -eq 5 ] && grep -q 'instrument 1 is no longer this client' '$tmp/hc-cstall-$mode.log'; } || { [ $rc_client -eq 4 ] && grep -q 'just after this process did not run for 0\.[89]. s' '$tmp/hc-cstall-$mode.log'; }"
+      "{ [ $rc_client -eq 5 ] && grep -q 'instrument 1 is no longer this client' '$tmp/hc-cstall-$mode.log'; } || { [ $rc_client -eq 4 ] && grep -Eq 'just after this process did not run for (0\.[89]|1\.[0-4]). s' '$tmp/hc-cstall-$mode.log'; }"
   else
     check "client stall (reconnect): it claimed the instrument again" "grep -q 'instrument 1 claimed again' '$tmp/hc-cstall-$mode.log'"
     check "client stall (reconnect): it ran to the end (rc $rc_client)" "[ $rc_client -eq 0 ]"
@@ -174,7 +174,7 @@ r = json.load(open(sys.argv[1]))
 stopped = float(sys.argv[2]) - r["start_epoch_s"]
 assert r["instrument_lost_t_s"] == -1 and r["instrument_losses"] + r["server_returns"] >= 1, \
     f"instrument losses {r['instrument_losses']}, server returns {r['server_returns']}, lost at {r['instrument_lost_t_s']}"
-assert 0.75 < r["stall_s"] < 1.2 and stopped < r["stall_end_t_s"] < stopped + 1.5, f"stall {r['stall_s']:.3f} s ending at {r['stall_end_t_s']:.2f} s"
+assert 0.75 < r["stall_s"] < 1.5 and stopped < r["stall_end_t_s"] < stopped + 1.5, f"stall {r['stall_s']:.3f} s ending at {r['stall_end_t_s']:.2f} s"
 norm = lambda v: math.sqrt(sum(c * c for c in v))
 # The press goes 2 cm deep until 3.5 s, then back: the force returns within 1.5 s of the stall's end.
 before = [norm(s["rendered_force_n"]) for s in r["samples"] if stopped - 0.3 < s["t_s"] < stopped]
