@@ -115,13 +115,9 @@ std::string DeviceLoop::claimed(double t, bool ok, const std::string& why, const
   const Claim what = pending_;
   pending_ = Claim::none;
   generation_ = now.generation;
+  if (ok) instrument_lost_t_ = -1;  // whatever the claim was for, the instrument is this client's again
   if (what == Claim::instrument_free) {
-    if (ok) {
-      instrument_lost_t_ = -1;
-      retry_t_ = 0;
-    } else {
-      retry_t_ = t + kRetryS;
-    }
+    retry_t_ = ok ? 0 : t + kRetryS;
     return line("t = %5.2f s  instrument %u %s", t, o_.instrument,
                 ok ? "claimed again" : ("not claimed again: " + why + line("; trying again in %.0f s", kRetryS)).c_str());
   }

@@ -168,6 +168,21 @@ TEST(DeviceLoop, WithReconnectAFreedInstrumentAnotherClientTookIsNotClaimedWhile
   EXPECT_LT(t_again, t_free + 5.0 + 0.1 + 2 * kPeriod);
 }
 
+TEST(DeviceLoop, ANewSceneLoadedWhileTheFreedInstrumentFadesIsClaimedAndDrivenAgain) {
+  DeviceLoop loop(options(), 1);
+  feed_model(loop, 0);
+  run(loop, 0, 1.0, ServerState::alive, InstrumentView{1, kMe, "liver"}, Action::drive);
+  const auto [t_free, noticed] = run(loop, 1.0, 2.0, ServerState::alive, InstrumentView{1, 0, "liver"}, Action::drive);
+  ASSERT_EQ(noticed.action, Action::render_only);
+  const auto [t_scene, scene] = run(loop, t_free + kPeriod, 2.0, ServerState::alive, InstrumentView{2, 0, "liver-12k"}, Action::render_only);
+  ASSERT_EQ(scene.action, Action::claim_again) << scene.note;
+  loop.claimed(t_scene, true, "", {2, kMe, "liver-12k"});
+  EXPECT_EQ(loop.instrument_lost_t_s(), -1) << "claimed: no longer lost, so the run does not end with status 5";
+  feed_model(loop, t_scene + 0.01);
+  const auto [t, s] = run(loop, t_scene + 0.01, t_scene + 1.0, ServerState::alive, InstrumentView{2, kMe, "liver-12k"}, Action::drive);
+  EXPECT_NEAR(t, t_scene + 1.0, 1e-9) << s.note;
+}
+
 TEST(DeviceLoop, AGapBetweenPeriodsLongerThanTheLeaseIsNamedAsThisProcesssOwnStall) {
   DeviceLoop loop(options(), 1);
   feed_model(loop, 0);

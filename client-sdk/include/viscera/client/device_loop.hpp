@@ -66,9 +66,8 @@ class DeviceLoop {
   bool lost() const { return lost_; }  ///< ended because the server was gone
   double server_lost_t_s() const { return server_lost_t_; }  ///< -1: never
   double faded_t_s() const { return faded_t_; }  ///< when the force reached zero after a loss (-1: never)
-  double instrument_lost_t_s() const {
-    return instrument_lost_t_;
-  }  ///< the instrument shown free under this client and not claimed again (-1: never)
+  /// When the instrument was shown free under this client, if it was not claimed again since (-1: never).
+  double instrument_lost_t_s() const { return instrument_lost_t_; }
   int instrument_losses() const { return instrument_losses_; }  ///< how often the instrument was shown free under this client
   /// The longest gap between two periods longer than the server's lease (this process did not
   /// run), and when the last such gap ended (0 and -1: none).
