@@ -12,7 +12,7 @@
 # and viscera-plot draws both force curves in out/titin-vs-linear.svg. Last, a scalpel cuts an
 # incision along the organ's top and a probe presses on it (the cut is on the console, and in the
 # recording, whose re-simulation reproduces it bit for bit).
-# viscera-record records the whole session to out/demo.mcap; at the end the demo prints the
+# viscera-record records the whole session to out/demo.mcap (the last demo's, replaced); at the end the demo prints the
 # recording's summary and re-runs the session on a fresh server in lockstep, bit for bit, and the
 # Python package reads it into DataFrames (examples/python/analyse_session.py, out/demo-session.png).
 # The instructor's console (viscera-console) runs beside it all: open the address it prints in a
@@ -31,7 +31,7 @@ domain=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('do
 bin="$root/build"
 mkdir -p "$root/out"
 recording="$root/out/demo.mcap"
-"$bin/tools/viscera-record/viscera-record" --out "$recording" --domain "$domain" --quiet > >(sed -u 's/^/[record] /') 2>&1 &
+"$bin/tools/viscera-record/viscera-record" --out "$recording" --replace --domain "$domain" --quiet > >(sed -u 's/^/[record] /') 2>&1 &
 recorder=$!
 "$bin/server/runtime/viscera-server" --scene "$scene" > >(sed -u 's/^/[server] /') 2>&1 &
 server=$!

@@ -1,6 +1,13 @@
 #include "viscera/mcap/mcap_writer.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fcntl.h>
 
 #include "viscera/mcap/compression.hpp"
 
@@ -13,8 +20,22 @@ std::uint8_t op(Opcode o) { return static_cast<std::uint8_t>(o); }
 McapWriter::McapWriter(const std::string& path, WriterOptions options) : path_(path), options_(std::move(options)) {
   if (!options_.compression.empty() && options_.compression != "zstd" && options_.compression != "lz4")
     throw std::invalid_argument("compression '" + options_.compression + "' is not zstd, lz4 or none");
-  file_ = std::unique_ptr<std::FILE, CloseFile>(std::fopen(path.c_str(), "wb"));
-  if (!file_) throw std::runtime_error(path + ": cannot create the file");
+  // O_NOFOLLOW: a link planted at the path (a shared folder, /tmp) is not written through, whoever
+  // runs this; O_EXCL: an earlier recording is not replaced unless asked.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NOFOLLOW | (options_.replace ? O_TRUNC : O_EXCL), 0644);
+  if (fd < 0) {
+    const int e = errno;
+    struct stat st {};
+    if (e == ELOOP || (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode)))
+      throw std::runtime_error(path + ": is a symbolic link: not written through (name the file itself)");
+    if (e == EEXIST) throw std::runtime_error(path + ": exists, and is not replaced: a recording is never lost to the next one (choose another name, or remove it)");
+    throw std::runtime_error(path + ": cannot create the file: " + std::strerror(e));
+  }
+  file_ = std::unique_ptr<std::FILE, CloseFile>(::fdopen(fd, "wb"));
+  if (!file_) {
+    ::close(fd);
+    throw std::runtime_error(path + ": cannot create the file");
+  }
   ByteWriter w;
   w.raw(kMagic);
   const auto at = w.begin_record(op(Opcode::header));

@@ -18,6 +18,7 @@ DataEnd recover(const std::string& in, const std::string& out, const std::string
   options.library = reader.library();
   options.compression = compression;
   options.chunk_ns = ~std::uint64_t{0};  // chunks by size only: log times may be far apart
+  options.replace = false;  // the copy goes to a new file: never over another recording
   McapWriter writer(out, options);
   std::map<std::uint16_t, std::uint16_t> schema_id, channel_id;  // old -> new
   DataVisitor v;

@@ -64,7 +64,9 @@ void read_mcap(const std::string& path) {
     for (const auto& a : summary->attachments) (void)reader.read_attachment(a);
     for (const auto& m : summary->metadata) (void)reader.read_metadata(m);
   }
-  (void)viscera::mcap::recover(path, (folder() / "recovered.mcap").string());
+  const auto copy = folder() / "recovered.mcap";
+  std::filesystem::remove(copy);  // the last input's copy: recover writes a new file only
+  (void)viscera::mcap::recover(path, copy.string());
   viscera::mcap::McapReader again(path);
   (void)viscera::mcap::check_integrity(again);
 }

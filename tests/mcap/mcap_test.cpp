@@ -262,6 +262,7 @@ TEST(McapFile, AFileCutAtAnyByteGivesTheMessagesOfItsCompleteChunksAndRecoverMak
     expect_same(got, w.messages, got.size());
     EXPECT_FALSE(McapReader(part).summary()) << cut;  // no footer: no summary
     const std::string fixed = dir.file("fixed.mcap");
+    fs::remove(fixed);  // the last cut's copy: recover never replaces a file
     const DataEnd r = recover(part, fixed);
     EXPECT_EQ(r.messages, expected);
     DataEnd fixed_end;
@@ -352,6 +353,7 @@ TEST(McapFile, RecoverKeepsEveryIntactChunkAroundADamagedOneAndSaysWhatWasLost) 
       damaged[static_cast<std::size_t>(at)] ^= 0x40;
       const std::string in = dir.file("damaged.mcap"), out = dir.file("recovered.mcap");
       viscera::common::write_file_bytes(in, damaged);
+      fs::remove(out);  // the last byte's copy: recover never replaces a file
       const DataEnd end = recover(in, out);
       EXPECT_FALSE(end.intact()) << at;
       ASSERT_FALSE(end.damaged.empty()) << at;
@@ -428,12 +430,49 @@ TEST(McapFile, ADamagedAttachmentOrOneClaimingATerabyteIsNotIntact) {
     for (const auto& p : i.problems) named = named || p.find("attachment") != std::string::npos || p.find(std::to_string(at)) != std::string::npos;
     EXPECT_TRUE(named) << label << ": " << i.problems.front();
     // Recover keeps every message and says the attachment was lost.
+    fs::remove(dir.file("recovered.mcap"));  // the last case's copy: recover never replaces a file
     const DataEnd end = recover(in, dir.file("recovered.mcap"));
     EXPECT_EQ(end.messages, 150u) << label << damage_list(end);
     EXPECT_EQ(end.attachments, 0u) << label;
     ASSERT_EQ(end.damaged.size(), 1u) << label;
     EXPECT_EQ(end.damaged[0].offset, at) << label;
   }
+}
+
+// A recording is never lost to the next one, and a link planted at the path is not written through
+// (a recorder run as root with --out in a shared folder wrote an MCAP over /etc/passwd that way).
+TEST(McapFile, AWriterRefusesALinkAlwaysAndAnExistingFileUnlessToldToReplaceIt) {
+  TempDir dir;
+  const std::string victim = dir.file("victim.txt"), link = dir.file("link.mcap"), existing = dir.file("old.mcap");
+  viscera::common::write_file_bytes(victim, std::vector<std::uint8_t>{'m', 'i', 'n', 'e'});
+  fs::create_symlink(victim, link);
+  write_file(existing, "", 50, 16 * 1024);
+  const auto old_bytes = viscera::common::read_file_bytes(existing);
+  for (const bool replace : {false, true}) {
+    WriterOptions o;
+    o.replace = replace;
+    try {
+      McapWriter w(link, o);
+      ADD_FAILURE() << "wrote through a link, replace " << replace;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("link.mcap: is a symbolic link: not written through"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(viscera::common::read_file_bytes(victim), (std::vector<std::uint8_t>{'m', 'i', 'n', 'e'}));
+  }
+  WriterOptions keep;
+  keep.replace = false;
+  try {
+    McapWriter w(existing, keep);
+    ADD_FAILURE() << "replaced an existing recording";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("old.mcap: exists, and is not replaced"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(viscera::common::read_file_bytes(existing), old_bytes);
+  { McapWriter w(dir.file("new.mcap"), keep); }  // a new name: written
+  EXPECT_EQ(read_all(dir.file("new.mcap")).size(), 0u);
+  // recover writes its copy to a new file only.
+  EXPECT_THROW(recover(existing, dir.file("new.mcap")), std::runtime_error);
+  EXPECT_EQ(recover(existing, dir.file("copy.mcap")).messages, read_all(existing).size());
 }
 
 TEST(McapFile, RecoverRefusesToWriteOverItsInputByAnyName) {

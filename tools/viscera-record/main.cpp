@@ -69,6 +69,7 @@ int record(const viscera::common::CommandLine& cl) {
   options.chunk_bytes = static_cast<std::size_t>(cl.number_in("chunk-mb", 0.01, 1024) * 1024 * 1024);
   options.chunk_ns = static_cast<std::uint64_t>(cl.number_in("chunk-s", 0.01, 3600) * 1e9);
   options.library = info.recorder;
+  options.replace = cl.has("replace");
   const double duration = cl.number_in("duration", 0, 1e7);
   const int depth = static_cast<int>(cl.integer_in("depth", 1, 1000000));
   const bool quiet = cl.has("quiet");
@@ -242,7 +243,8 @@ int main(int argc, char** argv) {
       "  viscera-record recover IN.mcap OUT.mcap                            a complete, indexed copy of what is there\n"
       "  viscera-record info FILE.mcap [--verify]                           channels, schemas, counts, time span, drops");
   cl.usage("viscera-record --out FILE.mcap [options] | recover IN.mcap OUT.mcap | info FILE.mcap [--verify]");
-  cl.flag("out", "FILE.mcap", "the recording to write (replaced if it exists)");
+  cl.flag("out", "FILE.mcap", "the recording to write (a new file: an existing one is refused unless --replace; a symbolic link always)");
+  cl.option_switch("replace", "replace the --out file if it exists (never through a symbolic link)");
   cl.flag("duration", "S", "stop after S seconds; 0: until SIGINT/SIGTERM", "0");
   cl.flag("topics", "a,b,...", "streams to record (default: all; names as in docs/PROTOCOL.md, e.g. force_feedback,event)", "");
   cl.flag("domain", "ID", "DDS domain", "0");

@@ -26,11 +26,15 @@ struct WriterOptions {
   std::string compression = "zstd";  ///< zstd | lz4 | "" (none)
   std::size_t chunk_bytes = std::size_t{4} << 20;  ///< close a chunk at this many uncompressed bytes
   std::uint64_t chunk_ns = 1'000'000'000;  ///< or when its messages span this much log time
+  /// An existing file at the path: replaced (true) or refused (false: a recording is never lost to
+  /// the next one). A symbolic link at the path is refused either way, never written through.
+  bool replace = true;
 };
 
 class McapWriter {
  public:
-  /// Creates (truncates) `path`; throws std::runtime_error naming it when it cannot.
+  /// Creates `path` (an existing file: replaced or refused, WriterOptions::replace; a symbolic
+  /// link: refused); throws std::runtime_error naming it and why when it cannot.
   McapWriter(const std::string& path, WriterOptions options = {});
   /// Closes the file if close() was not called (the summary is written).
   ~McapWriter();
