@@ -28,7 +28,8 @@ McapWriter::McapWriter(const std::string& path, WriterOptions options) : path_(p
     struct stat st {};
     if (e == ELOOP || (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode)))
       throw std::runtime_error(path + ": is a symbolic link: not written through (name the file itself)");
-    if (e == EEXIST) throw std::runtime_error(path + ": exists, and is not replaced: a recording is never lost to the next one (choose another name, or remove it)");
+    if (e == EEXIST)
+      throw std::runtime_error(path + ": exists, and is not replaced: a recording is never lost to the next one (choose another name, or remove it)");
     throw std::runtime_error(path + ": cannot create the file: " + std::strerror(e));
   }
   file_ = std::unique_ptr<std::FILE, CloseFile>(::fdopen(fd, "wb"));
