@@ -22,7 +22,8 @@ McapWriter::McapWriter(const std::string& path, WriterOptions options) : path_(p
     throw std::invalid_argument("compression '" + options_.compression + "' is not zstd, lz4 or none");
   // O_NOFOLLOW: a link planted at the path (a shared folder, /tmp) is not written through, whoever
   // runs this; O_EXCL: an earlier recording is not replaced unless asked.
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NOFOLLOW | (options_.replace ? O_TRUNC : O_EXCL), 0644);
+  // O_NONBLOCK: a FIFO at the path fails or opens at once instead of blocking, and is refused below.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | (options_.replace ? O_TRUNC : O_EXCL), 0644);
   if (fd < 0) {
     const int e = errno;
     struct stat st {};
@@ -30,8 +31,14 @@ McapWriter::McapWriter(const std::string& path, WriterOptions options) : path_(p
       throw std::runtime_error(path + ": is a symbolic link: not written through (name the file itself)");
     if (e == EEXIST)
       throw std::runtime_error(path + ": exists, and is not replaced: a recording is never lost to the next one (choose another name, or remove it)");
+    if (e == ENXIO) throw std::runtime_error(path + ": is not a regular file (a FIFO): a recording is written to a file");
     throw std::runtime_error(path + ": cannot create the file: " + std::strerror(e));
   }
+  if (struct stat st{}; ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw std::runtime_error(path + ": is not a regular file: a recording is written to a file");
+  }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
   file_ = std::unique_ptr<std::FILE, CloseFile>(::fdopen(fd, "wb"));
   if (!file_) {
     ::close(fd);

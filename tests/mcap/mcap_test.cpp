@@ -9,6 +9,7 @@
 #include <fstream>
 #include <random>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -468,6 +469,17 @@ TEST(McapFile, AWriterRefusesALinkAlwaysAndAnExistingFileUnlessToldToReplaceIt) 
     EXPECT_NE(std::string(e.what()).find("old.mcap: exists, and is not replaced"), std::string::npos) << e.what();
   }
   EXPECT_EQ(viscera::common::read_file_bytes(existing), old_bytes);
+  // A FIFO or a device, even with replace: refused at once, not waited on or written to.
+  WriterOptions replace;
+  ASSERT_EQ(::mkfifo(dir.file("fifo.mcap").c_str(), 0644), 0);
+  for (const std::string& special : {dir.file("fifo.mcap"), std::string("/dev/null")}) {
+    try {
+      McapWriter w(special, replace);
+      ADD_FAILURE() << "wrote to " << special;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("is not a regular file"), std::string::npos) << e.what();
+    }
+  }
   { McapWriter w(dir.file("new.mcap"), keep); }  // a new name: written
   EXPECT_EQ(read_all(dir.file("new.mcap")).size(), 0u);
   // recover writes its copy to a new file only.
