@@ -26,7 +26,7 @@ b="$root/build"
 "$b/tools/viscera-console/viscera-console" --token-file "$tmp/token" --listen 127.0.0.1:0 --client-id 951 \
   --tls-cert "$tmp/pki/console-web.pem" --tls-key "$tmp/pki/console-web.key" > "$tmp/console-tls.log" 2>&1 & bridge_tls=$!; pids+=($bridge_tls)
 for _ in $(seq 50); do grep -q "open http" "$tmp/console.log" && grep -q "open https" "$tmp/console-tls.log" && break; sleep 0.1; done
-url=$(grep -o "http://[^ ]*" "$tmp/console.log"); url_tls=$(grep -o "https://[^ ]*" "$tmp/console-tls.log")
+url="$(grep -o "http://[^ ]*" "$tmp/console.log")?token=$(cat "$tmp/token")"; url_tls="$(grep -o "https://[^ ]*" "$tmp/console-tls.log")?token=$(cat "$tmp/token")"
 total=$(( 8 * seconds + 30 ))
 "$b/tools/haptic-client/haptic-client" --client-id 1 --instrument 1 --script press --depth 0.03 --duration "$total" --quiet > "$tmp/haptic.log" 2>&1 & pids+=($!)
 sleep 2

@@ -85,7 +85,7 @@ PY
   "$b/tools/viscera-record/viscera-record" --out "$d/session.mcap" --domain "$domain" --quiet > "$d/record.log" 2>&1 & recorder=$!; pids+=($recorder)
   "$b/tools/viscera-console/viscera-console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 > "$d/console.log" 2>&1 & bridge=$!; pids+=($bridge)
   wait_for "open http" "$d/console.log" 100
-  url=$(grep -o "http://[^ ]*" "$d/console.log")
+  url="$(grep -o "http://[^ ]*" "$d/console.log")?token=$(cat "$tmp/token")"
   "$b/tools/viscera-trainer/viscera-trainer" run "$d/drill.json" --domain "$domain" --report-dir "$d/report" > "$d/trainer.log" 2>&1 & trainer=$!; pids+=($trainer)
   wait_for "trainer: exercise" "$d/trainer.log" 900
   node "$root/tests/node/bench_console_page_delay.mjs" "$url" "$((seconds + 5))" "$seconds" > "$d/page.json" 2> "$d/page.err" & page=$!; pids+=($page)

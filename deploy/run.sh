@@ -41,6 +41,8 @@ token="$root/out/console-token"
 "$bin/tools/viscera-console/viscera-console" --domain "$domain" --token-file "$token" --listen "${LISTEN:-127.0.0.1:8080}" --recordings "$root/out" \
   > >(sed -u 's/^/[console] /') 2>&1 &
 console_pid=$!
+# The console never logs its token; the demo, on this terminal, prints the address with it.
+echo "[demo] the instructor's console: open http://${LISTEN:-127.0.0.1:8080}/?token=$(cat "$token")"
 trap 'kill -INT "$server" "$recorder" "$console_pid" 2>/dev/null || true; wait "$server" "$recorder" "$console_pid" 2>/dev/null || true; sleep 0.2' EXIT
 sleep 1  # the recorder discovers the server before the first command
 echo "[demo] probe 1 presses 3 cm into the liver and comes back (${duration} s)"

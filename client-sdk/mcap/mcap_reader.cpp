@@ -155,12 +155,22 @@ void McapReader::fail(std::uint64_t offset, const std::string& what) const {
 std::vector<std::uint8_t> McapReader::read_at(std::uint64_t offset, std::uint64_t n) {
   if (offset > size_ || n > size_ - offset)
     fail(offset, "a read of " + std::to_string(n) + " bytes runs past the end of the file (" + std::to_string(size_) + " bytes)");
-  std::vector<std::uint8_t> b(static_cast<std::size_t>(n));
+  constexpr std::uint64_t kBlock = 1 << 20;
+  const auto from_window = [&] {
+    const auto first = window_.begin() + static_cast<std::ptrdiff_t>(offset - window_start_);
+    return std::vector<std::uint8_t>(first, first + static_cast<std::ptrdiff_t>(n));
+  };
+  if (offset >= window_start_ && offset + n <= window_start_ + window_.size()) return from_window();
+  const std::uint64_t want = n >= kBlock ? n : std::min(kBlock, size_ - offset);  // a large read goes straight through
+  std::vector<std::uint8_t> b(static_cast<std::size_t>(want));
   in_.clear();
   in_.seekg(static_cast<std::streamoff>(offset));
-  in_.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(n));
-  if (static_cast<std::uint64_t>(in_.gcount()) != n) fail(offset, "cannot read the file");
-  return b;
+  in_.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(want));
+  if (static_cast<std::uint64_t>(in_.gcount()) != want) fail(offset, "cannot read the file");
+  if (want == n) return b;
+  window_ = std::move(b);
+  window_start_ = offset;
+  return from_window();
 }
 
 std::uint64_t McapReader::read_record(std::uint64_t at, Registry& known, const DataVisitor& visit, DataEnd& end) {

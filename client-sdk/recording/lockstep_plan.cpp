@@ -98,6 +98,11 @@ class PlanBuilder {
       plan_.tip_strain_recorded = false;
       plan_.notes.push_back("recorded with protocol schema " + version + ": its forces carry no strain at the instrument, which is not compared");
     }
+    if (schema < 19) {
+      plan_.organ_epoch_recorded = false;
+      plan_.notes.push_back("recorded with protocol schema " + version +
+                            ": its forces do not count the organ's resets and loads, which is not compared");
+    }
   }
 
   /// The whole recording once: commands and requests by their keys, server events and forces in
@@ -258,7 +263,7 @@ class PlanBuilder {
       const std::uint64_t result_tick = stepped ? f.tick : f.tick + 1;
       plan_.forces[result_tick].push_back({f.instrument_id, f.client_id, f.command_seq, stepped, f.in_contact, f.force, f.torque, f.contact_point,
                                            f.contact_normal, f.penetration_m, f.max_edge_strain, f.stiffness, force_log_times_[i], f.cutting,
-                                           f.cut_edge_strain, f.tip_strain});
+                                           f.cut_edge_strain, f.tip_strain, f.organ_epoch});
       ++plan_.recorded_forces;
       plan_.last_tick = std::max(plan_.last_tick, result_tick);
       if (stepped) {

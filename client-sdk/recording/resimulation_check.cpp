@@ -49,6 +49,8 @@ std::optional<std::tuple<std::string, std::string, std::string>> force_differenc
     return std::make_tuple("max_edge_strain", exact_number(e.max_edge_strain), exact_number(f.max_edge_strain));
   if (plan.tip_strain_recorded && !same_bits(e.tip_strain, f.tip_strain))
     return std::make_tuple("tip_strain", exact_number(e.tip_strain), exact_number(f.tip_strain));
+  if (plan.organ_epoch_recorded && e.organ_epoch != f.organ_epoch)
+    return std::make_tuple("organ_epoch", std::to_string(e.organ_epoch), std::to_string(f.organ_epoch));
   return std::nullopt;
 }
 

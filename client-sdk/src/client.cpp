@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <mutex>
 #include <set>
 #include <stdexcept>
 #include <thread>
 
+#include "viscera/common/command_line.hpp"
 #include "viscera/common/percentile.hpp"
 #include "viscera/protocol/dds.hpp"
 #include "viscera/protocol/surface_assembler.hpp"
@@ -135,8 +137,22 @@ struct Client::Impl {
   }
 };
 
+namespace {
+/// The participant's settings checked before DDS sees them: what every program's command line
+/// refuses, refused here for every client (the Python package's too). A station name of 66,000
+/// characters crashed Cyclone in dds_create_writer; '*' reached live servers' partitions.
+/// Returns the partition.
+const std::string& checked_participant(std::uint32_t domain_id, std::uint32_t client_id, const std::string& partition) {
+  if (domain_id > 230) throw common::UsageError("domain " + std::to_string(domain_id) + " is outside [0, 230]");
+  if (client_id == 0 || client_id > 4000000000u)
+    throw common::UsageError("client id " + std::to_string(client_id) + " is outside [1, 4000000000] (0 is reserved)");
+  proto::checked_station(partition, "station");
+  return partition;
+}
+}  // namespace
+
 Client::Client(std::uint32_t domain_id, std::uint32_t client_id, const std::string& partition)
-    : impl_(std::make_unique<Impl>(domain_id, partition)), client_id_(client_id) {}
+    : impl_(std::make_unique<Impl>(domain_id, checked_participant(domain_id, client_id, partition))), client_id_(client_id) {}
 Client::~Client() = default;
 
 std::optional<proto::Scene> Client::wait_for_scene(std::chrono::milliseconds timeout) {
@@ -214,6 +230,10 @@ std::optional<proto::RequestOutcome> Client::request(proto::SessionRequest r, st
   if (request_seq_ == 0) request_seq_ = static_cast<std::uint64_t>(proto::now_ns());
   r.client_id = client_id_;
   r.request_seq = ++request_seq_;
+  // Refused here, at once, with the server's own reason, what the server would refuse as malformed
+  // (and so never answer: the caller would wait its whole timeout).
+  std::string why;
+  if (!proto::decode_session_request(proto::encode(r), &why)) throw common::UsageError(std::string(proto::action_name(r.action)) + ": " + why);
   // Sent once: a second copy would load the scene twice.
   if (!impl_->session_readers_known(timeout)) return std::nullopt;
   impl_->sessions.write(client_id_, proto::encode(r));
@@ -271,6 +291,9 @@ std::optional<proto::RequestOutcome> Client::seek(double seconds, std::chrono::m
 }
 
 void Client::send_tip(std::uint32_t instrument_id, const proto::Vector3& tip, double jaw_opening_rad, std::uint32_t buttons) {
+  // The server refuses such a command as malformed: its instrument would go silent and be freed.
+  if (!std::isfinite(tip[0]) || !std::isfinite(tip[1]) || !std::isfinite(tip[2]) || !std::isfinite(jaw_opening_rad))
+    throw std::invalid_argument("send_tip: the tip position or jaw opening is not finite");
   proto::Command c;
   c.instrument_id = instrument_id;
   c.client_id = client_id_;

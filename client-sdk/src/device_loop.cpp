@@ -115,7 +115,13 @@ std::string DeviceLoop::claimed(double t, bool ok, const std::string& why, const
   const Claim what = pending_;
   pending_ = Claim::none;
   generation_ = now.generation;
-  if (ok) instrument_lost_t_ = -1;  // whatever the claim was for, the instrument is this client's again
+  if (ok) {
+    instrument_lost_t_ = -1;  // whatever the claim was for, the instrument is this client's again
+    // The tool may be anywhere in the tissue: the force ramps from what the hand felt to the first
+    // answer's (which may come 0.1 s after the claim).
+    renderer_.restart_at_next_model();
+    epoch_.reset();  // the new organ's epoch, in the next force, is no jump: the claim faded in already
+  }
   if (what == Claim::instrument_free) {
     retry_t_ = ok ? 0 : t + kRetryS;
     return line("t = %5.2f s  instrument %u %s", t, o_.instrument,
@@ -128,6 +134,15 @@ std::string DeviceLoop::claimed(double t, bool ok, const std::string& why, const
   }
   return line("t = %5.2f s  the server loaded scene %s: instrument %u %s", t, now.scene.c_str(), o_.instrument,
               ok ? "claimed again" : ("could not be claimed again: " + why).c_str());
+}
+
+std::string DeviceLoop::organ_epoch(double t, std::uint32_t epoch) {
+  const bool jumped = epoch_ && *epoch_ != epoch;
+  epoch_ = epoch;
+  if (!jumped) return {};
+  renderer_.restart(t);
+  return line("t = %5.2f s  the organ was reset, reloaded, paused, resumed or given another material: the force ramps to the new one over %.2f s", t,
+              o_.fade.fade_in_s);
 }
 
 }  // namespace viscera::client

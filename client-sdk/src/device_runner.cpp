@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "viscera/client/force_slew_limit.hpp"
 #include "viscera/client/tick_phase.hpp"
 
 namespace viscera::client {
@@ -45,7 +46,10 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
   bool in_phase_possible = true;
   protocol::Vector3 last_tip{};
   double last_model_t = -1;  // when the newest model came, while driving (-1: not driving)
-  const auto render_only = [&](double t) { device.render(loop.renderer().render(last_tip, t).force, false); };
+  // Every force the device is told to render passes the slew limit (force_slew_limit.hpp).
+  ForceSlewLimit slew(o.loop.slew_n_per_ms * 1e3, 1.0 / o.rate_hz);
+  loop.renderer().restart_at_next_model();  // the instrument was just claimed: the tool may be anywhere in the tissue
+  const auto render_only = [&](double t) { device.render(slew.limit(loop.renderer().render(last_tip, t).force, t), false); };
   for (;;) {
     const double t = std::chrono::duration<double>(clock::now() - start).count();
     if (t >= o.duration_s) break;
@@ -86,6 +90,7 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
       if (f->command_seq > model_seq)
         if (const Sent& it = sent[f->command_seq % sent.size()]; it.seq == f->command_seq && it.seq != 0) {
           loop.renderer().update(*f, it.tip, t);
+          note(loop.organ_epoch(t, f->organ_epoch));
           model_seq = f->command_seq;
           if (last_model_t >= 0 && t - last_model_t > run.longest_silence_s) {
             run.longest_silence_s = t - last_model_t;
@@ -93,7 +98,8 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
           }
           last_model_t = t;
         }
-      const auto rendered = loop.renderer().render(in.tip_m, t);
+      auto rendered = loop.renderer().render(in.tip_m, t);
+      rendered.force = slew.limit(rendered.force, t);
       device.render(rendered.force, f->in_contact);
       device.model_age(loop.renderer().model_age_s(t));
       run.clamps += rendered.clamped;
@@ -118,6 +124,8 @@ DeviceRunResult run_device(Client& client, Device& device, const DeviceRunOption
   run.stall_s = loop.stall_s();
   run.stall_end_t_s = loop.stall_end_t_s();
   run.lost = loop.lost();
+  run.slew_limited = slew.limited();
+  run.largest_step_asked_n = slew.largest_step_asked_n();
   return run;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace viscera::client {
 
@@ -32,6 +33,10 @@ void LocalForceRenderer::update(const protocol::Force& f, const protocol::Vector
     resume_gain_ = g;
   }
   lost_s_ = std::numeric_limits<double>::infinity();
+  // A contact regained with force is a jump (the first model after a claim is restarted by the
+  // device loop, restart_at_next_model()).
+  const bool regained = f.in_contact && has_new_ && !new_.force.in_contact &&
+                        std::sqrt(f.force[0] * f.force[0] + f.force[1] * f.force[1] + f.force[2] * f.force[2]) > fade_.contact_onset_n;
   if (has_new_) {
     old_ = new_;
     has_old_ = true;
@@ -39,6 +44,12 @@ void LocalForceRenderer::update(const protocol::Force& f, const protocol::Vector
   new_ = {f, x0};
   has_new_ = true;
   arrived_s_ = t_s;
+  if (regained || std::exchange(restart_pending_, false)) restart(t_s);
+}
+
+void LocalForceRenderer::restart(double t_s) {
+  jump_s_ = t_s;
+  jump_from_ = last_rendered_;
 }
 
 void LocalForceRenderer::server_lost(double t_s) { lost_s_ = std::min(lost_s_, t_s); }
@@ -57,7 +68,7 @@ double LocalForceRenderer::gain(double t_s) const {
   return std::max(0.0, at_start - rate * (t_s - start));
 }
 
-RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s) const {
+RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s) {
   if (!has_new_) return {};
   constexpr double kUnlimited = std::numeric_limits<double>::infinity();
   const auto now = render_local_model(new_.force, new_.x0, x, kUnlimited);
@@ -74,6 +85,12 @@ RenderedForce LocalForceRenderer::render(const protocol::Vector3& x, double t_s)
   }
   const double g = gain(t_s);
   for (double& c : r.force) c *= g;
+  if (jump_s_ >= 0) {  // after a jump: from the force the hand felt to this one
+    const double a = fade_.fade_in_s > 0 ? std::clamp((t_s - jump_s_) / fade_.fade_in_s, 0.0, 1.0) : 1.0;
+    for (int i = 0; i < 3; ++i) r.force[i] = a * r.force[i] + (1 - a) * jump_from_[i];
+    if (a >= 1) jump_s_ = -1;
+  }
+  last_rendered_ = r.force;
   return r;
 }
 

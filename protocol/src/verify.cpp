@@ -51,9 +51,9 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const auto& k = f.stiffness;
   const fb::Mat3 K(k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8]);
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
-  return finish(
-      b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force, &torque, model,
-                                 f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting, f.cut_edge_strain, f.tip_strain));
+  return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force,
+                                           &torque, model, f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting, f.cut_edge_strain,
+                                           f.tip_strain, f.organ_epoch));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -187,6 +187,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   f.cutting = m->cutting();
   f.cut_edge_strain = m->cut_edge_strain();
   f.tip_strain = m->tip_strain();
+  f.organ_epoch = m->organ_epoch();
   if (const auto* lm = m->local_model()) {
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());

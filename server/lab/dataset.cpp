@@ -6,10 +6,12 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <sstream>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
 
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/number_text.hpp"
@@ -288,7 +290,7 @@ Dataset read_dataset(const std::string& folder) {
 }
 
 void write_dataset(const Dataset& d, const std::string& folder) {
-  std::filesystem::create_directories(folder);
+  common::create_output_folder(folder, "folder");
   json j;
   j["name"] = d.name;
   j["mode"] = to_string(d.mode);
@@ -302,7 +304,7 @@ void write_dataset(const Dataset& d, const std::string& folder) {
   for (const auto& t : d.tests) {
     j["tests"].push_back({{"file", t.file}, {"control", to_string(t.control)}});
     if (t.specimen) j["tests"].back()["specimen"] = specimen(*t.specimen);
-    std::ofstream csv(std::filesystem::path(folder) / t.file);
+    std::ostringstream csv;
     csv.precision(10);
     csv << "time_s,strain,stress_pa" << (t.stress_sd_pa.empty() ? "" : ",stress_sd_pa") << "\n";
     for (std::size_t k = 0; k < t.time_s.size(); ++k) {
@@ -310,8 +312,9 @@ void write_dataset(const Dataset& d, const std::string& folder) {
       if (!t.stress_sd_pa.empty()) csv << ',' << t.stress_sd_pa[k];
       csv << '\n';
     }
+    common::write_file_text((std::filesystem::path(folder) / t.file).string(), csv.str());
   }
-  std::ofstream(std::filesystem::path(folder) / "dataset.json") << j.dump(2) << "\n";
+  common::write_file_text((std::filesystem::path(folder) / "dataset.json").string(), j.dump(2) + "\n");
 }
 
 }  // namespace viscera::lab

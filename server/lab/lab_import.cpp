@@ -129,10 +129,16 @@ TestData import_test(const std::string& path, const ImportOptions& o, ImportOffs
   const auto column = [&](const ImportColumn& c, const char* flag) {
     const auto at = std::find(header.begin(), header.end(), c.name);
     if (at == header.end()) {
+      // At most 12 names, each cut: a header of thousands of cells (a file whose line ends were
+      // not seen) made an error line of megabytes.
       std::string names;
-      for (const auto& h : header) names += (names.empty() ? "" : ", ") + common::printable(h, 30);
-      throw InputError(path, 1, c.name, std::string("no such column (--") + flag + "); the columns are: " + names);
+      for (std::size_t k = 0; k < std::min<std::size_t>(header.size(), 12); ++k)
+        names += (names.empty() ? "" : ", ") + common::printable(header[k], 30);
+      if (header.size() > 12) names += ", and " + std::to_string(header.size() - 12) + " more";
+      throw InputError(path, 1, common::printable(c.name, 40), std::string("no such column (--") + flag + "); the columns are: " + names);
     }
+    if (std::find(at + 1, header.end(), c.name) != header.end())
+      throw InputError(path, 1, common::printable(c.name, 40), std::string("named twice in the header (--") + flag + " cannot tell which)");
     return static_cast<std::size_t>(at - header.begin());
   };
   const std::size_t ct = column(o.time, "time"), cf = column(o.force, "force"), cd = column(o.displacement, "displacement");

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 
@@ -32,9 +33,7 @@ void write_model(const std::string& path, const MaterialModel& m, const std::str
   if (m.has(Mechanism::tension_compression_asymmetry)) j["compression_ratio"] = m.compression_ratio;
   if (m.has(Mechanism::first_load_softening)) j["softening_d"] = m.softening_d;
   if (m.has(Mechanism::contact_take_up)) j["contact_strain"] = m.contact_strain;
-  std::ofstream out(path);
-  out << j.dump(2) << "\n";
-  if (!out) throw common::InputError(path, 0, "", "cannot write");
+  common::write_file_text(path, j.dump(2) + "\n");
 }
 
 MaterialModel read_model(const std::string& path) {

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "viscera/common/file_bytes.hpp"
+
 namespace viscera::plot {
 
 namespace {
@@ -92,9 +94,7 @@ void write_svg(const std::string& path, const Figure& input) {
     ly += 18;
   }
   o << "</svg>\n";
-  std::ofstream out(path);
-  out << o.str();
-  if (!out) throw std::runtime_error(path + ": cannot write");
+  common::write_file_text(path, o.str());
 }
 
 }  // namespace viscera::plot

@@ -46,10 +46,9 @@ void SimulationServer::Impl::answer_new_commands() {
     if (offer_counted(*c, now)) updated.push_back({c->instrument_id, c->client_id, *c});
   });
   for (const auto& u : updated) {
-    std::uint64_t tick = 0;
-    double strain = 0;
-    const ContactResult r = responder.answer(u.id, u.command, &tick, &strain);
-    publish_force(u.id, u.owner, u.command, r, 0, tick, strain);
+    std::shared_ptr<const Snapshot> used;
+    const ContactResult r = responder.answer(u.id, u.command, &used);
+    publish_force(u.id, u.owner, u.command, r, 0, used->tick, used->max_edge_strain, used->organ_epoch);
   }
 }
 
@@ -66,10 +65,9 @@ void SimulationServer::Impl::answer_in_lockstep(const std::vector<std::vector<st
       ++counted.unknown_instrument;
       continue;
     }
-    std::uint64_t tick = 0;
-    double strain = 0;
-    const ContactResult r = responder.answer(c->instrument_id, *c, &tick, &strain);
-    publish_force(c->instrument_id, c->client_id, *c, r, 0, tick, strain);
+    std::shared_ptr<const Snapshot> used;
+    const ContactResult r = responder.answer(c->instrument_id, *c, &used);
+    publish_force(c->instrument_id, c->client_id, *c, r, 0, used->tick, used->max_edge_strain, used->organ_epoch);
   }
 }
 

@@ -5,6 +5,8 @@
 
 #include <Eigen/Geometry>
 
+#include "viscera/runtime/surface_exit.hpp"
+
 namespace viscera::runtime {
 
 void add_grasp(ContactResult& result, const GraspHold::Reaction& r) {
@@ -76,14 +78,32 @@ std::shared_ptr<const Snapshot> CommandResponder::latest() const {
   return snapshot_;
 }
 
-ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c, std::uint64_t* tick, double* max_edge_strain) const {
+ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protocol::Command& c, std::shared_ptr<const Snapshot>* used) const {
   const auto snap = latest();
-  if (tick) *tick = snap->tick;
-  if (max_edge_strain) *max_edge_strain = snap->max_edge_strain;
-  const Vec3 tip(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
+  if (used) *used = snap;
+  const Vec3 commanded(c.tip_position[0], c.tip_position[1], c.tip_position[2]);
+  const auto held = snap->tool_position.find(instrument_id);
+  // Answered where the tool can be after the next tick: the commanded tip, unless the tool lags
+  // it by more than a tick's reach at the scene's speed limit (just claimed with the device deep
+  // in the organ, a hand faster than the limit): then as far toward it as the tool can go. The
+  // commanded tip itself gave the contact's whole depth at once (14.5 N in one answer after the
+  // 12k liver was loaded under a holding probe) while the server's tool entered from outside.
+  // A paused organ's tools do not move: its answers are at the commanded tip (a wall).
+  // Not active when the snapshot was taken (claimed since): the server starts it outside the
+  // tissue, so it touches nothing yet.
+  if (held == snap->tool_position.end()) return ContactResult{};
+  Vec3 tip = commanded;
+  if (!snap->paused)
+    if (const Vec3 gap = commanded - held->second; gap.norm() > snap->tool_reach_m) tip = held->second + (snap->tool_reach_m / gap.norm()) * gap;
   if (scalpels_.contains(instrument_id) && ((c.buttons & kCutButton) != 0 || snap->pressed_through.contains(instrument_id)))
     return ContactResult{.cutting = true};  // cutting: the blade passes through
-  ContactResult result = queries_.at(instrument_id)->query(tip, snap->x);
+  if (snap->in_cut.contains(instrument_id)) return ContactResult{};  // leaving the cut: it touches nothing
+  const ProbeContact& query = *queries_.at(instrument_id);
+  ContactResult result = query.query(tip, snap->x);
+  if (snap->paused && !result.in_contact) {
+    const Vec3 back = held->second - tip;
+    result = contact_from_inside(query, snap->x, tip, back.norm() > 1e-9 ? Vec3(back.normalized()) : Vec3::UnitZ());
+  }
   if (const auto g = snap->grasped.find(instrument_id); g != snap->grasped.end() && !g->second.empty()) {
     const Eigen::Quaterniond q = Eigen::Quaterniond(c.orientation[0], c.orientation[1], c.orientation[2], c.orientation[3]).normalized();
     add_grasp(result, g->second.query(tip, q, snap->x));

@@ -67,9 +67,14 @@ void SimulationServer::Impl::publish_snapshot(std::uint64_t tick) {
   snap->tick = tick;
   snap->max_edge_strain = organ->integrator->max_edge_strain();
   snap->x = state.x;
+  snap->organ_epoch = organ_epoch;
+  snap->paused = paused;
+  snap->tool_reach_m = scene.max_tool_speed_m_s / scene.physics_rate_hz;
   for (const auto& [id, t] : tools) {
     if (!t.tool.held().empty()) snap->grasped[id] = t.tool.held();
     if (t.tool.pressed_through()) snap->pressed_through.insert(id);
+    if (t.tool.cutting() || t.tool.leaving_cut()) snap->in_cut.insert(id);
+    if (t.tool.active()) snap->tool_position[id] = t.tool.position();
     if (t.result.in_contact) snap->tip_strain[id] = t.result.tip_strain;
   }
   responder.publish(std::move(snap));
@@ -78,11 +83,13 @@ void SimulationServer::Impl::publish_snapshot(std::uint64_t tick) {
 /// `tick`: the tick that stepped with the command, or whose state answered it; `strain`: the
 /// organ's largest edge strain that tick.
 void SimulationServer::Impl::publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r,
-                                           std::int64_t step_time_ns, std::uint64_t tick, double strain, double cut_edge_strain) {
+                                           std::int64_t step_time_ns, std::uint64_t tick, double strain, std::uint32_t epoch,
+                                           double cut_edge_strain) {
   proto::Force f = force_message(id, owner, command, r, local_stiffness(r, *organ->compliance, lockstep), proto::now_ns(), step_time_ns);
   f.tick = tick;
   f.max_edge_strain = strain;
   f.cut_edge_strain = cut_edge_strain;
+  f.organ_epoch = epoch;
   auto payload = proto::encode(f);
   if (capture)
     capture->forces.push_back(std::move(payload));
@@ -96,7 +103,7 @@ void SimulationServer::Impl::publish_forces(std::int64_t step_time_ns) {
   for (auto& [id, t] : tools) {
     if (t.tool.active())
       publish_force(id, t.tool.owner(), t.tool.command(), t.result, std::max<std::int64_t>(step_time_ns, 1), current_tick(),
-                    organ->integrator->max_edge_strain(), t.cut_edge_strain);
+                    organ->integrator->max_edge_strain(), organ_epoch, t.cut_edge_strain);
     if (const ToolEvent e = t.tool.update_contact(t.result.in_contact, sim_time_s); e != ToolEvent::none)
       event(e == ToolEvent::contact_started ? proto::EventKind::contact_started : proto::EventKind::contact_ended, id, t.tool.owner());
   }

@@ -43,6 +43,7 @@ void SimulationServer::Impl::take_sessions(const Status& status, const proto::Lo
         if (paused != (req->action == proto::Action::pause)) {
           if (status) status(who + (paused ? " resumed" : " paused") + " the simulation");
           event(paused ? proto::EventKind::resumed : proto::EventKind::paused, 0, req->client_id);
+          ++organ_epoch;  // the organ freezes or thaws under the tools
         }
         paused = req->action == proto::Action::pause;
         changed = true;

@@ -14,8 +14,10 @@ bool SimulatedTool::begin_tick(bool active, std::uint32_t owner, const protocol:
   if (!active_) {
     held_ = {};  // released, or its client silent: a grasper lets go
     press_ = {};
+    leaving_ = false;
     return false;
   }
+  if (was_active && blade_cuts(spec_, command_) && !blade_cuts(spec_, command)) leaving_ = true;
   command_ = command;
   if (was_active) return false;
   position_ = Vec3(command.tip_position[0], command.tip_position[1], command.tip_position[2]);

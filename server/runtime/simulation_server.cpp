@@ -13,6 +13,7 @@
 #include <pthread.h>
 
 #include "viscera/runtime/organ_cutting.hpp"
+#include "viscera/runtime/surface_exit.hpp"
 #include "viscera/runtime/tick_grid.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 
@@ -74,7 +75,10 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
     } else {
       scene.physics_rate_hz = rate;  // a set_physics_rate outlives a material change
       if (state.memory.size() != organ->model->memory_size()) state.memory.clear();  // relaxed
+      for (auto& [id, t] : tools)  // a stiffer material under a pressing tool: it enters again
+        if (t.tool.active()) start_outside(t);
     }
+    if (old) ++organ_epoch;
     publish_snapshot(ticks_run);
   }
   for (const auto& o : released)
@@ -97,6 +101,7 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
 void SimulationServer::Impl::reset_organ() {
   state = State::at_rest(*organ->mesh);
   reserve_for_cuts(*organ, state);
+  ++organ_epoch;
   for (auto& [id, t] : tools) {
     t.tool.let_go();
     if (t.tool.active()) start_outside(t);
@@ -104,6 +109,10 @@ void SimulationServer::Impl::reset_organ() {
 }
 
 void SimulationServer::Impl::start_outside(Tool& t) const {
+  // Out the way it came: along the normal of the contact it had (a reset or a new material under a
+  // press), else up against gravity (scenes' gravity is along -z), the way a hand brings a tool.
+  const Vec3 back = t.result.in_contact ? t.result.normal : Vec3::UnitZ();
+  if (const auto out = way_out(*organ->contact_surface, state.x, t.tool.position(), back, t.tool.spec().tip_radius_m)) t.tool.withdraw(*out);
   const BoundaryConditions::FieldEvaluation look{.x = state.x, .v = {}, .f = {}, .stiffness = {}, .damping = {}, .dt_s = 0.0};
   for (int k = 0; k < 4; ++k) {  // the contact's normal is the touched triangles' mean: a few passes
     const ContactResult r = t.contact->apply(t.tool.position(), Vec3::Zero(), look);
@@ -112,11 +121,18 @@ void SimulationServer::Impl::start_outside(Tool& t) const {
   }
 }
 
+void SimulationServer::Impl::leave_cuts() {
+  for (auto& [id, t] : tools)
+    if (t.tool.leaving_cut() && !t.contact->query(t.tool.position(), state.x).in_contact &&
+        !inside_surface(*organ->contact_surface, state.x, t.tool.position()))
+      t.tool.clear_of_tissue();
+}
+
 /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
 /// contact of each active tool, and the springs holding grasped nodes to the jaws.
 void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEvaluation& e) {
   for (auto& [id, t] : tools) {
-    if (!t.tool.active() || t.tool.cutting()) {  // a cutting blade passes through the tissue
+    if (!t.tool.active() || t.tool.cutting() || t.tool.leaving_cut()) {  // a cutting blade passes through the tissue
       t.result = ContactResult{.cutting = t.tool.cutting()};
       continue;
     }
@@ -176,6 +192,7 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
       organ->integrator->advance(state, dt);
       sim_time_s += dt;
       cut_with_scalpels(status);
+      leave_cuts();
       measure_tip_strain();
     } catch (const SimulationError& e) {
       // Keep serving, but never stay stuck: the same input would fail again from the rolled-back

@@ -54,6 +54,9 @@ struct SimulationServer::Impl {
   std::uint64_t ticks_run = 0;  // physics thread; the tick in progress (or the next) is ticks_run + 1
   std::uint32_t generation = 1;  // +1 per scene loaded: the surface's mesh_id
   bool paused = false;
+  // physics thread: +1 at each reset, scene loaded, material changed, pause and resume (the forces'
+  // organ_epoch: a client fades its force in again when it changes)
+  std::uint32_t organ_epoch = 0;
   // What the scene was loaded with and changed by since (SceneFiles, for recordings).
   struct SceneRecord {
     std::uint64_t first_tick = 1;
@@ -109,9 +112,11 @@ struct SimulationServer::Impl {
   void reset_organ();
 
   /// A tool that appears inside the tissue (claimed there, or held there while the organ went back
-  /// to rest) is withdrawn to the surface above its tip and enters at the scene's speed limit:
-  /// placed at full depth in one tick, the contact's whole force would strike a few surface nodes
-  /// in one step (on the 12k liver, a probe claimed 2 cm deep reset the organ 17 times a second).
+  /// to rest, was replaced or changed its material) is withdrawn to the surface above its tip and
+  /// enters at the scene's speed limit: placed at full depth in one tick, the contact's whole force
+  /// would strike a few surface nodes in one step (on the 12k liver, a probe claimed 2 cm deep
+  /// reset the organ 17 times a second). At any depth: a tip deeper than the contact's depth limit
+  /// leaves through the nearest surface point (surface_exit.hpp).
   void start_outside(Tool& t) const;
 
   /// The instruments' forces on the organ (the integrator's force field, taken implicitly):
@@ -128,6 +133,9 @@ struct SimulationServer::Impl {
   /// its blade swept during the tick, and strokes begin and end with events. The contacts see the
   /// cut surface from the next tick on.
   void cut_with_scalpels(const Status& status);
+  /// After the step: a scalpel leaving a cut (its button released in the tissue) touches again
+  /// once neither its tip's contact nor the surface holds it inside.
+  void leave_cuts();
   /// A scalpel's stroke ends (its cut_ended event says what it cut).
   void end_stroke(std::uint32_t id, Tool& t);
   /// Between strokes, the haptic local model's contact compliance of the cut organ: built again in
@@ -151,9 +159,10 @@ struct SimulationServer::Impl {
   void publish_snapshot(std::uint64_t tick);
 
   /// `tick`: the tick that stepped with the command, or whose state answered it; `strain`: the
-  /// organ's largest edge strain that tick; `cut_edge_strain`: a scalpel's, of what it cut that tick.
+  /// organ's largest edge strain that tick; `epoch`: the organ's epoch then; `cut_edge_strain`: a
+  /// scalpel's, of what it cut that tick.
   void publish_force(std::uint32_t id, std::uint32_t owner, const proto::Command& command, const ContactResult& r, std::int64_t step_time_ns,
-                     std::uint64_t tick, double strain, double cut_edge_strain = 0);
+                     std::uint64_t tick, double strain, std::uint32_t epoch, double cut_edge_strain = 0);
 
   /// After a tick: every active tool's force, and its contact and grasp events.
   void publish_forces(std::int64_t step_time_ns);

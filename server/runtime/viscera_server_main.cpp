@@ -5,8 +5,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include "viscera/common/command_line.hpp"
@@ -41,6 +43,7 @@ int main(int argc, char** argv) {
       "resimulate) sends each tick and reads what it produced (docs/RECORDING.md).");
   cl.flag("scene", "FILE", "scene file (required)");
   cl.flag("scene-dir", "DIR", "scenes that clients may load by name (default: the scene file's directory)");
+  cl.flag("domain", "N", "the DDS domain, 0-230 (default: the scene file's domain_id)");
   cl.flag("duration", "S", "stop after S seconds; 0 runs until signalled", "0");
   cl.flag("max-tick-ms", "MS", "longest a physics tick may take on this machine [ms]: a scene, material or rate needing more is refused", "100");
   cl.flag(
@@ -54,6 +57,7 @@ int main(int argc, char** argv) {
   double duration = 0;
   viscera::runtime::TickBudget budget;
   bool quiet = false, lockstep = false;
+  std::optional<std::uint32_t> domain;
   std::string station;
   try {
     if (!cl.parse(argc, argv)) return 0;
@@ -66,6 +70,7 @@ int main(int argc, char** argv) {
     budget.max_tick_s = 1e-3 * cl.number_in("max-tick-ms", 0.1, 10000);
     quiet = cl.has("quiet");
     lockstep = cl.has("lockstep");
+    if (cl.has("domain")) domain = static_cast<std::uint32_t>(cl.integer_in("domain", 0, 230));
     station = viscera::protocol::checked_station(cl.text("station"));
     if (lockstep && !cl.given("max-tick-ms")) budget.max_tick_s = 1e9;  // no real time to keep
   } catch (const viscera::common::UsageError& e) {
@@ -83,10 +88,17 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  // A lockstep server serves the driver that started it: it stops when that process dies, even by
+  // SIGKILL (which runs nothing of the driver's), instead of waiting for steps for ever.
+  if (lockstep) {
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() == 1) std::raise(SIGTERM);  // the driver died before the line above
+  }
   try {
     // Building a large organ takes seconds (the 96k liver about 3 s): say so before it starts.
     if (!quiet) log->info("loading {}", scene);
-    const viscera::runtime::SceneSpec spec = viscera::runtime::read_scene_file(scene);
+    viscera::runtime::SceneSpec spec = viscera::runtime::read_scene_file(scene);
+    if (domain) spec.domain_id = *domain;
     viscera::runtime::DdsEndpoints endpoints(spec.domain_id, station, lockstep);
     auto server = std::make_unique<viscera::runtime::SimulationServer>(spec, endpoints, scene_dir, budget, lockstep);
     log->info("{}{}{}", lockstep ? "lockstep, " : "", server->describe(), station.empty() ? "" : ", station " + station);

@@ -30,6 +30,7 @@ DeviceLoopOptions options(bool reconnect = false) {
 void feed_model(DeviceLoop& loop, double t) {
   viscera::protocol::Force f;
   f.force = {0, 0, 1.0};
+  f.contact_normal = {0, 0, 1};
   f.in_contact = true;
   loop.renderer().update(f, {0, 0, 0}, t);
 }
@@ -220,4 +221,39 @@ TEST(DeviceLoop, ANewSceneMeansClaimingAgainAndTheNewGenerationThen) {
   const auto [t2, s2] = run(loop, t + kPeriod, 2.0, ServerState::alive, InstrumentView{2, 22, "liver-nodule"}, Action::drive);
   EXPECT_EQ(s2.action, Action::render_only);
   EXPECT_LT(t2, t + 0.1 + 2 * kPeriod);
+}
+
+TEST(DeviceLoop, AJumpOfTheOrganRampsTheForceAndSaysSo) {
+  DeviceLoop loop(options(), 1);
+  const viscera::protocol::Vector3 x{0, 0, 0};
+  feed_model(loop, 0);  // 1 N
+  EXPECT_EQ(loop.organ_epoch(0.0, 3), "");  // the first epoch seen is no jump
+  EXPECT_EQ(loop.organ_epoch(0.5, 3), "");
+  EXPECT_NEAR(loop.renderer().render(x, 0.99).force[2], 1.0, 1e-12);
+  viscera::protocol::Force after;  // reset under the tool: it is out of contact at once
+  loop.renderer().update(after, x, 1.0);
+  const std::string said = loop.organ_epoch(1.0, 4);
+  EXPECT_NE(said.find("the force ramps to the new one over 0.10 s"), std::string::npos) << said;
+  EXPECT_NEAR(loop.renderer().render(x, 1.0).force[2], 1.0, 1e-12);  // from what the hand felt ...
+  EXPECT_NEAR(loop.renderer().render(x, 1.05).force[2], 0.5, 1e-12);  // ... linearly ...
+  EXPECT_NEAR(loop.renderer().render(x, 1.1).force[2], 0.0, 1e-12);  // ... to the new force, in 0.1 s
+}
+
+TEST(DeviceLoop, AfterAClaimTheForceRampsFromTheFirstAnswer) {
+  DeviceLoop loop(options(), 1);
+  const viscera::protocol::Vector3 x{0, 0, 0};
+  feed_model(loop, 0);
+  const auto [t, s] = run(loop, 0.0, 1.0, ServerState::alive, InstrumentView{2, 0, "liver-12k"}, Action::drive);
+  ASSERT_EQ(s.action, Action::claim_again);
+  viscera::protocol::Force none;  // nothing felt while the new scene was loaded
+  loop.renderer().update(none, x, t);
+  EXPECT_EQ(loop.renderer().render(x, t + 0.01).force[2], 0.0);  // after the 3 ms blend
+  loop.claimed(t + 0.5, true, "", {2, kMe, "liver-12k"});
+  EXPECT_EQ(loop.organ_epoch(t + 0.6, 9), "");  // the new organ's epoch, with the first answer: no second jump
+  feed_model(loop, t + 0.6);  // the first answer, 0.1 s after the claim: 1 N, the tool deep in the tissue
+  EXPECT_EQ(loop.renderer().render(x, t + 0.6).force[2], 0.0);
+  EXPECT_NEAR(loop.renderer().render(x, t + 0.65).force[2], 0.5, 1e-9);
+  EXPECT_NEAR(loop.renderer().render(x, t + 0.7).force[2], 1.0, 1e-9);
+  feed_model(loop, t + 0.8);  // and only after that answer
+  EXPECT_NEAR(loop.renderer().render(x, t + 0.8).force[2], 1.0, 1e-12);
 }

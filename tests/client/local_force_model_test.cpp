@@ -92,3 +92,42 @@ TEST(LocalForceRenderer, AServerKnownToBeGoneFadesAtOnceAndAReturningOneFadesBac
   EXPECT_NEAR(renderer.gain(1.25), 1.0, 1e-12);
   EXPECT_NEAR(renderer.gain(1.3), 1.0, 1e-12);
 }
+
+TEST(LocalForceRenderer, AfterARestartTheForceRampsFromWhatTheHandFeltToTheNewModel) {
+  client::LocalForceRenderer renderer(10.0, 0.0, {.stale_after_s = 10.0, .fade_s = 0.05, .fade_in_s = 0.2});
+  const protocol::Vector3 x{0, 0, 0.01};
+  renderer.update(contact(), x, 1.0);
+  EXPECT_NEAR(renderer.render(x, 1.09).force[2], 2.0, 1e-12);
+  auto stiffer = contact();  // the organ jumped under the tool: 4 N at once
+  stiffer.force = {0, 0, 4.0};
+  renderer.update(stiffer, x, 1.1);
+  renderer.restart(1.1);
+  EXPECT_NEAR(renderer.render(x, 1.1).force[2], 2.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.15).force[2], 2.5, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.2).force[2], 3.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 1.3).force[2], 4.0, 1e-12);
+  // Down as well: the tool withdrawn from the tissue (no contact) after another jump.
+  renderer.update(protocol::Force{}, x, 2.0);
+  renderer.restart(2.0);
+  EXPECT_NEAR(renderer.render(x, 2.0).force[2], 4.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 2.1).force[2], 2.0, 1e-12);
+  EXPECT_NEAR(renderer.render(x, 2.2).force[2], 0.0, 1e-12);
+}
+
+TEST(LocalForceRenderer, AContactRegainedWithForceRampsInAndATouchDoesNot) {
+  client::LocalForceRenderer renderer(10.0, 0.0, {.stale_after_s = 10.0, .fade_s = 0.05, .fade_in_s = 0.2, .contact_onset_n = 1.0});
+  const protocol::Vector3 x{0, 0, 0.01};
+  protocol::Force off;  // out of contact
+  renderer.update(off, x, 1.0);
+  auto touch = contact();
+  touch.force = {0, 0, 0.4};  // a first touch: below the 1 N onset
+  renderer.update(touch, x, 1.001);
+  EXPECT_NEAR(renderer.render(x, 1.001).force[2], 0.4, 1e-12);
+  renderer.update(off, x, 1.002);  // lost (a flicker) ...
+  EXPECT_EQ(renderer.render(x, 1.002).force[2], 0.0);
+  renderer.update(contact(), x, 1.003);  // ... and back at 2 N: a jump, ramped in
+  EXPECT_EQ(renderer.render(x, 1.003).force[2], 0.0);
+  EXPECT_NEAR(renderer.render(x, 1.103).force[2], 1.0, 1e-12);
+  renderer.update(contact(), x, 1.5);  // staying in contact does not ramp again
+  EXPECT_NEAR(renderer.render(x, 1.5).force[2], 2.0, 1e-12);
+}

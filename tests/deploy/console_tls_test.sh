@@ -54,7 +54,7 @@ PY
 "$console" --domain "$domain" --stations bay-1 --listen 127.0.0.1:0 --token-file "$tmp/token" \
   --tls-cert "$pki/console-web.pem" --tls-key "$pki/console-web.key" > "$tmp/console.log" 2>&1 & pids+=($!)
 wait_for "station(s); open https" "$tmp/console.log" 100 || exit 1
-url=$(grep -o 'https://[^ ]*' "$tmp/console.log" | head -1)
+url="$(grep -o 'https://[^ ]*' "$tmp/console.log" | head -1)?token=$(cat "$tmp/token")"
 wait_for "station bay-1" "$tmp/server.log" 150 || exit 1
 plain=$(curl -s --max-time 5 "${url/https/http}")
 check "a plain HTTP request on the TLS port is told to use https" '[[ "$plain" == *"speaks HTTPS only"* ]]'

@@ -21,7 +21,7 @@ openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 "$build/tools/viscera-console/viscera-console" --domain "$domain" --stations bay-1,bay-2,bay-3 --listen 127.0.0.1:0 --token-file "$tmp/token" > "$tmp/console.log" 2>&1 &
 console=$!; pids+=($console)
 wait_for "station(s); open" "$tmp/console.log" 100
-url=$(grep -o 'http://[^ ]*' "$tmp/console.log" | head -1)
+url="$(grep -o 'http://[^ ]*' "$tmp/console.log" | head -1)?token=$(cat "$tmp/token")"
 for b in 1 2; do
   "$hc" --domain "$domain" --station "bay-$b" --client-id 11 --instrument 1 --duration 6 --quiet --report "$tmp/hc-$b.json" > "$tmp/hc-$b.log" 2>&1 &
   clients[$b]=$!

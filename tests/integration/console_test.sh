@@ -50,7 +50,7 @@ mkdir -p "$tmp/recordings"
 "$build/tools/viscera-record/viscera-record" --out "$tmp/recordings/session.mcap" --domain "$domain" --quiet > "$tmp/record.log" 2>&1 & recorder=$!; pids+=($recorder)
 "$console" --domain "$domain" --token-file "$tmp/token" --listen 127.0.0.1:0 --recordings "$tmp/recordings" --discover > "$tmp/console.log" 2>&1 & bridge=$!; pids+=($bridge)
 wait_for "open http" "$tmp/console.log" || exit 1
-url=$(grep -o "http://[^ ]*" "$tmp/console.log")
+url="$(grep -o "http://[^ ]*" "$tmp/console.log")?token=$(cat "$tmp/token")"
 sleep 1
 # --reconnect, as a station's client runs (docs/DEPLOY.md): a stall of the loaded machine (Chromium
 # draws in software beside everything) that looks like a lost server is ridden through.
@@ -78,6 +78,7 @@ check "nothing was written through a link in /tmp" '[ "$(cat "$tmp/victim")" = m
 node "$node_dir/console_robustness.mjs" "$url" "$bridge" > "$tmp/robust.json" 2> "$tmp/robust.err"; rc_robust=$?; cat "$tmp/robust.err" >&2
 check "misbehaving browsers (console_robustness.mjs) $(fails_in "$tmp/robust.err")" '[ $rc_robust -eq 0 ]'
 check "the bridge still runs" 'kill -0 "$bridge" 2>/dev/null'
+check "the access token is in no log line (the address is printed without it)" '! grep -qF "$(cat "$tmp/token")" "$tmp/console.log"'
 # Another station's server appears on the domain (partition bay-2, at 200 Hz to spare the CPU): the
 # console (--discover) offers it as a station, once; the default station and the replay it opened
 # itself are not offered again.

@@ -316,6 +316,34 @@ TEST(Import, ExportsBecomeADataSetByTheStatedConversion) {
   wrong.force.name = "Load";
   const std::string missing = error([&] { import_dataset({dir + "/sample A.txt"}, wrong, dir + "/ds2"); });
   EXPECT_NE(missing.find("sample A.txt:1: Load: no such column (--force); the columns are: Time, Force, Disp"), std::string::npos) << missing;
+  // Line ends of CR alone (some machines' exports) end lines as CR LF does: the same test.
+  {
+    std::ifstream in(dir + "/sample A.txt");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.erase(std::remove(text.begin(), text.end(), '\n'), text.end());
+    std::ofstream(dir + "/sample C.txt") << text;
+  }
+  const Dataset cr = import_dataset({dir + "/sample C.txt"}, o, dir + "/ds-cr");
+  ASSERT_EQ(cr.tests.size(), 1u);
+  EXPECT_EQ(cr.tests[0].time_s, t.time_s);
+  EXPECT_EQ(cr.tests[0].stress_pa, t.stress_pa);
+  // A header of thousands of cells: the error names a dozen of them, not the whole file.
+  {
+    std::ofstream f(dir + "/wide.txt");
+    for (int k = 0; k < 5000; ++k) f << (k ? "\t" : "") << "column number " << k;
+    f << "\n1\n";
+  }
+  const std::string wide = error([&] { import_dataset({dir + "/wide.txt"}, o, dir + "/ds-wide"); });
+  EXPECT_NE(wide.find("no such column (--time)"), std::string::npos) << wide.substr(0, 300);
+  EXPECT_NE(wide.find("and 4988 more"), std::string::npos) << wide.substr(0, 300);
+  EXPECT_LT(wide.size(), 700u);
+  // A column taken by name that the header names twice: which one is meant cannot be told.
+  {
+    std::ofstream f(dir + "/twice.txt");
+    f << "Time\tForce\tDisp\tForce\n0\t0\t0\t0\n";
+  }
+  EXPECT_NE(error([&] { import_dataset({dir + "/twice.txt"}, o, dir + "/ds-twice"); }).find("twice.txt:1: Force: named twice in the header"),
+            std::string::npos);
   // Millimetres declared as metres: strains of 1000% are refused by the data set's own checks.
   wrong = o;
   wrong.displacement = parse_import_column("displacement", "Disp:m", ImportQuantity::displacement);

@@ -71,6 +71,8 @@ const closed = new Promise((resolve) => big.once('close', (code) => resolve(code
 big.send('x'.repeat(100 * 1024));
 const code = await Promise.race([closed, sleep(5000).then(() => 'still open')]);
 check('an oversized message closes the connection', code === 1009, `close code ${code}`);
+const s3 = await stats();
+check('the oversized close is counted', s3.closed_oversized >= 1, `closed_oversized ${s3.closed_oversized}`);
 
 // 4. A flood: rate-limit errors, then closed.
 const flooder = await open();

@@ -51,6 +51,15 @@ def test_analyze_gives_the_programs_report(tmp_path: Path) -> None:
     subprocess.run([program("tools/viscera-lab/viscera-lab"), "predict", str(tmp_path / "model.json"), str(TITIN), "--out", str(tmp_path / "p")],
                    check=True, capture_output=True)
     figures_equal(json.loads((tmp_path / "p/report.json").read_text()), viscera.lab.predict(tmp_path / "model.json", TITIN))
+    # Never over the data set it was fitted to, nor through a link planted at the path.
+    with pytest.raises(viscera.InputError, match="dataset.json"):
+        a.write_model(TITIN / "dataset.json")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("mine")
+    (tmp_path / "planted.json").symlink_to(victim)
+    with pytest.raises(viscera.InputError, match="symbolic link"):
+        a.write_model(tmp_path / "planted.json")
+    assert victim.read_text() == "mine"
     # The prediction of a test is the model's: its RMS error is the report's.
     for t, reported in zip(a.dataset.tests, a.report["final"]["tests"]):
         y = a.predict(t.file, "final")

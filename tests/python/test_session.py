@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import subprocess
+import time
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,36 @@ def test_requests_refused_with_the_servers_reason(server: Server, domain: int) -
     scene = c.scene()
     assert scene is not None and scene.paused
     assert c.resume(5.0)
+
+
+def test_what_the_server_would_refuse_is_refused_at_once(server: Server, domain: int) -> None:
+    # The participant: what every program's command line refuses (a 66,000-character station
+    # crashed Cyclone; '*' reached live servers' partitions; 0 is no client id).
+    for client_id, partition in ((0, ""), (33, "*"), (33, "s" * 66000), (33, "a/b")):
+        with pytest.raises(viscera.UsageError):
+            viscera.session.Client(domain, client_id, partition)
+    # Requests the server's decoder refuses as malformed (it would never answer them: each call
+    # waited its whole 30 s timeout): refused here at once, with the decoder's reason.
+    c = viscera.session.Client(domain, 33)
+    assert c.wait_for_scene(10.0) is not None
+    started = time.monotonic()
+    for call, reason in (
+        (lambda: c.load_scene("../liver"), "scene_name"),
+        (lambda: c.load_scene(""), "scene_name"),
+        (lambda: c.load_scene(".hidden"), "scene_name"),
+        (lambda: c.load_scene("liver\n"), "scene_name"),
+        (lambda: c.set_material(youngs_modulus_pa=float("nan")), "youngs_modulus_pa"),
+        (lambda: c.set_material(youngs_modulus_pa=-1.0), "youngs_modulus_pa"),
+        (lambda: c.set_material(youngs_modulus_pa=1e-300), "youngs_modulus_pa"),
+        (lambda: c.set_material(file_text="{}" + " " * 70000, file_name="big.json"), "file_text"),
+        (lambda: c.set_material(file_text="{}", file_name="../../etc/passwd"), "file_name"),
+        (lambda: c.set_physics_rate(0.0), "physics_rate_hz"),
+    ):
+        with pytest.raises(viscera.UsageError, match=reason):
+            call()
+    assert time.monotonic() - started < 2.0, "a refusal waited for the server"
+    with pytest.raises(ValueError, match="not finite"):
+        c.send_tip(1, [0.0, float("nan"), 0.0])
 
 
 def test_recording_reads_into_dataframes_as_the_official_reader_counts(session: Session) -> None:

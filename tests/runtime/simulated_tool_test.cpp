@@ -79,3 +79,33 @@ TEST(SimulatedTool, AContactEndsAfter50msWithoutTouchingSoABounceIsOneContact) {
 
 }  // namespace
 }  // namespace viscera::runtime
+
+namespace viscera::runtime {
+namespace {
+
+TEST(SimulatedTool, AScalpelWhoseCutButtonIsReleasedLeavesTheCutTouchingNothingUntilClear) {
+  SimulatedTool scalpel({4, InstrumentKind::scalpel, 0.001});
+  protocol::Command cut = at(-0.012);
+  cut.buttons = kCutButton;
+  scalpel.begin_tick(true, 11, cut);
+  EXPECT_TRUE(scalpel.cutting());
+  EXPECT_FALSE(scalpel.leaving_cut());
+  scalpel.begin_tick(true, 11, at(-0.012));  // released with the blade 12 mm in the tissue
+  EXPECT_FALSE(scalpel.cutting());
+  EXPECT_TRUE(scalpel.leaving_cut());
+  scalpel.begin_tick(true, 11, at(-0.01));  // leaving stays until the server finds it clear
+  EXPECT_TRUE(scalpel.leaving_cut());
+  scalpel.clear_of_tissue();
+  EXPECT_FALSE(scalpel.leaving_cut());
+  // Released by its owner: nothing left of it; a probe's buttons mean nothing.
+  scalpel.begin_tick(true, 11, cut);
+  scalpel.begin_tick(false, 0, at(-0.012));
+  EXPECT_FALSE(scalpel.leaving_cut());
+  SimulatedTool probe({1, InstrumentKind::probe});
+  probe.begin_tick(true, 11, cut);
+  probe.begin_tick(true, 11, at(-0.012));
+  EXPECT_FALSE(probe.leaving_cut());
+}
+
+}  // namespace
+}  // namespace viscera::runtime

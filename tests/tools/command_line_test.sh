@@ -74,7 +74,7 @@ printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n0.5,0,0,0\n0.5,0,0,-0.01\n' >"$tmp/t2.cs
 printf 'time_s,x_m,y_m\n0,0,0\n' >"$tmp/t3.csv"
 printf 'time_s,x_m,y_m,z_m\n0,0,0,0\n1,0,0,-20\n' >"$tmp/t4.csv"
 printf 'time_s,x_m,y_m,z_m,jaw_rad\n0,0,0,0,0.5\n1,0,0,0,7\n' >"$tmp/t5.csv"
-expect hc-traj-missing 2 "nowhere.csv: cannot open file" -- "$hc" --trajectory "$tmp/nowhere.csv"
+expect hc-traj-missing 2 "nowhere.csv: no such file" -- "$hc" --trajectory "$tmp/nowhere.csv"
 expect hc-traj-number 2 "t1.csv:3: column z_m: 'abc' is not a number" -- "$hc" --trajectory "$tmp/t1.csv"
 expect hc-traj-time 2 "t2.csv:4: column time_s" -- "$hc" --trajectory "$tmp/t2.csv"
 expect hc-traj-header 2 "t3.csv:1: column z_m: missing from the header" -- "$hc" --trajectory "$tmp/t3.csv"

@@ -82,6 +82,29 @@ diff -r "$tmp/ds" "$tmp/ds.copy" >/dev/null && passed=$((passed+1)) || fail "the
 printf 'time_s,x_m,y_m,z_m\n0,0,0,0.01\n1,0,0,0\n' > "$tmp/t.csv"; cp "$tmp/t.csv" "$tmp/t.copy"
 expect hc-report-over-trajectory 2 "is the same file as" -- "$hc" --trajectory "$tmp/t.csv" --report "$tmp/t.csv"
 unchanged hc-report "$tmp/t.csv" "$tmp/t.copy"
+# A trajectory is a regular file of bounded size: a FIFO blocked the client for ever, /dev/zero
+# grew it to 735 MB in 5 s.
+mkfifo "$tmp/traj-fifo"
+expect hc-trajectory-fifo 2 "traj-fifo: is not a regular file" -- "$hc" --trajectory "$tmp/traj-fifo"
+expect hc-trajectory-zero 2 "/dev/zero: is not a regular file" -- "$hc" --trajectory /dev/zero
+
+# 4b. Outputs are never written through a symbolic link planted at their path (a shared folder,
+#     /tmp): the one way every program writes a file (common::write_file_text) refuses it, and the
+#     link's target is left as it was.
+echo mine > "$tmp/victim"; cp "$tmp/victim" "$tmp/victim.copy"
+ln -s "$tmp/victim" "$tmp/planted.csv"; ln -s "$tmp/victim" "$tmp/planted.svg"
+f2="$build/tools/viscera-figure2/viscera-figure2"
+expect figure2-csv-link 2 "planted.csv: is a symbolic link" -- "$f2" --csv "$tmp/planted.csv" --svg "$tmp/f2.svg"
+expect figure2-svg-link 2 "planted.svg: is a symbolic link" -- "$f2" --csv "$tmp/f2.csv" --svg "$tmp/planted.svg"
+mkdir -p "$tmp/sim"; ln -s "$tmp/victim" "$tmp/sim/frames.pvd"
+expect sim-pvd-link 2 "frames.pvd: is a symbolic link" -- "$build/tools/viscera-sim/viscera-sim" --mesh "$src/data/meshes/liver.msh" \
+  --scale 0.01 --duration 0.01 --frame-rate 100 --out "$tmp/sim"
+unchanged outputs-through-links "$tmp/victim" "$tmp/victim.copy"
+# An --out that cannot be a folder is refused before the analysis, in one line (it aborted after it).
+touch "$tmp/plain-file"
+expect lab-out-under-a-file 2 "--out: cannot create the folder" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/plain-file/sub"
+expect lab-out-too-long 2 "--out: cannot create the folder" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/$(printf 'x%.0s' $(seq 300))"
+expect figure2-csv-fifo 2 "is not a regular file" -- "$f2" --csv "$tmp/traj-fifo" --svg "$tmp/f2.svg"
 
 # 5. Station names are DDS partitions: a wildcard would reach other stations' live sessions, and
 #    every program that joins a station checks the name before it touches the network.

@@ -21,6 +21,7 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/device_runner.hpp"
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
 #include "viscera/protocol/dds.hpp"
@@ -112,7 +113,7 @@ nlohmann::json to_json(const std::vector<ForceSample>& samples) {
 struct Options {
   std::uint32_t domain = 0, client_id = 1, instrument = 1;
   double rate_hz = 1000, depth_m = 0.03, pull_m = 0.02, length_m = 0.04, offset_y_m = 0, hold_s = -1, force_n = 1.0, max_force_n = 15,
-         blend_s = 0.003, tick_phase_us = 100, duration_s = 4;
+         blend_s = 0.003, tick_phase_us = 100, duration_s = 4, slew_n_per_ms = 1.0;
   viscera::client::FadePolicy fade;
   std::string station, script, frame, report;
   std::vector<viscera::haptic::TrajectoryPoint> trajectory;
@@ -137,6 +138,8 @@ Options parse(viscera::common::CommandLine& cl) {
   o.blend_s = cl.number_in("blend", 0, 0.1);
   o.fade.fade_s = cl.number_in("fade", 0.001, 5);
   o.fade.stale_after_s = cl.number_in("stale-after", 0.001, 5);
+  o.fade.fade_in_s = cl.number_in("fade-in", 0.001, 5);
+  o.slew_n_per_ms = cl.number_in("slew-limit", 0.01, 1000);
   o.script = cl.text("script");
   o.frame = cl.text("frame");
   if (o.script != "press" && o.script != "grasp" && o.script != "hold" && o.script != "palpate" && o.script != "incise")
@@ -194,7 +197,7 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
   // Reserved up front so the loop never reallocates (pages are touched only as samples come).
   if (!o.report.empty()) run.samples.reserve(static_cast<std::size_t>(std::min(o.duration_s * o.rate_hz + 16, double{1 << 22})));
   viscera::client::DeviceRunOptions options;
-  options.loop = {o.client_id, o.instrument, o.max_force_n, o.blend_s, o.fade, o.reconnect};
+  options.loop = {o.client_id, o.instrument, o.max_force_n, o.blend_s, o.fade, o.reconnect, o.slew_n_per_ms};
   options.rate_hz = o.rate_hz;
   options.duration_s = o.duration_s;
   options.tick_phase_us = o.tick_phase_us;
@@ -222,34 +225,36 @@ RunResult run_device(const Options& o, viscera::client::Client& client, viscera:
 
 void write_report(const Options& o, const std::string& scene, const std::string& device, double start_epoch_s,
                   const viscera::client::LatencyStats& rtt, const RunResult& run) {
-  nlohmann::json r{{"scene", scene},
-                   {"instrument", o.instrument},
-                   {"client_id", o.client_id},
-                   {"rate_hz", o.rate_hz},
-                   {"start_epoch_s", start_epoch_s},
-                   {"duration_s", o.duration_s},
-                   {"device", device},
-                   {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
-                   {"tick_phase", {{"offset_us", o.tick_phase_us}, {"periods", run.phased}, {"within_50us", run.near_phase}}},
-                   {"fade", {{"stale_after_s", o.fade.stale_after_s}, {"fade_s", o.fade.fade_s}}},
-                   {"server_lost_t_s", run.server_lost_t_s},
-                   {"taken_over", run.taken_over},
-                   {"instrument_lost_t_s", run.instrument_lost_t_s},
-                   {"instrument_losses", run.instrument_losses},
-                   {"stall_s", run.stall_s},
-                   {"stall_end_t_s", run.stall_end_t_s},
-                   {"faded_t_s", run.faded_t_s},
-                   {"server_returns", run.server_returns},
-                   {"longest_silence_s", run.longest_silence_s},
-                   {"longest_silence_end_t_s", run.longest_silence_end_t_s},
-                   {"samples", to_json(run.samples)}};
+  nlohmann::json r{
+      {"scene", scene},
+      {"instrument", o.instrument},
+      {"client_id", o.client_id},
+      {"rate_hz", o.rate_hz},
+      {"start_epoch_s", start_epoch_s},
+      {"duration_s", o.duration_s},
+      {"device", device},
+      {"round_trip_us", {{"samples", rtt.samples}, {"p50", rtt.p50_us}, {"p99", rtt.p99_us}, {"max", rtt.max_us}}},
+      {"tick_phase", {{"offset_us", o.tick_phase_us}, {"periods", run.phased}, {"within_50us", run.near_phase}}},
+      {"fade", {{"stale_after_s", o.fade.stale_after_s}, {"fade_s", o.fade.fade_s}, {"fade_in_s", o.fade.fade_in_s}}},
+      {"slew_limit", {{"n_per_ms", o.slew_n_per_ms}, {"periods_limited", run.slew_limited}, {"largest_step_asked_n", run.largest_step_asked_n}}},
+      {"server_lost_t_s", run.server_lost_t_s},
+      {"taken_over", run.taken_over},
+      {"instrument_lost_t_s", run.instrument_lost_t_s},
+      {"instrument_losses", run.instrument_losses},
+      {"stall_s", run.stall_s},
+      {"stall_end_t_s", run.stall_end_t_s},
+      {"faded_t_s", run.faded_t_s},
+      {"server_returns", run.server_returns},
+      {"longest_silence_s", run.longest_silence_s},
+      {"longest_silence_end_t_s", run.longest_silence_end_t_s},
+      {"samples", to_json(run.samples)}};
   if (o.watch_mesh)
     r["mesh"] = {{"frames", run.mesh.frames},
                  {"rate_hz", run.mesh.rate_hz()},
                  {"topology_generation", run.mesh.generation},
                  {"surface_vertices", run.mesh.rest.size() / 3},
                  {"samples", run.mesh.samples}};
-  std::ofstream(o.report) << r.dump(1) << "\n";
+  viscera::common::write_file_text(o.report, r.dump(1) + "\n");
 }
 
 }  // namespace
@@ -298,6 +303,12 @@ int main(int argc, char** argv) {
   cl.flag("blend", "S", "blend from one local force model to the next over this time [s]", "0.003");
   cl.flag("fade", "S", "when the server stops answering or is gone, fade the rendered force to zero over this time [s]", "0.25");
   cl.flag("stale-after", "S", "a local force model this old means the server is not answering: start the fade [s]", "0.25");
+  cl.flag("fade-in", "S", "after a jump (a claim, the organ reset, reloaded, paused or given another material) fade the force in over this time [s]",
+          "0.1");
+  cl.flag("slew-limit", "N_PER_MS",
+          "the rendered force changes by at most this much per millisecond [N/ms], whatever the server sends (docs/FAULTS.md, \"The force "
+          "on the hand\")",
+          "1");
   cl.flag("tick-phase", "US", "send commands this long after each server tick [us] (at --rate = physics rate; negative: loop free)", "100");
   cl.option_switch("watch-mesh", "receive the organ's surface frames and report their rate and the surface's displacement");
   cl.option_switch("reconnect",

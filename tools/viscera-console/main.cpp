@@ -310,7 +310,9 @@ int main(int argc, char** argv) {
     stations.attach(server.get());
     const auto ep = server->endpoint();
     const std::string host = ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
-    logger->info("domain {}, {} station(s); open {}://{}:{}/?token={}", domain, stations.size(), tls ? "https" : "http", host, ep.port(), token);
+    // The token is a secret: never in a log (the unit sends this line to the journal and a log file).
+    logger->info("domain {}, {} station(s); open {}://{}:{}/ with ?token= and the token in {} (it is never logged)", domain, stations.size(),
+                 tls ? "https" : "http", host, ep.port(), cl.text("token-file"));
 
     std::optional<viscera::protocol::Participant> discovery_participant;
     std::optional<viscera::protocol::PartitionDiscovery> discovery;

@@ -70,7 +70,10 @@ class Browser : public std::enable_shared_from_this<Browser> {
     std::visit(
         [&](auto& ws) {
           ws.set_option(timeouts);
-          ws.read_message_max(kMaxRequestBytes);
+          // The size of a message is this session's to count (on_read): Beast's own limit closes
+          // with 1009 too, but its error is lost when the browser's side of the teardown fails,
+          // and such closes went uncounted.
+          ws.read_message_max(0);
           ws.set_option(websocket::stream_base::decorator([foxglove](websocket::response_type& r) {
             r.set(http::field::server, "viscera-console");
             if (foxglove) r.set(http::field::sec_websocket_protocol, kFoxgloveSubprotocol);
@@ -172,17 +175,30 @@ class Browser : public std::enable_shared_from_this<Browser> {
     send_json({{"type", "error"}, {"id", id}, {"message", message}});
   }
 
+  /// A message is read a piece at a time: never more than kMaxRequestBytes and one piece held.
   void read() {
-    std::visit([this](auto& ws) { ws.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); }); }, ws_);
+    std::visit(
+        [this](auto& ws) {
+          ws.async_read_some(in_, 16 * 1024, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+        },
+        ws_);
   }
 
   void on_read(beast::error_code ec) {
     if (ec) {
-      if (ec == websocket::error::message_too_big) ++server_->counters.oversized;
       if (!closing_) leave();
       closing_ = true;
       return;
     }
+    if (in_.size() > kMaxRequestBytes) {  // too big: closed with 1009, counted
+      ++server_->counters.oversized;
+      leave();
+      closing_ = true;
+      in_.consume(in_.size());
+      std::visit([self = shared_from_this()](auto& ws) { ws.async_close(websocket::close_code::too_big, [self](beast::error_code) {}); }, ws_);
+      return;
+    }
+    if (!std::visit([](auto& ws) { return ws.is_message_done(); }, ws_)) return read();
     const std::string message = beast::buffers_to_string(in_.data());
     in_.consume(in_.size());
     if (!limit_.allow(seconds_since(server_->start))) {

@@ -1,8 +1,10 @@
 // viscera-figure2: regenerates the paper's Figure 2 (docs/figure2.csv, docs/figure2.svg).
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/plot/svg_plot.hpp"
 #include "viscera/tissue/viscoelastic/figure2.hpp"
@@ -31,12 +33,12 @@ int main(int argc, char** argv) {
     std::printf("RMS error / peak over 0-%g s: memory variables 1D column %.2f%% (dt %.3g s), 3D GPS block %.2f%% (dt %.3g s), Kelvin-Voigt %.2f%%\n",
                 o.end_time_s, 100 * r.rms_memory_variables, r.column_dt_s, 100 * r.rms_gps_block, r.block_dt_s, 100 * r.rms_kelvin_voigt);
     const std::string csv = cl.text("csv");
-    std::ofstream out(csv);
+    std::ostringstream out;
     out << "time_s,exact_cq_m,memory_variables_m,kelvin_voigt_m,gps_block_m\n";
     out.precision(9);
     for (std::size_t k = 0; k < r.time_s.size(); ++k)
       out << r.time_s[k] << ',' << r.exact_cq_m[k] << ',' << r.memory_variables_m[k] << ',' << r.kelvin_voigt_m[k] << ',' << r.gps_block_m[k] << '\n';
-    if (!out) throw std::runtime_error(csv + ": cannot write");
+    viscera::common::write_file_text(csv, out.str());
     const auto mm = [](const std::vector<double>& v) {
       std::vector<double> o2;
       o2.reserve(v.size());

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
 #include "viscera/lab/analysis.hpp"
@@ -172,6 +173,9 @@ int main(int argc, char** argv) {
     // The report never goes over what the run reads: not into the data set's folder (its plots are
     // named after the tests), and not over the model predict reads.
     if (positional.size() >= 2) viscera::common::refuse_overwrite(out, {positional.back()}, "--out");
+    // The folder made before the work: an analysis of minutes never fails at its end for want of it
+    // (import makes its data set's folder itself, and refuses one that exists).
+    if (positional[0] != "import") viscera::common::create_output_folder(out, "--out");
     if (positional[0] == "predict" && positional.size() == 3)
       for (const char* written : {"report.json", "model.json"}) viscera::common::refuse_overwrite(out + "/" + written, {positional[1]}, "--out");
     if (positional[0] == "analyze")
@@ -188,5 +192,8 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const UsageError& e) {
     return usage_error(e.what());
+  } catch (const std::exception& e) {  // a file system's refusal (a path too long to read): one line, never an abort
+    std::fprintf(stderr, "viscera-lab: %s\n", e.what());
+    return 1;
   }
 }

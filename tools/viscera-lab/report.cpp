@@ -2,9 +2,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/lab/fit.hpp"
 #include "viscera/lab/material_export.hpp"
 #include "viscera/lab/model_file.hpp"
@@ -178,15 +180,16 @@ void md_test_plots(std::ostream& md, const Analysis& a, const TestData& t, const
 }  // namespace
 
 void write_report(const Analysis& a, const Dataset& d, const std::string& out_dir, double seconds) {
-  fs::create_directories(out_dir);
+  common::create_output_folder(out_dir, "--out");
   const MaterialFiles files = material_files(a, d);
   const std::string &material = files.material, &baseline = files.baseline, &why = files.why, &note = files.note;
-  if (!material.empty()) std::ofstream(fs::path(out_dir) / "material.json") << material;
-  if (!baseline.empty()) std::ofstream(fs::path(out_dir) / "material-baseline.json") << baseline;
-  std::ofstream(fs::path(out_dir) / "report.json") << report_json(a, d, seconds, files).dump(2) << "\n";
+  const auto out = [&](const char* name) { return (fs::path(out_dir) / name).string(); };
+  if (!material.empty()) common::write_file_text(out("material.json"), material);
+  if (!baseline.empty()) common::write_file_text(out("material-baseline.json"), baseline);
+  common::write_file_text(out("report.json"), report_json(a, d, seconds, files).dump(2) + "\n");
   write_model((fs::path(out_dir) / "model.json").string(), a.supported_model(), a.dataset);
 
-  std::ofstream md(fs::path(out_dir) / "report.md");
+  std::ostringstream md;
   md << "# viscera-lab report: " << a.dataset << "\n\n" << a.verdict << "\n\n";
   md_noise(md, a, seconds);
   md_errors(md, a, d);
@@ -205,11 +208,12 @@ void write_report(const Analysis& a, const Dataset& d, const std::string& out_di
      << (note.empty() ? std::string() : " (" + note + ")") << ".\n\n";
   md << "## Data, baseline and final model\n\n";
   for (const TestData& t : d.tests) md_test_plots(md, a, t, out_dir);
+  common::write_file_text(out("report.md"), md.str());
 }
 
 void write_prediction(const MaterialModel& m, const std::string& model_path, const Dataset& d, const std::string& out_dir) {
-  fs::create_directories(out_dir);
-  std::ofstream(fs::path(out_dir) / "report.json") << prediction_json(m, model_path, d).dump(2) << "\n";
+  common::create_output_folder(out_dir, "--out");
+  common::write_file_text((fs::path(out_dir) / "report.json").string(), prediction_json(m, model_path, d).dump(2) + "\n");
 }
 
 }  // namespace viscera::lab

@@ -75,7 +75,10 @@ int main(int argc, char** argv) {
     o.server = cl.has("server") ? cl.text("server") : viscera::process::find_program("viscera-server", "server/runtime");
     o.domain = domain;
     o.quiet = cl.has("quiet");
-    return viscera::replay::resimulate(o);
+    return viscera::replay::resimulate(o, g_stop);
+  } catch (const viscera::replay::Interrupted& e) {
+    std::fprintf(stderr, "viscera-replay: %s\n", e.what());
+    return 130;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "viscera-replay: %s\n", e.what());
     return 2;

@@ -1,7 +1,10 @@
 #include "resimulate.hpp"
 
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -9,6 +12,7 @@
 #include <unistd.h>
 
 #include "viscera/client/lockstep_driver.hpp"
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
 #include "viscera/process/child_process.hpp"
@@ -25,10 +29,18 @@ namespace rec = viscera::recording;
 
 namespace {
 
-/// A directory removed with everything in it when done.
+/// A directory removed with everything in it when done. One left by a run that was killed
+/// (SIGKILL runs no destructor) is removed by the next run, once the process that made it is gone.
 struct TempDir {
   fs::path path;
   TempDir() {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(fs::temp_directory_path(), ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind("viscera-resim-", 0) != 0) continue;
+      const long pid = std::strtol(name.c_str() + 14, nullptr, 10);
+      if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+    }
     path = fs::temp_directory_path() / ("viscera-resim-" + std::to_string(::getpid()) + "-" + std::to_string(proto::now_ns()));
     fs::create_directories(path);
   }
@@ -54,13 +66,18 @@ void print_plan(const ResimulateOptions& o, const rec::LockstepPlan& plan, const
 /// failure.
 class LockstepRun {
  public:
-  LockstepRun(const ResimulateOptions& o, const rec::ExtractedScenes& scenes, std::uint32_t domain, const std::string& partition, const fs::path& log)
+  LockstepRun(const ResimulateOptions& o, const rec::ExtractedScenes& scenes, std::uint32_t domain, const std::string& partition, const fs::path& log,
+              const std::atomic<bool>& stop)
       : o_(o),
+        stop_(stop),
         driver_(domain, partition),
-        server_({o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--station", partition, "--quiet"},
+        // On the driver's domain, whatever the recorded scene file says (--domain).
+        server_({o.server, "--lockstep", "--scene", scenes.first_scene, "--scene-dir", scenes.scene_dir, "--station", partition, "--domain",
+                 std::to_string(domain), "--quiet"},
                 log.string()) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.server_timeout_s);
     while (!driver_.wait_for_server(std::chrono::milliseconds(200))) {
+      if (stop_) throw Interrupted();
       if (!server_.alive()) fail("the lockstep server (" + o.server + ") stopped before it was ready");
       if (std::chrono::steady_clock::now() > end)
         fail("no lockstep server ready within " + std::to_string(static_cast<int>(o.server_timeout_s)) + " s");
@@ -79,7 +96,9 @@ class LockstepRun {
         if (next_send == plan.first_tick) step.sim_time_s = plan.sim_time_s;
         driver_.send(step);
       }
-      const auto result = driver_.next_result(std::chrono::seconds(30));
+      std::optional<proto::LockstepResult> result;
+      for (int waited = 0; !result && waited < 150 && !stop_; ++waited) result = driver_.next_result(std::chrono::milliseconds(200));
+      if (stop_) throw Interrupted();
       if (!result) {
         if (!server_.alive()) fail("the lockstep server stopped at tick " + std::to_string(next_result));
         fail("no result for tick " + std::to_string(next_result) + " within 30 s");
@@ -112,6 +131,7 @@ class LockstepRun {
   }
 
   const ResimulateOptions& o_;
+  const std::atomic<bool>& stop_;
   client::LockstepDriver driver_;
   process::ChildProcess server_;
 };
@@ -137,7 +157,7 @@ int print_outcome(const rec::ResimulationCheck& check, const rec::LockstepPlan& 
 
 }  // namespace
 
-int resimulate(const ResimulateOptions& o) {
+int resimulate(const ResimulateOptions& o, const std::atomic<bool>& stop) {
   if (o.report) {  // before the work: never over a file this run reads
     std::vector<std::string> inputs{o.recording};
     if (o.scene) inputs.push_back(*o.scene);
@@ -152,7 +172,7 @@ int resimulate(const ResimulateOptions& o) {
   if (!o.quiet) print_plan(o, plan, scenes);
 
   rec::ResimulationCheck check(plan, recording);
-  const double seconds = LockstepRun(o, scenes, domain, partition, dir.path / "server.log").run(plan, check);
+  const double seconds = LockstepRun(o, scenes, domain, partition, dir.path / "server.log", stop).run(plan, check);
 
   nlohmann::json report = check.report();
   report["recording"] = o.recording;
@@ -161,9 +181,7 @@ int resimulate(const ResimulateOptions& o) {
   report["what_if"] = scenes.differences;
   report["seconds"] = seconds;
   if (o.report) {
-    std::ofstream out(*o.report);
-    out << report.dump(2) << "\n";
-    if (!out) throw common::InputError(*o.report, 0, "", "cannot write the report");
+    common::write_file_text(*o.report, report.dump(2) + "\n");
   }
   return print_outcome(check, plan);
 }

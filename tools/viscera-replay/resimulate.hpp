@@ -2,8 +2,10 @@
 // viscera-replay resimulate: a fresh lockstep server on the recorded scene, fed the recorded
 // commands and requests at the ticks the original applied them, every force, event and frame
 // compared (client-sdk/recording: lockstep_plan.hpp, resimulation_check.hpp).
+#include <atomic>
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace viscera::replay {
@@ -20,7 +22,11 @@ struct ResimulateOptions {
 };
 
 /// Returns 0 bit-identical, 1 diverged; throws common::InputError (bad recording or scene),
-/// std::runtime_error (the server could not be run).
-int resimulate(const ResimulateOptions& options);
+/// std::runtime_error (the server could not be run), Interrupted once `stop` is set (SIGINT,
+/// SIGTERM: the lockstep server is stopped and the temporary folder removed on the way out).
+struct Interrupted : std::runtime_error {
+  Interrupted() : std::runtime_error("interrupted: the re-simulation was stopped") {}
+};
+int resimulate(const ResimulateOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace viscera::replay

@@ -1,12 +1,14 @@
 // viscera._viscera.lab: viscera-lab's data sets, analysis and prediction, with the report as the
 // program writes it (report_json.hpp), parsed into Python objects by the package.
 #include <chrono>
+#include <filesystem>
 
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
 #include "viscera/common/command_line.hpp"
 #include "viscera/common/input_error.hpp"
+#include "viscera/common/same_file.hpp"
 #include "viscera/lab/analysis.hpp"
 #include "viscera/lab/decimation.hpp"
 #include "viscera/lab/model_file.hpp"
@@ -94,7 +96,13 @@ void bind_lab(py::module_& m) {
           "The measured quantity of a test as a model predicts it: stress [Pa] (strain control) or strain (stress control).")
       .def(
           "write_model",
-          [](const AnalysisResult& r, const std::string& path) { write_model(path, r.analysis.supported_model(), r.analysis.dataset); },
+          [](const AnalysisResult& r, const std::string& path) {
+            // Never over the data set it was fitted to (its dataset.json and CSVs), as the command line.
+            std::vector<std::string> inputs{(std::filesystem::path(r.dataset.folder) / "dataset.json").string()};
+            for (const TestData& t : r.dataset.tests) inputs.push_back((std::filesystem::path(r.dataset.folder) / t.file).string());
+            common::refuse_overwrite(path, inputs, "write_model's path");
+            write_model(path, r.analysis.supported_model(), r.analysis.dataset);
+          },
           py::arg("path"), "Writes model.json (the model the analysis stands by), readable by predict and viscera-lab predict.");
 
   m.def(
@@ -109,20 +117,25 @@ void bind_lab(py::module_& m) {
         if (bootstrap_replicates < 0) throw common::UsageError("bootstrap_replicates must be at least 0");
         if (max_fit_points < 10) throw common::UsageError("max_fit_points must be at least 10");
         auto result = std::make_unique<AnalysisResult>();
-        {
+        struct Interrupted {};
+        try {
           py::gil_scoped_release unlocked;  // progress takes the lock back for each line
           const auto t0 = std::chrono::steady_clock::now();
-          result->analysis = analyze(d,
-                                     progress ? std::function<void(const std::string&)>([&](const std::string& line) {
-                                       py::gil_scoped_acquire locked;
-                                       progress(line);
-                                     })
-                                              : std::function<void(const std::string&)>(),
-                                     o);
+          // Between stages: Ctrl-C (a signal Python raises) stops the analysis there.
+          result->analysis = analyze(
+              d,
+              [&](const std::string& line) {
+                py::gil_scoped_acquire locked;
+                if (PyErr_CheckSignals() != 0) throw Interrupted{};
+                if (progress) progress(line);
+              },
+              o);
           const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           result->dataset = decimate(d, o.max_fit_points);
           result->files = material_files(result->analysis, result->dataset);
           result->report_json = report_json(result->analysis, result->dataset, seconds, result->files).dump();
+        } catch (const Interrupted&) {
+          throw py::error_already_set();  // the KeyboardInterrupt the signal handler set
         }
         return result;
       },

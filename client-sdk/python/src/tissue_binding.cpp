@@ -2,6 +2,8 @@
 // material file or isotropic parameters, a force model, fixed nodes, an integrator), stepped from
 // Python; positions and velocities are numpy views of the state, never copies.
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
@@ -43,7 +45,13 @@ class Organ {
     if (!o.material.empty()) {
       material = read_material_file(o.material);
     } else {
-      if (!(o.density_kg_m3 > 0)) throw UsageError("density_kg_m3 must be positive");
+      // The ranges a material file has (docs/MATERIAL.md): E = 1e30 was accepted, and its stable
+      // step made advance(0.01) run for more than ten minutes.
+      if (!(o.youngs_modulus_pa >= 1e-3 && o.youngs_modulus_pa <= 1e12))
+        throw UsageError("youngs_modulus_pa: " + std::to_string(o.youngs_modulus_pa) + " is outside [1e-3, 1e12] Pa");
+      if (!(o.poisson_ratio >= -0.9999 && o.poisson_ratio <= 0.4999))
+        throw UsageError("poisson_ratio: " + std::to_string(o.poisson_ratio) + " is outside [-0.9999, 0.4999]");
+      if (!(o.density_kg_m3 > 0 && o.density_kg_m3 <= 1e5)) throw UsageError("density_kg_m3 must lie in (0, 1e5]");
       material.name = "isotropic";
       material.density_kg_m3 = o.density_kg_m3;
       material.elasticity = elasticity_matrix(IsotropicElasticity{o.youngs_modulus_pa, o.poisson_ratio}, "Organ");
@@ -80,18 +88,41 @@ class Organ {
     name_ = material.name;
   }
 
-  /// Advances by `duration_s`; returns the steps taken.
+  /// Advances by `duration_s`; returns the steps taken. Ctrl-C (any Python signal handler that
+  /// raises) stops it between steps, within 0.1 s, and raises there.
   long advance(double duration_s) {
-    if (!(duration_s >= 0)) throw UsageError("duration_s must be at least 0");
-    if (explicit_) return explicit_->advance(state_, duration_s);
+    if (!(duration_s >= 0 && std::isfinite(duration_s))) throw UsageError("duration_s must be a finite time of at least 0 s");
+    if (explicit_) {
+      explicit_->set_interruption([this] { return signalled(); });
+      const long steps = explicit_->advance(state_, duration_s);
+      explicit_->set_interruption({});
+      if (interrupted_) throw_interrupted();
+      return steps;
+    }
     long steps = 0;
     const double end = state_.time_s + duration_s;
     while (state_.time_s < end - 1e-12) {
+      if (signalled()) throw_interrupted();
       implicit_->set_dt(std::min(implicit_dt_s_, end - state_.time_s));
       implicit_->step(state_);
       ++steps;
     }
     return steps;
+  }
+
+  /// Whether Python has a signal to raise (Ctrl-C): asked at most every 0.1 s, with the GIL.
+  bool signalled() {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_signal_check_ < std::chrono::milliseconds(100)) return interrupted_;
+    last_signal_check_ = now;
+    pybind11::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) interrupted_ = true;
+    return interrupted_;
+  }
+  [[noreturn]] void throw_interrupted() {
+    interrupted_ = false;
+    pybind11::gil_scoped_acquire gil;
+    throw pybind11::error_already_set();  // the KeyboardInterrupt the signal handler set
   }
 
   void set_nodal_forces(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& f) {
@@ -126,6 +157,8 @@ class Organ {
   std::unique_ptr<ForceModel> model_;
   std::unique_ptr<ExplicitIntegrator> explicit_;
   std::unique_ptr<ImplicitIntegrator> implicit_;
+  std::chrono::steady_clock::time_point last_signal_check_{};
+  bool interrupted_ = false;
   double implicit_dt_s_ = 0;
   State state_;
   std::string name_;

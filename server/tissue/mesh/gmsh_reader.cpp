@@ -121,9 +121,9 @@ void read_nodes_v4(TextCursor& in, MeshBuilder& b) {
     in.integer("entity tag");
     const long long parametric = in.integer_in("parametric", 0, 1);
     const long long count = in.integer_in("nodes in block", 0, 1'000'000'000);
-    std::vector<long long> tags(count);
-    std::vector<long> lines(count);
-    for (auto& t : tags) t = in.integer("node tag");
+    // Grown as the file proves it holds them: the header may claim 10^9 nodes in 100 bytes.
+    std::vector<long long> tags;
+    for (long long k = 0; k < count; ++k) tags.push_back(in.integer("node tag"));
     for (long long k = 0; k < count; ++k) {
       const long line = in.next_line();
       Vec3 p;

@@ -1,10 +1,11 @@
 #include "viscera/tissue/mesh/vtu_writer.hpp"
 
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
 #include <Eigen/Eigenvalues>
 
+#include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/element/tet_geometry.hpp"
 
@@ -13,9 +14,9 @@ namespace viscera::tissue {
 using common::InputError;
 
 namespace {
-std::ofstream open_for_writing(const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path, 0, "", "cannot open for writing");
+/// The file's text is built here and written by common::write_file_text (never through a link).
+std::ostringstream text() {
+  std::ostringstream out;
   out.precision(9);
   return out;
 }
@@ -23,7 +24,7 @@ std::ofstream open_for_writing(const std::string& path) {
 
 void write_vtu(const std::string& path, const TetMesh& mesh, std::span<const Vec3> x, std::span<const Vec3> v) {
   const std::span<const Vec3> pos = x.empty() ? std::span<const Vec3>(mesh.nodes) : x;
-  std::ofstream out = open_for_writing(path);
+  std::ostringstream out = text();
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
          "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
       << mesh.nodes.size() << "\" NumberOfCells=\"" << mesh.tets.size() << "\">\n";
@@ -63,15 +64,15 @@ void write_vtu(const std::string& path, const TetMesh& mesh, std::span<const Vec
   out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
   for (std::size_t e = 0; e < mesh.tets.size(); ++e) out << "10\n";
   out << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  if (!out) throw InputError(path, 0, "", "write failed (disk full?)");
+  common::write_file_text(path, out.str());
 }
 
 void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& frames) {
-  std::ofstream out = open_for_writing(path);
+  std::ostringstream out = text();
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
   for (const auto& [t, file] : frames) out << "<DataSet timestep=\"" << t << "\" part=\"0\" file=\"" << file << "\"/>\n";
   out << "</Collection>\n</VTKFile>\n";
-  if (!out) throw InputError(path, 0, "", "write failed (disk full?)");
+  common::write_file_text(path, out.str());
 }
 
 }  // namespace viscera::tissue

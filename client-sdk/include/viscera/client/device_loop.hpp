@@ -13,6 +13,9 @@
 //                                                                                                       └─ reconnect ─▶ claim again (every 1 s until
 //                                                                                                       it holds) ─▶ driving
 //   driving ──a new scene was loaded──▶ claim again ─▶ driving
+//   after every claim that holds, every jump of the organ (its epoch) and every contact regained
+//   with force, the force ramps from what the hand felt to the new one; ForceSlewLimit bounds its
+//   change per period besides.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -30,6 +33,9 @@ struct DeviceLoopOptions {
   /// instrument was freed under this client (the server's lease ran out during a stall of this
   /// process), claim it again once the force has faded.
   bool reconnect = false;
+  /// The largest change of the force on the hand per millisecond [N/ms] (ForceSlewLimit; the
+  /// default is argued in docs/FAULTS.md); infinite: no limit.
+  double slew_n_per_ms = 1.0;
 };
 
 /// What the scene state says, when the loop looks (every 0.1 s while the server is there).
@@ -58,8 +64,13 @@ class DeviceLoop {
   bool scene_check_due(double t_s) const;
   /// The start of a period at `t_s`: the server's state, and the scene if it was looked at.
   Step next(double t_s, ServerState server, const std::optional<InstrumentView>& scene);
-  /// After Action::claim_again: whether the claim held (`why` if not) and the scene now.
+  /// After Action::claim_again: whether the claim held (`why` if not) and the scene now. After a
+  /// claim that holds, the force ramps to the first answer's (LocalForceRenderer::restart).
   std::string claimed(double t_s, bool ok, const std::string& why, const InstrumentView& now);
+  /// A force from the server at `t_s` with the organ's epoch `epoch` (protocol::Force): when the
+  /// organ jumped since the last one (a reset, a scene or material loaded, a pause or a resume),
+  /// the force ramps from what the hand felt to the new one; returns a note then.
+  std::string organ_epoch(double t_s, std::uint32_t epoch);
 
   LocalForceRenderer& renderer() { return renderer_; }
   bool standing_by() const { return standing_by_; }
@@ -87,6 +98,7 @@ class DeviceLoop {
   double server_lost_t_ = -1, faded_t_ = -1, instrument_lost_t_ = -1, last_scene_check_ = 0, retry_t_ = 0;
   double last_t_ = -1, stall_s_ = 0, stall_end_t_ = -1;
   int server_returns_ = 0, taken_over_ = 0, instrument_losses_ = 0;
+  std::optional<std::uint32_t> epoch_;
 };
 
 }  // namespace viscera::client

@@ -28,7 +28,7 @@ struct DevicePeriod {
   double t_s;
   const DeviceSample& device;
   const protocol::Force& force;  ///< the newest answer from the server
-  const RenderedForce& rendered;  ///< what the device was told to render
+  const RenderedForce& rendered;  ///< what the device was told to render (after the slew limit)
   double model_age_s;
   std::uint64_t model_age_commands;  ///< commands sent since the one the model answers
 };
@@ -49,6 +49,10 @@ struct DeviceRunResult {
   /// gone and came back included), and when it ended (-1: none): a server or network that fell
   /// silent (the liveliness lease runs out at 0.5 s).
   double longest_silence_s = 0, longest_silence_end_t_s = -1;
+  /// Periods whose force the slew limit changed, and the largest change per period the renderer
+  /// asked for [N] (what the hand would have felt without the limit).
+  long slew_limited = 0;
+  double largest_step_asked_n = 0;
 };
 
 /// Runs the loop; `generation` is that of the scene in which the instrument was claimed.

@@ -48,6 +48,9 @@ struct Force {
   /// principal stretch strain |lambda - 1| averaged within the scene's strain radius of where it
   /// touches (0 out of contact; 0 from older servers)
   double tip_strain = 0;
+  /// schema 19: +1 at each reset, scene load, material change, pause and resume: the organ under
+  /// the tool jumped without the tool moving (a client fades its force in again); 0 from older servers
+  std::uint32_t organ_epoch = 0;
 };
 
 enum class Action : std::int8_t {
@@ -269,7 +272,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 18;
+inline constexpr int kSchemaVersion = 19;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

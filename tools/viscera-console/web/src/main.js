@@ -102,8 +102,10 @@ function onFrame(buf) {
   state.frame = dv.getFloat64(16, true);
   state.simTimeS = dv.getFloat64(24, true);
   // The delay from the server's frame to the page; not for the first frame of a connection, which
-  // is the bridge's copy of the newest frame, possibly old.
-  const delay = performance.timeOrigin + performance.now() - dv.getFloat64(32, true);
+  // is the bridge's copy of the newest frame, possibly old. Both stamps from the wall clock (the
+  // server's is DDS time, the system's real-time clock): performance.timeOrigin + now() is the
+  // page's monotonic clock, which drifts from it by seconds (it showed -1,100 ms on one host).
+  const delay = Date.now() - dv.getFloat64(32, true);
   if (framesThisConnection++ > 0) state.latenciesMs.push(delay);
   if (state.latenciesMs.length > 10000) state.latenciesMs.splice(0, 5000);
   dirty = true;

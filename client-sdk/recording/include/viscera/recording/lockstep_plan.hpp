@@ -40,6 +40,7 @@ struct ExpectedForce {
   bool cutting = false;  ///< a scalpel's blade cutting (schema 17)
   double cut_edge_strain = 0;  ///< the largest edge strain of what it cut that tick (schema 17)
   double tip_strain = 0;  ///< the tissue's strain at the instrument (schema 18)
+  std::uint32_t organ_epoch = 0;  ///< the organ's jumps so far (schema 19)
 };
 
 struct ExpectedEvent {
@@ -72,6 +73,7 @@ struct LockstepPlan {
   bool strain_recorded = true;  ///< forces carry the organ's edge strain (recorded with schema 8 or later)
   bool cutting_recorded = true;  ///< forces say whether a blade cut (recorded with schema 17 or later)
   bool tip_strain_recorded = true;  ///< forces carry the strain at the instrument (recorded with schema 18 or later)
+  bool organ_epoch_recorded = true;  ///< forces carry the organ's epoch (recorded with schema 19 or later)
   /// The step of `tick` (an empty one where nothing happens).
   protocol::LockstepStep step(std::uint64_t tick) const;
 };

@@ -14,12 +14,15 @@ class CsvLines {
   explicit CsvLines(std::string_view text) : text_(text) {
     if (text_.starts_with("\xEF\xBB\xBF")) text_.remove_prefix(3);
   }
-  /// The next line without its newline; nullopt at the end.
+  /// The next line without its line end: "\n", "\r\n", or a lone "\r" (classic Mac OS, and
+  /// some test machines' exports); nullopt at the end.
   std::optional<std::string_view> next() {
     if (text_.empty()) return std::nullopt;
-    const std::size_t end = text_.find('\n');
+    const std::size_t end = text_.find_first_of("\r\n");
     const std::string_view line = text_.substr(0, end);
-    text_.remove_prefix(end == std::string_view::npos ? text_.size() : end + 1);
+    std::size_t skip = end == std::string_view::npos ? text_.size() : end + 1;
+    if (end != std::string_view::npos && text_[end] == '\r' && end + 1 < text_.size() && text_[end + 1] == '\n') ++skip;
+    text_.remove_prefix(skip);
     return line;
   }
 

@@ -28,8 +28,20 @@ struct Snapshot {
   std::map<std::uint32_t, GraspHold> grasped;
   /// The scalpels pressed through the tissue (above the scene's cut force) and cutting
   std::set<std::uint32_t> pressed_through;
+  /// The scalpels whose blade was in a cut after the tick: cutting, or leaving a cut
+  /// (SimulatedTool::leaving_cut). A command that releases the cut button leaves the cut (the
+  /// next tick says so): it touches nothing, as the blade did not.
+  std::set<std::uint32_t> in_cut;
   /// Per instrument in contact: the tissue's strain at it after the tick (ContactResult::tip_strain)
   std::map<std::uint32_t, double> tip_strain;
+  /// The organ's jumps so far (protocol::Force::organ_epoch)
+  std::uint32_t organ_epoch = 0;
+  /// A paused organ: a tip pressed deeper than the contact's depth limit still meets the surface
+  /// it went in through (surface_exit.hpp, on the way back to where the tool is held: the tools
+  /// do not move while paused), so a hand pressing on a frozen organ never falls through.
+  bool paused = false;
+  std::map<std::uint32_t, Vec3> tool_position;  ///< each active tool's, after the tick
+  double tool_reach_m = 0;  ///< how far a tool may move in one tick (the scene's speed limit / rate)
 };
 
 /// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.
@@ -56,10 +68,10 @@ class CommandResponder {
   /// Physics thread, after each tick.
   void publish(std::shared_ptr<const Snapshot> snapshot);
   std::shared_ptr<const Snapshot> latest() const;
-  /// Command thread: the reaction on `instrument_id` at the commanded pose on the newest snapshot
-  /// (`tick` and `max_edge_strain`, if given, get the snapshot's).
-  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command, std::uint64_t* tick = nullptr,
-                       double* max_edge_strain = nullptr) const;
+  /// Command thread: the reaction on `instrument_id` at the commanded pose on the newest snapshot,
+  /// or as near it as the tool can be after the next tick (`used`, if given, gets that snapshot:
+  /// its tick, strain and epoch go with the answer).
+  ContactResult answer(std::uint32_t instrument_id, const protocol::Command& command, std::shared_ptr<const Snapshot>* used = nullptr) const;
 
  private:
   std::map<std::uint32_t, std::unique_ptr<ProbeContact>> queries_;

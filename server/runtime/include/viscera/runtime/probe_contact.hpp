@@ -71,6 +71,8 @@ class ProbeContact {
   /// positions the contact is given from now on.
   void set_surface(std::shared_ptr<const ContactSurface> surface) { surface_ = std::move(surface); }
   const std::shared_ptr<const ContactSurface>& surface() const { return surface_; }
+  double tip_radius_m() const { return radius_; }
+  double stiffness_n_per_m() const { return stiffness_; }
   /// The contact's forces on the organ during one explicit step (the integrator's force field,
   /// tissue::BoundaryConditions::FieldEvaluation): adds the penalty forces to field.f and to
   /// field.stiffness a bound on their stiffness per node, sqrt(3) k share w (the Gershgorin row

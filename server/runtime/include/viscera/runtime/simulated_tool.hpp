@@ -55,6 +55,12 @@ class SimulatedTool {
   bool cutting() const { return active_ && (blade_cuts(spec_, command_) || press_.through); }
   /// A scalpel of a scene with a cut force, pressed through the tissue (PressThrough).
   bool pressed_through() const { return active_ && press_.through; }
+  /// A scalpel whose cut button was released: its blade may still be in the tissue, and it leaves
+  /// the cut touching nothing until it is clear of the tissue (clear_of_tissue()), so releasing
+  /// the button with the blade 12 mm deep does not put the whole depth on the contact at once.
+  bool leaving_cut() const { return active_ && leaving_; }
+  /// The blade is clear of the tissue: it touches as any tool from now on.
+  void clear_of_tissue() { leaving_ = false; }
   /// After a tick: a scalpel of a scene with a cut force presses through when `contact`'s force
   /// reaches it, and comes out when its tip is back above the entry surface (PressThrough).
   void update_press_through(const ContactResult& contact);
@@ -89,6 +95,7 @@ class SimulatedTool {
   Vec3 velocity_ = Vec3::Zero();  // over the current tick [m/s]
   GraspHold held_;
   PressThrough press_;
+  bool leaving_ = false;
   bool touching_ = false;
   double last_touch_s_ = 0;
 };

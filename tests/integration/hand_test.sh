@@ -1,0 +1,170 @@
+#!/usr/bin/env bash
+# Integration, separate processes over a real DDS domain on loopback: a hand is never struck
+# (docs/FAULTS.md, "The force on the hand"). A real server and a real haptic client whose report
+# holds the force it commanded its device, one sample a millisecond; in each scenario an event
+# comes under a pressing probe, and the force on the hand must
+#  - change by at most the slew limit (1 N/ms, the default) from one 1 ms sample to the next, and
+#  - never exceed the larger of 1.5x the force just before the event and that force plus 1 N.
+# Scenarios: the organ reset under a 2 cm press; the 12k liver loaded under a probe holding 0.5 N
+# (the client claims again in the new scene, its tip still deep); the organ paused under a press
+# that goes on deeper (the frozen organ must not let the tip through: the force never falls to
+# zero while the tip is in it); a scalpel's cut button released with the blade 2 cm in the tissue
+# (it leaves the cut touching nothing).
+# Usage: hand_test.sh BUILD_DIR SOURCE_DIR
+set -u
+build="$1"; src="$2"
+. "$(dirname "$0")/common.sh"
+server=""
+trap 'kill -KILL $server 2>/dev/null || true; rm -rf "$tmp"' EXIT
+bin_server="$build/server/runtime/viscera-server"
+hc="$build/tools/haptic-client/haptic-client"
+ctl="$build/tools/viscera-control/viscera-control"
+now() { date +%s.%N; }
+# The 1.5k liver, with the 12k liver beside it to load.
+mkdir -p "$tmp/scenes"
+cp "$scene" "$tmp/scenes/liver.json"
+sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" \
+  "$src/data/scenes/liver-12k.json" > "$tmp/scenes/liver-12k.json"
+start_server() {  # log; waits for its first status line
+  "$bin_server" --scene "$tmp/scenes/liver.json" > "$1" 2>&1 &
+  server=$!
+  wait_for "physics" "$1" 200
+}
+stop_server() { kill -INT "$server"; wait "$server"; }
+# The force on the hand around an event at epoch time EVENT: the two bounds above; NAME for the
+# figure line; FLOOR (optional): while the tip is deeper than at the event, the force stays above
+# this fraction of the force at the event (a paused organ never lets the tip through).
+hand_check() {  # REPORT EVENT NAME [FLOOR]
+  pycheck "$1" "$2" "$3" "${4:-}" <<'PY'
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+event, name, floor = float(sys.argv[2]) - r["start_epoch_s"], sys.argv[3], sys.argv[4]
+slew = r["slew_limit"]["n_per_ms"]
+s = r["samples"]
+mag = lambda x: math.sqrt(sum(c * c for c in x["rendered_force_n"]))
+before = [mag(x) for x in s if event - 0.05 <= x["t_s"] <= event]
+assert before, f"{name}: no samples in the 50 ms before the event at t = {event:.3f} s"
+f0 = sum(before) / len(before)
+assert f0 > 0.2, f"{name}: the probe was not pressing before the event ({f0:.3f} N)"
+bound = max(1.5 * f0, f0 + 1.0)
+after = [x for x in s if x["t_s"] > event]
+assert len(after) > 500, f"{name}: only {len(after)} samples after the event"
+peak = max(mag(x) for x in after)
+# Consecutive periods (a period the loop only rendered, or waited through, leaves no sample).
+steps = [(abs(mag(b) - mag(a)), b["t_s"]) for a, b in zip(s, s[1:]) if b["t_s"] - a["t_s"] <= 1.05e-3]
+worst, at = max(steps)
+print(f"[ figure ] {name}: force before {f0:.3f} N, largest after {peak:.3f} N (bound {bound:.3f} N); largest 1 ms change "
+      f"{worst:.3f} N at t = {at:.3f} s (limit {slew} N/ms; the renderer asked for at most {r['slew_limit']['largest_step_asked_n']:.3f} N)")
+assert worst <= slew + 1e-9, f"{name}: the force changed by {worst:.3f} N in one sample"
+assert peak <= bound, f"{name}: the force reached {peak:.3f} N after the event, above {bound:.3f} N"
+if floor:
+    z0 = min(x["tip_z_m"] for x in s if x["t_s"] <= event)
+    f_event = mag([x for x in s if x["t_s"] <= event][-1])
+    deeper = [x for x in after if x["tip_z_m"] < z0 - 0.002]
+    assert deeper, f"{name}: the tip never went deeper after the event"
+    low = min(mag(x) for x in deeper)
+    print(f"[ figure ] {name}: with the tip up to {1e3 * (z0 - min(x['tip_z_m'] for x in deeper)):.1f} mm deeper, the force stayed >= {low:.3f} N")
+    assert low >= float(floor) * f_event, f"{name}: the tip went through: the force fell to {low:.3f} N while it pressed deeper"
+PY
+}
+
+# --- The organ reset under a 2 cm press (the press is deepest at 3 s). ---
+start_server "$tmp/server.log"
+"$hc" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.02 --duration 6 --quiet --report "$tmp/reset.json" \
+  > "$tmp/hc-reset.log" 2>&1 &
+client=$!
+wait_for "claimed" "$tmp/hc-reset.log"
+sleep 3.2
+reset_at=$(now)
+"$ctl" reset --domain "$domain" > "$tmp/ctl-reset.log" 2>&1
+wait "$client"; rc_client=$?
+cat "$tmp/hc-reset.log"
+check "reset: the client ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
+check "reset: the client saw the organ jump and faded its force in" "grep -q 'the organ was reset, reloaded' '$tmp/hc-reset.log'"
+check "reset: no physics reset on the server" "! grep -q 'physics: ' '$tmp/server.log'"
+hand_check "$tmp/reset.json" "$reset_at" "reset under a 2 cm press"
+
+# --- The 12k liver loaded under a probe holding 0.5 N: the client claims again, its tip deep. ---
+"$hc" --domain "$domain" --client-id 1 --instrument 1 --script hold --force 0.5 --duration 9 --quiet --report "$tmp/load.json" \
+  > "$tmp/hc-load.log" 2>&1 &
+client=$!
+wait_for "claimed" "$tmp/hc-load.log"
+sleep 3
+load_at=$(now)
+"$ctl" load liver-12k --domain "$domain" > "$tmp/ctl-load.log" 2>&1
+wait "$client"; rc_client=$?
+cat "$tmp/hc-load.log"
+check "load: the client claimed again in the new scene (rc $rc_client)" "[ $rc_client -eq 0 ] && grep -q 'the server loaded scene liver-12k: instrument 1 claimed again' '$tmp/hc-load.log'"
+hand_check "$tmp/load.json" "$load_at" "scene loaded under a 0.5 N hold"
+
+# --- The organ paused under a press that goes on deeper, then resumed. ---
+"$hc" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.04 --duration 8 --quiet --report "$tmp/pause.json" \
+  > "$tmp/hc-pause.log" 2>&1 &
+client=$!
+wait_for "claimed" "$tmp/hc-pause.log"
+sleep 2
+pause_at=$(now)
+"$ctl" pause --domain "$domain" > "$tmp/ctl-pause.log" 2>&1
+sleep 1.5
+"$ctl" resume --domain "$domain" >> "$tmp/ctl-pause.log" 2>&1
+wait "$client"; rc_client=$?
+cat "$tmp/hc-pause.log"
+check "pause: the client ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
+# The bound on the peak does not hold for a frozen organ pressed 1.5 s deeper (it is a wall): only
+# the slew and the floor are asked here, so the peak bound is checked up to the pause alone.
+pycheck "$tmp/pause.json" "$pause_at" <<'PY'
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+pause = float(sys.argv[2]) - r["start_epoch_s"]
+s = r["samples"]
+mag = lambda x: math.sqrt(sum(c * c for c in x["rendered_force_n"]))
+slew = r["slew_limit"]["n_per_ms"]
+worst = max(abs(mag(b) - mag(a)) for a, b in zip(s, s[1:]) if b["t_s"] - a["t_s"] <= 1.05e-3)
+at_pause = [x for x in s if x["t_s"] <= pause][-1]
+z0, f0 = at_pause["tip_z_m"], mag(at_pause)
+frozen = [x for x in s if pause + 0.3 < x["t_s"] < pause + 1.4 and x["tip_z_m"] < z0 - 0.002]
+assert f0 > 0.2 and frozen, f"the probe was not pressing at the pause ({f0:.3f} N) or never went deeper"
+low = min(mag(x) for x in frozen)
+depth = 1e3 * (z0 - min(x["tip_z_m"] for x in frozen))
+print(f"[ figure ] paused organ: {f0:.3f} N at the pause; with the tip up to {depth:.1f} mm deeper the force stayed >= {low:.3f} N; "
+      f"largest 1 ms change {worst:.3f} N")
+assert worst <= slew + 1e-9, f"the force changed by {worst:.3f} N in one sample"
+assert low >= 0.5 * f0, f"the tip went through the paused organ: the force fell to {low:.3f} N"
+PY
+
+# --- A scalpel's cut button released with the blade 2 cm in the tissue; it stays there 1.5 s. ---
+cat > "$tmp/release.csv" <<'CSV'
+time_s,x_m,y_m,z_m,jaw_rad,buttons
+0.0,0.0,0.0,0.02,0.5,1
+0.8,0.0,0.0,-0.02,0.5,1
+2.3,0.005,0.0,-0.02,0.5,1
+2.301,0.005,0.0,-0.02,0.5,0
+3.8,0.005,0.0,-0.02,0.5,0
+4.6,0.005,0.0,0.02,0.5,0
+CSV
+"$hc" --domain "$domain" --client-id 1 --instrument 4 --trajectory "$tmp/release.csv" --frame organ-top --duration 4.8 --quiet \
+  --report "$tmp/release.json" > "$tmp/hc-release.log" 2>&1
+rc_client=$?
+stop_server
+cat "$tmp/hc-release.log"
+check "scalpel: the client ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
+check "scalpel: no physics reset on the server" "! grep -q 'physics: ' '$tmp/server.log'"
+pycheck "$tmp/release.json" <<'PY'
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+s = r["samples"]
+mag = lambda x: math.sqrt(sum(c * c for c in x["rendered_force_n"]))
+slew = r["slew_limit"]["n_per_ms"]
+held = [mag(x) for x in s if 2.1 <= x["t_s"] <= 2.3]
+after = [mag(x) for x in s if 2.3 < x["t_s"] < 3.8]
+worst = max(abs(mag(b) - mag(a)) for a, b in zip(s, s[1:]) if b["t_s"] - a["t_s"] <= 1.05e-3)
+f0 = sum(held) / len(held)
+bound = max(1.5 * f0, f0 + 1.0)
+print(f"[ figure ] scalpel released 2 cm deep: {f0:.3f} N while cutting, at most {max(after):.3f} N after (bound {bound:.3f} N), "
+      f"asked for at most {r['slew_limit']['largest_step_asked_n']:.3f} N in one sample; largest 1 ms change {worst:.3f} N")
+assert worst <= slew + 1e-9, f"the force changed by {worst:.3f} N in one sample"
+assert max(after) <= bound, f"releasing the button in the tissue gave {max(after):.3f} N, above {bound:.3f} N"
+PY
+
+echo "hand_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
+[ "$failures" -eq 0 ]
