@@ -190,6 +190,32 @@ ok = r["identical"] and f["recorded"] > 4000 and m["recorded"] > 150 and e["reco
 ok = ok and f["identical"] == f["recorded"] and m["identical"] == m["recorded"] and e["identical"] == e["recorded"]
 sys.exit(0 if ok else 1)
 PY
+# On a domain other than the recording's: the lockstep server follows the driver's --domain (it
+# started on the recording's, ran 0 ticks and waited for ever).
+other=$(( domain % 200 + 1 ))
+"$replay" resimulate "$tmp/session.mcap" --domain "$other" --quiet > "$tmp/resim-other.log" 2>&1; rc_other=$?
+check "re-simulated on domain $other, not the recording's $domain (rc $rc_other)" "[ $rc_other -eq 0 ]"
+# Stopped: SIGINT ends it within 2 s with its lockstep server and its folder; after a SIGKILL (which
+# runs nothing of it) its server dies with it, and the next run removes the folder it left.
+resim_tmp="$tmp/resim-tmp"; mkdir -p "$resim_tmp"
+lockstep_servers() { pgrep -f -- "--scene-dir $resim_tmp" | wc -l; }
+resim_started() { for _ in $(seq 300); do grep -q "tick [0-9]* of" "$tmp/resim-$1.log" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
+TMPDIR="$resim_tmp" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" > "$tmp/resim-int.log" 2>&1 & resim=$!
+resim_started int
+t0=$(date +%s.%N); kill -INT "$resim"; wait "$resim"; rc_int=$?; t1=$(date +%s.%N)
+sleep 0.5
+check "SIGINT stops a re-simulation (rc $rc_int, 130) within 2 s, saying so" \
+  "[ $rc_int -eq 130 ] && python3 -c 'import sys; sys.exit(not $t1 - $t0 < 2)' && grep -q 'interrupted' '$tmp/resim-int.log'"
+check "... with its lockstep server and its folder" "[ \$(lockstep_servers) -eq 0 ] && [ -z \"\$(ls -A '$resim_tmp')\" ]"
+TMPDIR="$resim_tmp" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" > "$tmp/resim-kill.log" 2>&1 & resim=$!
+resim_started kill
+kill -KILL "$resim"; wait "$resim" 2>/dev/null
+# It leaves the DDS domain as it stops: about 1 s here.
+for _ in $(seq 50); do [ "$(lockstep_servers)" -eq 0 ] && break; sleep 0.1; done
+check "after a SIGKILL the lockstep server has stopped too, within 5 s" "[ \$(lockstep_servers) -eq 0 ]"
+check "... and left its folder" "[ -n \"\$(ls -A '$resim_tmp')\" ]"
+TMPDIR="$resim_tmp" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --scene "$tmp/no-such-scene.json" --quiet > /dev/null 2>&1
+check "the next run removed the folder of the killed one" "[ -z \"\$(ls -A '$resim_tmp')\" ]"
 # What if the liver were stiffer: the same session, another material; the first divergence named.
 sed 's/"youngs_modulus_pa": 5000/"youngs_modulus_pa": 5200/' "$src/data/materials/liver-viscoelastic.json" > "$tmp/stiffer.json"
 sed "s#\"material\": \"[^\"]*\"#\"material\": \"$tmp/stiffer.json\"#" "$scene" > "$tmp/stiffer-scene.json"

@@ -31,6 +31,11 @@ import json, sys
 for name, limit in (("force-drill", 20), ("force-drill-titin", 20), ("retraction", 15), ("palpation", 90), ("incision", 20)):
     e = json.load(open(f"{sys.argv[1]}/{name}.json"))
     e["time_limit_s"] = limit
+    # The titin-fitted organ runs at a third of real time or less under a press (its stiffening
+    # takes 8 sub-steps of 0.4 ms on this machine: 270-290 ticks/s, the old build and the new alike,
+    # 2026-12-07): the client's 18 s give it 5-7 s of simulated time, so the hold it must show is 4 s.
+    if name == "force-drill-titin":
+        e["force_drill"]["hold_s"] = 4
     json.dump(e, open(f"{sys.argv[2]}/{name}.json", "w"), indent=1)
 PY
 "$build/server/runtime/viscera-server" --scene "$scenes/liver.json" > "$tmp/server.log" 2>&1 & server=$!; pids+=($server)

@@ -8,6 +8,7 @@ import json
 import subprocess
 import time
 from pathlib import Path
+from typing import Callable, List, Tuple
 
 import numpy as np
 import pytest
@@ -75,7 +76,7 @@ def test_what_the_server_would_refuse_is_refused_at_once(server: Server, domain:
     c = viscera.session.Client(domain, 33)
     assert c.wait_for_scene(10.0) is not None
     started = time.monotonic()
-    for call, reason in (
+    refused: List[Tuple[Callable[[], object], str]] = [
         (lambda: c.load_scene("../liver"), "scene_name"),
         (lambda: c.load_scene(""), "scene_name"),
         (lambda: c.load_scene(".hidden"), "scene_name"),
@@ -86,7 +87,8 @@ def test_what_the_server_would_refuse_is_refused_at_once(server: Server, domain:
         (lambda: c.set_material(file_text="{}" + " " * 70000, file_name="big.json"), "file_text"),
         (lambda: c.set_material(file_text="{}", file_name="../../etc/passwd"), "file_name"),
         (lambda: c.set_physics_rate(0.0), "physics_rate_hz"),
-    ):
+    ]
+    for call, reason in refused:
         with pytest.raises(viscera.UsageError, match=reason):
             call()
     assert time.monotonic() - started < 2.0, "a refusal waited for the server"

@@ -112,3 +112,53 @@ def test_bad_input_names_file_and_field(tmp_path: Path) -> None:
     organ = viscera.tissue.Organ(str(tmp_path / "bar.vtk"))
     with pytest.raises(viscera.UsageError, match="rows"):
         organ.set_nodal_forces(np.zeros((3, 3)))
+
+
+def test_out_of_range_material_and_times_are_refused(tmp_path: Path) -> None:
+    # The ranges a material file has: E = 1e30 was accepted, and advance(0.01) then ran for more
+    # than ten minutes (its stable step); advance(inf) returned at once with NaN positions.
+    write_bar(tmp_path / "bar.vtk", 0.05, 0.02, 2)
+    bar = str(tmp_path / "bar.vtk")
+    with pytest.raises(viscera.UsageError, match="youngs_modulus_pa"):
+        viscera.tissue.Organ(bar, youngs_modulus_pa=1e30)
+    with pytest.raises(viscera.UsageError, match="youngs_modulus_pa"):
+        viscera.tissue.Organ(bar, youngs_modulus_pa=float("nan"))
+    with pytest.raises(viscera.UsageError, match="poisson_ratio"):
+        viscera.tissue.Organ(bar, poisson_ratio=0.5)
+    with pytest.raises(viscera.UsageError, match="density_kg_m3"):
+        viscera.tissue.Organ(bar, density_kg_m3=1e9)
+    organ = viscera.tissue.Organ(str(tmp_path / "bar.vtk"))
+    for bad in (float("inf"), float("nan"), -1.0):
+        with pytest.raises(viscera.UsageError, match="duration_s"):
+            organ.advance(bad)
+    assert np.isfinite(organ.positions).all()
+
+
+def test_ctrl_c_stops_a_long_advance(tmp_path: Path) -> None:
+    # advance() releases the interpreter lock; a SIGINT (Ctrl-C) must still stop it, within a
+    # fraction of a second, as KeyboardInterrupt, in a child interpreter of its own.
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    write_bar(tmp_path / "bar.vtk", 0.05, 0.02, 8)
+    code = ("import sys, time, viscera\n"
+            f"o = viscera.tissue.Organ({str(tmp_path / 'bar.vtk')!r}, youngs_modulus_pa=1e9)\n"
+            "print('advancing', flush=True)\n"
+            "t0 = time.monotonic()\n"
+            "try:\n"
+            "    o.advance(1e4)\n"
+            "except KeyboardInterrupt:\n"
+            "    print(f'interrupted {time.monotonic() - t0:.2f}', flush=True)\n"
+            "    sys.exit(7)\n")
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, env=os.environ.copy())
+    assert child.stdout is not None
+    assert child.stdout.readline().strip() == "advancing"
+    time.sleep(0.5)
+    sent = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    rc = child.wait(timeout=10)
+    assert rc == 7, f"exit {rc}: {child.stdout.read()}"
+    assert time.monotonic() - sent < 2.0
