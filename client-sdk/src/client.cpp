@@ -41,6 +41,9 @@ struct Client::Impl {
   proto::TypedReader<proto::Stream::force_feedback> forces;
   proto::TypedReader<proto::Stream::scene_state> scene;
   std::set<std::uint32_t> claimed;  // instruments this client claimed (another process may run under its id)
+  // When each was claimed [DDS time, ns]: a force answering a command stamped before is another
+  // process's under this id (it held the instrument before), never this client's.
+  std::map<std::uint32_t, std::int64_t> claimed_at_ns;
   std::unique_ptr<proto::TypedReader<proto::Stream::surface_topology>> topology;  // created on first use
   std::unique_ptr<proto::TypedReader<proto::Stream::mesh_frame>> frames;
   std::unique_ptr<proto::TypedReader<proto::Stream::event>> events;
@@ -190,16 +193,28 @@ ClaimResult Client::claim(std::uint32_t instrument_id, std::chrono::milliseconds
         impl_->scene.wait(std::chrono::milliseconds(100));
         continue;
       }
+      const bool twin_seen = !another_owner_seen && it->owner_client_id == 0 && impl_->claimed.count(instrument_id) == 0 &&
+                             why.find("held under this client id") != std::string::npos;
       another_owner_seen = true;
       if (it->owner_client_id == client_id_) {
         impl_->claimed.insert(instrument_id);
+        // Forces of a process that held it under this id before (their sequence numbers, higher
+        // than this client's, hid every answer to it: a second haptic-client drove the tip to -6 cm
+        // with 0 N) are never this client's.
+        impl_->claimed_at_ns[instrument_id] = proto::now_ns();
+        latest_.erase(instrument_id);
         // Before the first command: every reader of commands (the server's, a recorder's) knows
         // this client's writer, or the first commands are lost to the one that learns of it last.
         impl_->command_writer().wait_for_settled_readers(std::chrono::milliseconds(100), std::chrono::milliseconds(500));
         return {true, {}};
       }
       // Taken: keep asking until the timeout, its owner may release it (or lose it to the lease).
-      why = it->owner_client_id != 0 ? "taken by client " + std::to_string(it->owner_client_id) : "the server did not confirm the claim";
+      if (twin_seen || why.find("until just now") != std::string::npos)
+        why = "instrument " + std::to_string(instrument_id) + " was held under this client id (" + std::to_string(client_id_) +
+              ") by another client until just now, and the server did not confirm the claim (it keeps an id for the process that used "
+              "it until that process has been silent for 0.5 s): two clients must not run with one id";
+      else
+        why = it->owner_client_id != 0 ? "taken by client " + std::to_string(it->owner_client_id) : "the server did not confirm the claim";
     }
     impl_->sessions.write(client_id_, proto::encode(r));
     impl_->scene.wait(std::chrono::milliseconds(100));
@@ -314,6 +329,8 @@ void Client::take_forces() {
           impl_->force_stamp_ns = r.stamp_ns;
         }
         if (f.client_id != client_id_) return;
+        if (const auto c = impl_->claimed_at_ns.find(f.instrument_id); c != impl_->claimed_at_ns.end() && f.command_client_stamp_ns < c->second)
+          return;  // another process's, under this client id, from before this client's claim
         if (f.step_time_ns > 0) {  // published after a tick (the immediate answers carry 0)
           auto& end = tick_end_ns_[f.instrument_id];
           end = std::max(end, f.server_stamp_ns);

@@ -61,6 +61,25 @@ check "a second run under one client id is refused its claim (rc $rc_twin_b)" \
   "[ $rc_twin_b -eq 3 ] && grep -q 'held under this client id (7) by another client' '$tmp/twin-b.log'"
 check "another participant's release under the first run's id is refused: it keeps its instrument to its end (rc $rc_twin_a)" \
   "[ $rc_twin_a -eq 0 ] && ! grep -q 'no longer this client' '$tmp/twin-a.log'"
+# A second run under one id whose first run ends within its claim timeout claims the instrument
+# then, and drives it: the first run's answers (higher sequence numbers, same id) no longer hide
+# its own (it drove the tip to -6 cm with 0 N, 32 of 2,000 round trips answered).
+"$hc" --domain "$domain" --client-id 71 --instrument 2 --duration 3 --depth 0.01 --quiet > "$tmp/twin-c.log" 2>&1 &
+twin_c=$!
+for _ in $(seq 100); do grep -q "claimed" "$tmp/twin-c.log" && break; sleep 0.05; done
+"$hc" --domain "$domain" --client-id 71 --instrument 2 --duration 2 --depth 0.01 --quiet --report "$tmp/twin-d.json" > "$tmp/twin-d.log" 2>&1
+rc_twin_d=$?
+wait "$twin_c"
+check "a second run under one id claims the instrument once the first lets it go (rc $rc_twin_d)" "[ $rc_twin_d -eq 0 ]"
+pycheck "$tmp/twin-d.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+answered, periods = r["round_trip_us"]["samples"], len(r["samples"])
+touched = [s for s in r["samples"] if s["in_contact"]]
+print(f"[ figure ] the second run under one id: {answered} of {periods} commands answered, {len(touched)} periods in contact")
+assert answered > 0.5 * periods, f"only {answered} of {periods} commands answered (the bug answered 32 of 2,000)"
+assert touched and max(s["force_n"][2] for s in touched) > 0.05, "it never pressed the tissue"
+PY
 kill -INT "$server"; wait "$server"; rc_server=$?
 cat "$tmp/control.log" "$tmp/ctl.log" "$tmp/events.log"
 check "annotation sent (rc $rc_note)" "[ $rc_note -eq 0 ]"
