@@ -373,17 +373,23 @@ TEST(McapFile, RecoverKeepsEveryIntactChunkAroundADamagedOneAndSaysWhatWasLost) 
   }
 }
 
-TEST(McapFile, AZeroFilledTailEndsTheWalkAtItsFirstByteAtOnce) {
-  TempDir dir;
+/// A file of three complete chunks: the bytes of a written file up to where its fourth chunk
+/// starts (after the third's message indexes).
+std::vector<std::uint8_t> three_chunks(const TempDir& dir) {
   const std::string path = dir.file("a.mcap");
   write_file(path, "zstd", 300, 16 * 1024);
   const auto summary = McapReader(path).summary();
-  ASSERT_TRUE(summary && summary->chunks.size() >= 3);
-  // Cut after the third chunk's message indexes (where the fourth chunk starts), then 8 MiB of
-  // zeros, as a file system leaves space a crash never wrote.
-  const std::uint64_t cut = summary->chunks[3].offset;
+  if (!summary || summary->chunks.size() < 4) throw std::runtime_error("the test file has fewer than four chunks");
   auto bytes = viscera::common::read_file_bytes(path);
-  bytes.resize(static_cast<std::size_t>(cut));
+  bytes.resize(static_cast<std::size_t>(summary->chunks[3].offset));
+  return bytes;
+}
+
+TEST(McapFile, AZeroFilledTailEndsTheWalkAtItsFirstByteAtOnce) {
+  TempDir dir;
+  // Three chunks, then 8 MiB of zeros, as a file system leaves space a crash never wrote.
+  auto bytes = three_chunks(dir);
+  const std::uint64_t cut = bytes.size();
   bytes.resize(bytes.size() + (8u << 20), 0);
   const std::string in = dir.file("zeros.mcap");
   viscera::common::write_file_bytes(in, bytes);
@@ -406,16 +412,10 @@ TEST(McapFile, AZeroFilledTailEndsTheWalkAtItsFirstByteAtOnce) {
 
 TEST(McapFile, AWalkOverMillionsOfSmallRecordsReadsTheFileInBlocks) {
   TempDir dir;
-  const std::string path = dir.file("a.mcap");
-  write_file(path, "zstd", 300, 16 * 1024);
-  const auto summary = McapReader(path).summary();
-  ASSERT_TRUE(summary && summary->chunks.size() >= 3);
-  // After the third chunk, 20 MB of records of an opcode this reader does not know (the
+  // After three chunks, 20 MB of records of an opcode this reader does not know (the
   // specification: skip them), 9 bytes each: 2.2 million records. A seek and a read per record
   // took more than 60 s for 50 MB.
-  const std::uint64_t cut = summary->chunks[3].offset;
-  auto bytes = viscera::common::read_file_bytes(path);
-  bytes.resize(static_cast<std::size_t>(cut));
+  auto bytes = three_chunks(dir);
   constexpr std::size_t kRecords = 20'000'000 / 9;
   for (std::size_t k = 0; k < kRecords; ++k) bytes.insert(bytes.end(), {0x80, 0, 0, 0, 0, 0, 0, 0, 0});
   const std::string in = dir.file("small-records.mcap");
