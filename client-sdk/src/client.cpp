@@ -41,8 +41,8 @@ struct Client::Impl {
   proto::TypedReader<proto::Stream::force_feedback> forces;
   proto::TypedReader<proto::Stream::scene_state> scene;
   std::set<std::uint32_t> claimed;  // instruments this client claimed (another process may run under its id)
-  // When each was claimed [DDS time, ns]: a force answering a command stamped before is another
-  // process's under this id (it held the instrument before), never this client's.
+  // When each was claimed [DDS time, ns], until the first answer to this client's own commands: a
+  // force answering a command stamped before is another process's under this id, never its own.
   std::map<std::uint32_t, std::int64_t> claimed_at_ns;
   std::unique_ptr<proto::TypedReader<proto::Stream::surface_topology>> topology;  // created on first use
   std::unique_ptr<proto::TypedReader<proto::Stream::mesh_frame>> frames;
@@ -329,8 +329,13 @@ void Client::take_forces() {
           impl_->force_stamp_ns = r.stamp_ns;
         }
         if (f.client_id != client_id_) return;
-        if (const auto c = impl_->claimed_at_ns.find(f.instrument_id); c != impl_->claimed_at_ns.end() && f.command_client_stamp_ns < c->second)
-          return;  // another process's, under this client id, from before this client's claim
+        // Until the first answer to this client's own commands after a claim, those to commands
+        // stamped before it are another process's under this id (only until then: a step of the
+        // wall clock later must not hide this client's answers).
+        if (const auto c = impl_->claimed_at_ns.find(f.instrument_id); c != impl_->claimed_at_ns.end()) {
+          if (f.command_client_stamp_ns < c->second) return;
+          impl_->claimed_at_ns.erase(c);
+        }
         if (f.step_time_ns > 0) {  // published after a tick (the immediate answers carry 0)
           auto& end = tick_end_ns_[f.instrument_id];
           end = std::max(end, f.server_stamp_ns);

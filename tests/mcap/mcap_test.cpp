@@ -425,7 +425,9 @@ TEST(McapFile, AWalkOverMillionsOfSmallRecordsReadsTheFileInBlocks) {
   const DataEnd end = r.salvage_data({});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("[ figure ] %zu records of 9 bytes walked in %.2f s\n", kRecords, seconds);
-  EXPECT_LT(seconds, 5.0);
+  // A seek and a read per record took more than 60 s for 50 MB of them (so more than 24 s for these
+  // 20 MB); reading in blocks, 0.24 s in Release, 5.9 s under ASan on a busy machine.
+  EXPECT_LT(seconds, 15.0);
   EXPECT_EQ(end.chunks, 3u);
   EXPECT_EQ(end.offset, bytes.size());
 }
