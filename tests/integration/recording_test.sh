@@ -210,8 +210,9 @@ check "... with its lockstep server and its folder" "[ \$(lockstep_servers) -eq 
 TMPDIR="$resim_tmp" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" > "$tmp/resim-kill.log" 2>&1 & resim=$!
 resim_started kill
 kill -KILL "$resim"; wait "$resim" 2>/dev/null
-# It leaves the DDS domain as it stops: about 1 s here.
+# It is killed with its driver (PR_SET_PDEATHSIG).
 for _ in $(seq 50); do [ "$(lockstep_servers)" -eq 0 ] && break; sleep 0.1; done
+pgrep -af -- "--scene-dir $resim_tmp" | sed 's/^/still running: /'
 check "after a SIGKILL the lockstep server has stopped too, within 5 s" "[ \$(lockstep_servers) -eq 0 ]"
 check "... and left its folder" "[ -n \"\$(ls -A '$resim_tmp')\" ]"
 TMPDIR="$resim_tmp" "$replay" resimulate "$tmp/session.mcap" --domain "$domain" --scene "$tmp/no-such-scene.json" --quiet > /dev/null 2>&1
