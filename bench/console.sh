@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The console bridge measured in one run, on the bundled liver with a probe pressing it: the delay
 # from a server's surface frame to WebSocket clients (p50, p99), bytes per second per client and
 # the bridge's CPU, with 1 and with 4 clients; the DDS leg alone (server -> bridge) beside it; and

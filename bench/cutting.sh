@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Continuous cutting against pressing, side by side (docs/CUTTING.md, "Timing"): viscera-server on
 # a bundled liver scene with a haptic client for SECONDS, once pressing with probe 1
 # (--script press) and once cutting all the while with scalpel 4 (--script incise: the blade held

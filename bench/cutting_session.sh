@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A long session with many cuts, recorded and re-simulated (docs/CUTTING.md, "Timing"): the 1.5k
 # liver, scalpel 4 driven by a generated trajectory (haptic-client --trajectory, organ-top frame)
 # of STROKES strokes over SECONDS: each goes to a place on a grid over the top, holds the cut

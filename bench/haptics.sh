@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Haptic loop over DDS in one run: ddsperf ping-pong (the floor), then viscera-server + haptic-client
 # at 1 kHz on the liver at 1.5k, 12k (and with SCENES="... liver-96k" 96k) tetrahedra, each scene
 # twice: without mesh updates, and with surface frames at 60 Hz received by the haptic client.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The palpation exercise on the coarse and the fine nodule liver, side by side: for each seed (the
 # nodule's place), viscera-trainer runs the exercise on a live server while the haptic client
 # searches by touch (--script palpate --depth 0.006: it reads only the forces, docs/TRAINING.md) and

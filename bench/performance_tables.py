@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Regenerates the tables of docs/PERFORMANCE.md from the benchmarks' results in bench/results:
 tissue.json (bench/run.sh), tick.json (bench/tick.sh: the ticks and the materials), haptics.json (bench/haptics.sh),
 soak.json (bench/soak.sh), record.json (bench/record.sh) and console.json (bench/console.sh). Each table goes between its markers <!-- begin NAME --> and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Live surface frames in Python copy nothing: viscera-server on a scene (default the 96k liver), a
 # Python client takes frames and measures with tracemalloc what taking their positions allocates,
 # against what a copy allocates. Prints one line per scene.

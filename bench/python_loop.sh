@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A 1 kHz haptic loop written in Python (examples/python/haptic_client.py) against the C++
 # haptic-client, in one run on one server (the 1.5k liver, loopback): each presses for SECONDS
 # (default 60), one after the other, REPEAT times interleaved. Reports the command-to-force round

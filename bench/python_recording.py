@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """A recording into pandas DataFrames and numpy arrays with the Python package: the time every
 stream and the frames take to read, the decoded size, and the peak resident memory of the process
 against it. The issue's case is ten minutes of the 12k liver (bench/record.sh 600 with

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The recorder under the load the issue names: viscera-server on a scene (default the 12k liver,
 # surface frames at 60 Hz), a haptic client pressing at 1 kHz for SECONDS (default 600: ten
 # minutes), viscera-record recording every stream on loopback. Measures the file's size, the

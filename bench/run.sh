@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Builds and runs the tissue benchmarks in one process (all models, all meshes, bandwidth probe),
 # writes bench/results/tissue.json and prints the summary table used in docs/PERFORMANCE.md.
 set -euo pipefail

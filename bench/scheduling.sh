@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What real-time scheduling and a pinned core change for the server (docs/DEPLOY.md, the systemd
 # unit's CPUSchedulingPolicy=fifo): viscera-server on the liver with a haptic client pressing at
 # 1 kHz, the machine loaded by LOAD busy processes (default: one per core), started plainly, with

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What DDS Security costs a station (docs/DEPLOY.md): viscera-server on the liver with a haptic
 # client pressing at 1 kHz, once with loopback.xml and once with secure.xml added (authentication,
 # access control, every stream encrypted; the test PKI of deploy/dds/make-test-pki.sh),

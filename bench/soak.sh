@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A soak of viscera-server as a training session uses it: a probe client pressing the liver over
 # and over, a grasper client grasping and pulling it, and an instructor's console making a request
 # every 10 s (pause, resume, change the material, change the physics rate, annotate, show, load the

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """The soak's summary (bench/soak.sh): growth per hour of the server's resident memory, threads and
 file descriptors, fitted by least squares over the samples after the warm-up; soak.json and a plot,
 soak.svg. Usage: soak_report.py SAMPLES.csv OUT_DIR WARMUP_S MINUTES SCENE ALIVE RC_SERVER

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A whole training station on the 12k liver, as a class runs it: viscera-server, a haptic client
 # holding 1 N, viscera-trainer scoring a force drill on it, viscera-record recording the session,
 # and viscera-console with one page open in headless Chromium. RUNS runs of SECONDS each (the

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Summarises tissue_bench JSON: per model and mesh, ns per tet (median of repetitions), tet
 updates per second per core, the GPS / corotational speed ratio, and the distance to the memory
 bandwidth limit measured in the same run."""

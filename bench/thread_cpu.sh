@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Where the two cores go while a haptic client presses the liver: CPU time of every thread of
 # viscera-server and haptic-client over a window of the run (from /proc/PID/task/TID/stat, user +
 # system), as a markdown table in % of one core, then the server's exit line.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # One physics tick of each bundled scene as the server builds it, forces on one and two threads
 # (build/bench/tick_bench, Google Benchmark; 3 repetitions, medians), into bench/results/tick.json,
 # and the tables of docs/PERFORMANCE.md regenerated. Usage: bench/tick.sh [benchmark flags]

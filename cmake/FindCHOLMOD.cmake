@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Finds CHOLMOD from Debian 12's libsuitesparse-dev (SuiteSparse 5.12 ships no CMake config).
 # Defines the imported target CHOLMOD::CHOLMOD.
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -P: writes OUT, a C++ source defining viscera::protocol::detail::kBinarySchemas, the bytes
 # of each binary FlatBuffers schema (.bfbs) in FILES (separated by |), in that order.
 string(REPLACE "|" ";" FILES "${FILES}")

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what is missing and builds viscera. Usage: deploy/build.sh [BUILD_DIR] [extra cmake args]
 # TARGETS="a b" builds only those targets (default: all).
 set -euo pipefail

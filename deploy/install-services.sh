@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs viscera as services on this host (docs/DEPLOY.md): builds what is missing, installs the
 # programs, data, console page and DDS configurations under PREFIX (default /opt/viscera), the
 # systemd units under UNITS (default /etc/systemd/system), and with --system also the service user

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The main job: installs and builds what is missing, then runs viscera as it is used: the
 # simulation server on the bundled liver (liver2, 1,493 tetrahedra, constant-Q viscoelastic GPS
 # at 1 kHz) and, as a separate process over Cyclone DDS, a scripted haptic client that presses a
@@ -23,7 +24,9 @@
 #   LISTEN=0.0.0.0:8080 ./deploy/run.sh                   the console reachable from other hosts (default: this one only)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-"$root/deploy/build.sh" "$root/build"
+# Only what the demo runs is installed and built (the tests are built by deploy/test.sh).
+DEPS=demo TARGETS="viscera-server viscera-record viscera-console haptic-client viscera-control viscera-plot viscera-replay _viscera" \
+  "$root/deploy/build.sh" "$root/build"
 scene="${SCENE:-$root/data/scenes/liver.json}"
 duration="${DURATION:-8}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$root/deploy/dds/loopback.xml}"
@@ -64,10 +67,10 @@ echo "[demo] for the same data; probe 1 presses 2 cm into each (6 s), and viscer
 for tissue in titin-fitted titin-linear; do
   "$bin/tools/viscera-control/viscera-control" material --file "$root/data/materials/$tissue.json" --domain "$domain" 2>&1 | head -1 | sed -u 's/^/[console] /'
   "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.02 --duration 6 \
-    --report "$root/out/press-$tissue.json" 2>&1 | sed -u 's/^/[haptic] /'
+    --report "$root/out/press-$tissue.json" --replace 2>&1 | sed -u 's/^/[haptic] /'
 done
 "$bin/tools/viscera-plot/viscera-plot" "$root/out/press-titin-fitted.json=titin as fitted (spectrum, stiffening)" \
-  "$root/out/press-titin-linear.json=its linear baseline (Kelvin-Voigt)" --svg "$root/out/titin-vs-linear.svg" \
+  "$root/out/press-titin-linear.json=its linear baseline (Kelvin-Voigt)" --svg "$root/out/titin-vs-linear.svg" --replace \
   --title "The same 2 cm press on the liver's shape: titin as fitted against its linear baseline" 2>&1 | sed -u 's/^/[plot] /'
 echo "[demo] scalpel 4 cuts a 6 cm incision 1.5 cm deep along the top of the organ (4 s; the console shows it open), then probe 2"
 echo "[demo] presses 1 cm on the incision's line (3 s): the cut's lips part under it (docs/CUTTING.md)"
@@ -86,7 +89,7 @@ sleep 0.2
 echo "[demo] the recording ($recording):"
 "$bin/tools/viscera-record/viscera-record" info "$recording" --verify 2>&1 | sed -u 's/^/[record] /'
 echo "[demo] the session re-run on a fresh server in lockstep, compared bit for bit with the recording"
-"$bin/tools/viscera-replay/viscera-replay" resimulate "$recording" --report "$root/out/demo-resimulation.json" --domain "$domain" 2>&1 \
+"$bin/tools/viscera-replay/viscera-replay" resimulate "$recording" --report "$root/out/demo-resimulation.json" --replace --domain "$domain" 2>&1 \
   | sed -u 's/^/[replay] /' || echo "[demo] the re-simulation did not reproduce the session: see the first divergence above"
 echo "[demo] the same recording in Python (numpy, pandas, matplotlib): examples/python/analyse_session.py"
 python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$bin/CMakeCache.txt")"

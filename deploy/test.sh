@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Runs every test: installs and builds what is missing, then
 #  1. the whole suite in Release with ctest (unit, lab, physics, tools, integration over a real DDS
 #     domain, the fuzz targets, the soak, and lint: clang-format on every file, clang-tidy on the

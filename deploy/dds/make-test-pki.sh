@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Creates a TEST public-key infrastructure for viscera's DDS Security (deploy/dds/secure.xml):
 #   ca.pem, ca.key                   the test certificate authority (EC prime256v1, 10 years)
 #   IDENTITY.pem, IDENTITY.key       one certificate and key per identity, signed by the CA

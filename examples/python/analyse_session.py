@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """A recorded training session, analysed: the force on each instrument, the tool's path, the
 tissue's largest edge strain over time, and the surface's deepest dent; printed, and plotted to
 a PNG when matplotlib is installed.

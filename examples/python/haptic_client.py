@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """A scripted haptic client in Python: claims a probe, presses the organ from above at the centre of
 its bounds at a fixed rate (default 1 kHz), down to a depth below the surface and back, and
 prints the forces, the command-to-force round trip and the periods that ran late.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """viscera-lab from Python: analyze a data set, print what the baseline gets wrong and what the
 extended model gains on held-out tests, and plot each test with both models.
 

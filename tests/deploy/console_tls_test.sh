@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The console serves HTTPS and WSS itself (issue 33): a server (the 1.5k liver) and a console with
 # the test PKI's web certificate (deploy/dds/make-test-pki.sh), judged by clients that verify the
 # certificate against the test CA (tests/node/console_tls.mjs: Node's OpenSSL, the ws client, and
@@ -10,7 +11,7 @@ set -u
 build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 console="$build/tools/viscera-console/viscera-console"
 command -v certutil >/dev/null || { echo "FAIL certutil is not installed (deploy/install-deps.sh installs libnss3-tools)"; exit 1; }
 [ -d "$src/tests/node/node_modules/playwright-core" ] || { echo "FAIL playwright-core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }
@@ -72,5 +73,4 @@ print(f"console: tls {s['tls']}, {s['tls_handshakes_failed']} TLS handshakes ref
 sys.exit(0 if s["tls"] and s["tls_handshakes_failed"] >= 3 and s["plain_http_refused"] >= 1 else 1)
 PY
 check "the console still runs" 'kill -0 "${pids[1]}"'
-echo "console_tls: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """One half of a slow, lossy Ethernet link in user space (the kernel of the project's machines has
 no netem qdisc). Each half opens a TAP device in the network namespace it runs in; the two halves
 pass whole frames to each other over a Unix socket (which crosses namespaces). Each half delays the

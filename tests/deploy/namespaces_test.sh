@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Several hosts on one machine: three network namespaces joined by veth pairs to a bridge in a
 # fourth, with addresses from 198.18.0.0/15 (reserved for network tests) that exist only on those
 # links. The server runs in one, a haptic client in a second, the recorder in a third, each with
@@ -25,7 +26,7 @@ cleanup() {
   kill "${pids[@]}" 2>/dev/null || true; wait "${pids[@]}" 2>/dev/null || true
   for h in "${hosts[@]}"; do ip netns del "v$tag$h" 2>/dev/null || true; done
   ip netns del "$bridge" 2>/dev/null || true
-  rm -rf "$tmp"
+  show_output; rm -rf "$tmp"
 }
 trap cleanup EXIT
 if [ "$(id -u)" -ne 0 ] || ! command -v ip >/dev/null || ! ip netns add "$bridge" 2>"$tmp/netns.err"; then
@@ -125,5 +126,4 @@ sys.exit(0 if commands >= 7000 and forces >= commands and rt_slow["p50"] >= 4000
 PY
 kill -INT "${pids[0]}"; wait "${pids[0]}"; rc_server=$?
 check "the server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
-echo "namespaces_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # DDS Security, with real processes on one DDS domain (deploy/dds/secure.xml and a test PKI from
 # deploy/dds/make-test-pki.sh, stations bay-1 and bay-2):
 #  - the authorized server, haptic client, trainer, console identity and recorder work as before:
@@ -17,7 +18,7 @@ build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
 server=; holder=
 recorder=
-trap 'kill $server $holder $recorder 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill $server $holder $recorder 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 hc="$build/tools/haptic-client/haptic-client"; ctl="$build/tools/viscera-control/viscera-control"
 rec="$build/tools/viscera-record/viscera-record"; hostile="$build/tests/integration/hostile_publisher"
 
@@ -127,5 +128,4 @@ print(f"[ figure ] round trip without security p50 {rt(p, 'p50'):.0f} us p99 {rt
       f"(ratio p50 {rt(s, 'p50') / rt(p, 'p50'):.2f}, p99 {rt(s, 'p99') / rt(p, 'p99'):.2f})")
 sys.exit(0 if rt(s, "p50") > 0 and rt(p, "p50") > 0 else 1)
 PY
-echo "security_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

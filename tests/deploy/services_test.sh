@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The services as installed (deploy/install-services.sh): programs, data, console page and DDS
 # configurations under a scratch prefix, the systemd units under a scratch folder, checked by
 # systemd-analyze verify (syntax, and that each ExecStart exists and is executable); the installed
@@ -9,7 +10,7 @@
 set -u
 build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
-trap 'rm -rf "$tmp"' EXIT
+trap 'show_output; rm -rf "$tmp"' EXIT
 "$src/deploy/install-services.sh" --prefix "$tmp/opt" --units "$tmp/units" --build "$build" > "$tmp/install.log" 2>&1; rc=$?
 cat "$tmp/install.log"
 check "install-services installed into a scratch prefix (rc $rc)" "[ $rc -eq 0 ] && [ -x '$tmp/opt/bin/viscera-server' ] && [ -f '$tmp/opt/share/viscera/web/index.html' ]"
@@ -31,5 +32,4 @@ openssl rand -hex 16 > "$tmp/token"; chmod 600 "$tmp/token"
 timeout 3 "$tmp/opt/bin/viscera-console" --domain "$domain" --stations svc --listen 127.0.0.1:0 --token-file "$tmp/token" \
   --web-root "$tmp/opt/share/viscera/web" > "$tmp/console.log" 2>&1
 check "the installed console started on the installed page" "grep -q 'station(s); open' '$tmp/console.log'"
-echo "services_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

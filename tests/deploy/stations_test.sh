@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Several stations on one DDS domain and one machine: three servers (the 1.5k liver) in stations
 # bay-1, bay-2 and bay-3, scripted haptic clients in bay-1 and bay-2 under the same client id and
 # instrument (each station's ids are its own), nothing in bay-3, and one console watching all
@@ -10,7 +11,7 @@ set -u
 build="$1"; src="$(cd "$2" && pwd)"
 . "$src/tests/integration/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 server="$build/server/runtime/viscera-server"; hc="$build/tools/haptic-client/haptic-client"
 for b in 1 2 3; do
   "$server" --scene "$scene" --station "bay-$b" > "$tmp/server-$b.log" 2>&1 &
@@ -56,5 +57,4 @@ for b in (1, 2, 3):
     print(line)
 sys.exit(0)
 PY
-echo "stations_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Builds the fuzz targets with clang (libFuzzer + ASan + UBSan; tests/fuzz/CMakeLists.txt) and runs
 # each briefly from a seed corpus: the decoders from one valid payload of every message, the
 # readers from the shipped scenes, materials, meshes, data set and a fitted model.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain and a real browser: viscera-server, a
 # scripted haptic client pressing the liver, and viscera-console; the page opened in Debian's
 # headless Chromium by playwright-core (tests/node/console_page.mjs: refused without the token, the
@@ -14,7 +15,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/console-test/; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/console-test/; show_output; rm -rf "$tmp"' EXIT
 console="$build/tools/viscera-console/viscera-console"
 node_dir="$src/tests/node"
 [ -d "$node_dir/node_modules/playwright-core" ] || { echo "FAIL playwright-core is not installed (deploy/install-deps.sh runs npm ci in tests/node)"; exit 1; }
@@ -119,5 +120,4 @@ if [ "$failures" -gt 0 ]; then  # what the failing checks need to be understood
   echo "--- server (last 15 lines):"; tail -15 "$tmp/server.log"
   echo "--- console (last 15 lines):"; tail -15 "$tmp/console.log"
 fi
-echo "console: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain: a scalpel's incision through the liver
 # (haptic-client --script incise on instrument 4) while viscera-record records; the surface seen
 # by the cutting client and by a client that joins after the cut (transient local: it gets the
@@ -10,7 +11,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 hc="$build/tools/haptic-client/haptic-client"
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 & server=$!; pids+=($server)
 "$build/tools/viscera-record/viscera-record" --out "$tmp/cut.mcap" --domain "$domain" --compression none > "$tmp/rec.log" 2>&1 & recorder=$!; pids+=($recorder)
@@ -78,5 +79,4 @@ sys.exit(0 if got == (cut["topology_generation"], cut["surface_vertices"]) and f
 PY
 kill -INT "$player" 2>/dev/null; wait "$player" 2>/dev/null
 check "a replay from after the cut gives a new client the cut surface whole, and its frames (rc $rc_replay)" "[ $rc_replay -eq 0 ]"
-echo "cutting: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

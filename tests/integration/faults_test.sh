@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain on loopback: what the server and its
 # clients do on faults and bad input.
 # - The server killed (SIGKILL) and stopped (SIGTERM) under a pressing haptic client and a console
@@ -21,7 +22,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 server=""
-trap 'kill -KILL $server 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill -KILL $server 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 bin_server="$build/server/runtime/viscera-server"
 hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"
@@ -305,5 +306,4 @@ check "the server runs on (alive, still reporting)" "kill -0 $server && [ \$(gre
 kill -INT "$server"; wait "$server"; rc_server=$?
 check "the server stopped cleanly (rc $rc_server)" "[ $rc_server -eq 0 ]"
 
-echo "faults_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

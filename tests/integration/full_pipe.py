@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Runs a command whose standard output is a pipe filled to its last byte, as a pipe nobody reads
 (or a terminal stopped with Ctrl-S) is: every write to it blocks. After --read-after seconds the
 pipe is read (with --interrupt the command then gets SIGINT); prints when that was, the command's

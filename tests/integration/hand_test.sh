@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain on loopback: a hand is never struck
 # (docs/FAULTS.md, "The force on the hand"). A real server and a real haptic client whose report
 # holds the force it commanded its device, one sample a millisecond; in each scenario an event
@@ -15,7 +16,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 server=""
-trap 'kill -KILL $server 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill -KILL $server 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 bin_server="$build/server/runtime/viscera-server"
 hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"
@@ -150,5 +151,4 @@ assert worst <= slew + 1e-9, f"the force changed by {worst:.3f} N in one sample"
 assert max(after) <= bound, f"releasing the button in the tissue gave {max(after):.3f} N, above {bound:.3f} N"
 PY
 
-echo "hand_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

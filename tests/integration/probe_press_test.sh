@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, as separate processes over a real DDS domain on loopback with the project's Cyclone
 # configuration: viscera-server runs the liver scene; haptic-client claims a probe and presses it
 # into the liver and back at 1 kHz. The force must oppose the motion and grow with depth; the
@@ -7,7 +8,7 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill "$server" 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
 server=$!
 "$build/tools/viscera-control/viscera-control" health --domain "$domain" --client-id 903 --duration 4.5 > "$tmp/health.log" 2>&1 &
@@ -149,5 +150,4 @@ print(f"[ figure ] probe press: {len(down)} contact samples, {100*up:.0f}% oppos
       f"({100 * deep / (k * travel):.0f}% of the penalty on a rigid surface over {1000 * travel:.0f} mm); "
       f"round trip p50 {rt['p50']:.0f} us, p99 {rt['p99']:.0f} us, max {rt['max']:.0f} us over {rt['samples']} commands")
 PY
-echo "probe_press_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain: a scripted session (a press, a material
 # change, a material file refused and one taken whole, a grasp and lift, an annotation, the first client pressing again under the same id)
 # recorded by viscera-record; the file judged by the
@@ -14,7 +15,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/rt2/; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/rt2/; show_output; rm -rf "$tmp"' EXIT
 rec="$build/tools/viscera-record/viscera-record"
 replay="$build/tools/viscera-replay/viscera-replay"
 hc="$build/tools/haptic-client/haptic-client"
@@ -334,5 +335,4 @@ cat "$tmp/late.log"
 check "a server joining the replay's partition stops it (rc $rc_late, want 3)" "[ $rc_late -eq 3 ] && grep -q 'holds a live viscera-server' '$tmp/late.log'"
 kill -INT "$guard" "$late_server"; wait "$guard" "$late_server"
 
-echo "recording: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

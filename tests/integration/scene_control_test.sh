@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain on loopback: run-time session control.
 # A probe holds the liver pressed in while another process (an instructor) doubles Young's
 # modulus, lowers the physics rate, asks for scenes that do not exist or do not read, and loads
@@ -10,7 +11,7 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" "$presser" "$watcher" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill "$server" "$presser" "$watcher" 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 presser=; watcher=
 hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"
@@ -113,5 +114,4 @@ assert len(a["samples"]) / a["duration_s"] > 800, "forces in the new scene below
 print(f"[ figure ] after loading liver-12k: a new client received {len(frames)} frames of the new surface and "
       f"{len(a['samples']) / a['duration_s']:.0f} forces/s")
 PY
-echo "scene_control_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain on loopback: two clients with two
 # instruments at once; a hostile publisher's garbage, truncated, wrong-schema, NaN and not-owned
 # payloads are rejected and counted while the good clients keep their 1 kHz force stream; a client
@@ -8,7 +9,7 @@
 set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
-trap 'kill "$server" "$victim" "$watcher" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+trap 'kill "$server" "$victim" "$watcher" 2>/dev/null || true; show_output; rm -rf "$tmp"' EXIT
 watcher=
 hc="$build/tools/haptic-client/haptic-client"
 "$build/server/runtime/viscera-server" --scene "$scene" > "$tmp/server.log" 2>&1 &
@@ -154,5 +155,4 @@ for path in sys.argv[1:3]:
           f"round trip p50 {r['round_trip_us']['p50']:.0f} us p99 {r['round_trip_us']['p99']:.0f} us")
 print(f"[ figure ] SIGKILLed client's instrument claimed by another {float(sys.argv[3]):.2f} s after the kill")
 PY
-echo "sessions_test: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ "$failures" -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The soak (bench/soak.sh) for 100 s instead of an hour: a pressing client, a grasping client and a
 # console making a request every 10 s against one server. Everything must succeed, the server's
 # threads and file descriptors must stay put, and its resident memory must not grow by more than

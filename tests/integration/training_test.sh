@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Integration, separate processes over a real DDS domain: each exercise (docs/TRAINING.md) run by
 # viscera-trainer on a live server, performed by a scripted haptic client once well and once
 # badly, and recorded by viscera-record. The good performance passes, the bad one fails for the
@@ -11,7 +12,7 @@ set -u
 build="$1"; src="$2"
 . "$(dirname "$0")/common.sh"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/training-test/; rm -rf "$tmp"' EXIT
+trap 'kill "${pids[@]}" 2>/dev/null || true; [ -n "${KEEP:-}" ] && cp -r "$tmp" /tmp/training-test/; show_output; rm -rf "$tmp"' EXIT
 rec="$build/tools/viscera-record/viscera-record"
 trainer="$build/tools/viscera-trainer/viscera-trainer"
 hc="$build/tools/haptic-client/haptic-client"
@@ -175,5 +176,4 @@ cat "$tmp/bad1.err" "$tmp/bad2.err" "$tmp/bad3.err"
 check "unknown field: exit 2 naming file and field" "[ $rc1 -eq 2 ] && grep -q 'unknown.json: colour: unknown field' '$tmp/bad1.err' && [ \$(wc -l < '$tmp/bad1.err') -eq 1 ]"
 check "value out of range: exit 2 naming file and field" "[ $rc2 -eq 2 ] && grep -q 'range.json: time_limit_s' '$tmp/bad2.err'"
 check "bad command line: exit 2" "[ $rc3 -eq 2 ]"
-echo "training: $passed passed, $failures failed${failed_names:+:$failed_names}"
-[ $failures -eq 0 ]
+finish

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """The C++ sources a change touches: every .cpp changed since BASE, and for each header changed
 since BASE that none of those includes, one source that does (its own .cpp where it has one), read
 from the build's dependency log (ninja -t deps): clang-tidy reports a header's findings in any

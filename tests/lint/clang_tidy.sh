@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # clang-tidy with the project's .clang-tidy (its findings are errors) on the C++ sources a change
 # touches: those changed since BASE, and for each header changed since BASE that none of them
 # includes, one source that does (tests/lint/changed_sources.py, from the build's dependency log).

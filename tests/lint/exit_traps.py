@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Every shell script's EXIT trap runs to its end. Under `set -e` a command that fails inside the
 trap stops it there and the script exits 1: a `kill` of a process that has already exited (the
 usual case at the end of a run) then skipped the `rm -rf` of the temporary folder, so each

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Every C++ file is laid out as .clang-format says (clang-format 14). Prints the files that are not.
 # Usage: format_check.sh SOURCE_DIR
 set -u

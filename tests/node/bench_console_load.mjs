@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Load on viscera-console: N WebSocket clients that take everything a page gets (binary frames,
 // forces, telemetry, events) for D seconds. Measures, in one run: the delay from the server's
 // frame to each client (the frame header's server stamp; one host, one clock), bytes per second

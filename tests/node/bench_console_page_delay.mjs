@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The console page in headless Chromium for D seconds (no screenshots, nothing else asked of it):
 // the delay from the server's frame to the page having it, as the page records it.
 // Usage (bench/console.sh, bench/station.sh): node bench_console_page_delay.mjs URL_WITH_TOKEN SECONDS [START_S]   -> one JSON line

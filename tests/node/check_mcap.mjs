@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The official MCAP reader (@mcap/core, with @mcap/support's zstd and lz4) judges a file:
 //   node check_mcap.mjs FILE.mcap
 // Reads it twice, as a stream (every record, chunk CRCs checked) and through its index (summary,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A replay judged against its original by the official MCAP reader (@mcap/core):
 //   node compare_replay.mjs ORIGINAL.mcap REPLAY.mcap TOPIC...
 // For each topic: whether the replay holds the original's payloads in the original's order (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the console let through before (issue 31), each checked against the running bridge:
 //   1. a Foxglove session receives only the Foxglove protocol's messages (never the page's frames,
 //      forces or scene, which its reference client took for garbage "time" and unknown opcodes);

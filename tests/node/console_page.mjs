@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The console page in a real browser (Debian's headless Chromium, driven by playwright-core): a
 // viscera-console bridge, a server and a haptic client pressing the liver are running (started by
 // tests/integration/console_test.sh). Checks what an instructor relies on, from the page's state

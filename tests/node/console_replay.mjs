@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Opening a recording for replay from the console (tests/integration/console_test.sh): the bridge
 // lists the recordings of its --recordings folder, starts viscera-replay in a partition of its own
 // when a browser asks, and offers it as a new station that the browser then watches: the

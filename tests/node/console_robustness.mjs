@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The console bridge under browsers that misbehave (tests/integration/console_test.sh starts the
 // bridge beside a server whose surface frames run at 60 Hz). One well-behaved browser watches
 // throughout; it must keep receiving frames while

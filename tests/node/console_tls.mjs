@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The console over HTTPS and WSS, judged by clients that verify its certificate against the test
 // CA, as a hospital's browsers and tools would (nothing here ignores a certificate error):
 //   Node's TLS (OpenSSL) with the CA: the page and /stats are served, the cookie is Secure; without

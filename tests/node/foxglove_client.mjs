@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A live session through viscera-console's Foxglove WebSocket protocol, read by the protocol's
 // reference client (@foxglove/ws-protocol) and decoded with the schemas the bridge advertises
 // (flatbuffers_reflection, as Foxglove decodes FlatBuffers): it connects, sees the channels,

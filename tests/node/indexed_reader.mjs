@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The official reader's indexed access to a file on disk (@mcap/core's McapIndexedReader over a
 // file handle), shared by the scripts here. Returns { reader, close }.
 import { open } from "node:fs/promises";

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the Python package's tests: the build and source trees (VISCERA_BUILD,
 VISCERA_SOURCE, set by ctest), a DDS domain of the test run's own, a real viscera-server on the
 liver scene, and a session recorded by viscera-record while a Python client presses the liver."""

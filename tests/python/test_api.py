@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The package's surface: every public name documented, the exceptions in their places."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The examples in examples/python run as a user runs them: the haptic client against the server,
 the analysis of the session recorded by the session test, a quick lab fit of the titin data."""
 
@@ -8,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import SOURCE, Server, Session
+from conftest import SOURCE, Server, Session, program
 
 EXAMPLES = SOURCE / "examples/python"
 
@@ -29,6 +30,20 @@ def test_haptic_client_presses_and_reports(server: Server, domain: int) -> None:
     assert "scene liver" in out and "round trip p50" in out
     peak = float(out.split("peak force ")[1].split(" N")[0])
     assert peak > 0.05, out
+
+
+def test_the_readmes_first_clients_press_and_let_go(server: Server, domain: int) -> None:
+    """The README's first clients, in C++ and in Python: the tip starts 5 mm above the organ's
+    bounds (no force), is 2 cm below them at the deepest (the tissue pushes it up), and is back
+    above them at the end (no force again)."""
+    for command in ([program("examples/cpp/first_client"), str(domain)], [sys.executable, str(EXAMPLES / "first_client.py"), str(domain)]):
+        done = subprocess.run(command, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, f"{command[-2]}: {done.stderr}"
+        forces = {float(x.split()[1]): float(x.split("force z ")[1].split()[0]) for x in done.stdout.splitlines()}
+        above = [f for t, f in forces.items() if t <= 0.25 or t >= 3.75]
+        deepest = [f for t, f in forces.items() if 1.75 <= t <= 2.25]
+        assert len(forces) >= 15 and len(above) >= 3 and not any(above), f"{command[-2]}: {done.stdout}"
+        assert deepest and min(deepest) > 0.05, f"{command[-2]}: no push at the deepest point: {done.stdout}"
 
 
 def test_analyse_session_summarises_and_plots(session: Session, tmp_path: Path) -> None:

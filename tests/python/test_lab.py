@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The lab from Python gives viscera-lab's numbers: the same analysis of the bundled titin data,
 compared figure by figure with the report.json the program writes."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A scene loaded while a Python client watches: the frames' shape follows the new surface, and
 taking a frame's positions copies nothing (tracemalloc sees numpy's allocations). Run last in
 python.session: the server then runs the 12k liver."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A 10-second session against a real viscera-server over DDS, recorded by viscera-record; the
 recording read back into DataFrames and judged against the official MCAP reader's counts and
 against what the client itself sent and received."""

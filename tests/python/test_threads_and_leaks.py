@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The package in long-running programs: waiting calls release the interpreter lock (a Python
 thread keeps running beside a blocked call), and creating and destroying clients and recording
 readers 10,000 times does not grow the process."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tissue core from Python against theory: a bar hanging under its own weight stretches by
 rho g L^2 / (2 E) (Poisson ratio 0: the 1-D solution is exact); numpy views of the state."""
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The programs' command lines: --help works, bad arguments and bad files give one clear line on
 # stderr and a non-zero exit. PART: "programs" (every program's flags and files), "lab-analysis"
 # (viscera-lab analyze and predict on the titin data, and hand-edited model files: a minute under

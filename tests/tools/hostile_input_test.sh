@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What a hostile new user hands the programs without a session running (issue 31): JSON nested
 # 100,000 deep, numbers that are not whole, names that are paths or carry control bytes, an output
 # that is one of the inputs under another name (a hard link, a symbolic link, the same folder),
@@ -94,17 +95,33 @@ expect hc-trajectory-zero 2 "/dev/zero: is not a regular file" -- "$hc" --trajec
 echo mine > "$tmp/victim"; cp "$tmp/victim" "$tmp/victim.copy"
 ln -s "$tmp/victim" "$tmp/planted.csv"; ln -s "$tmp/victim" "$tmp/planted.svg"
 f2="$build/tools/viscera-figure2/viscera-figure2"
-expect figure2-csv-link 2 "planted.csv: is a symbolic link" -- "$f2" --csv "$tmp/planted.csv" --svg "$tmp/f2.svg"
-expect figure2-svg-link 2 "planted.svg: is a symbolic link" -- "$f2" --csv "$tmp/f2.csv" --svg "$tmp/planted.svg"
+expect figure2-csv-link 2 "planted.csv: is a symbolic link" -- "$f2" --csv "$tmp/planted.csv" --svg "$tmp/f2.svg" --replace
+expect figure2-svg-link 2 "planted.svg: is a symbolic link" -- "$f2" --csv "$tmp/f2.csv" --svg "$tmp/planted.svg" --replace
 mkdir -p "$tmp/sim"; ln -s "$tmp/victim" "$tmp/sim/frames.pvd"
 expect sim-pvd-link 2 "frames.pvd: is a symbolic link" -- "$build/tools/viscera-sim/viscera-sim" --mesh "$src/data/meshes/liver.msh" \
-  --scale 0.01 --duration 0.01 --frame-rate 100 --out "$tmp/sim"
+  --scale 0.01 --duration 0.01 --frame-rate 100 --out "$tmp/sim" --replace
 unchanged outputs-through-links "$tmp/victim" "$tmp/victim.copy"
 # An --out that cannot be a folder is refused before the analysis, in one line (it aborted after it).
 touch "$tmp/plain-file"
 expect lab-out-under-a-file 2 "--out: cannot create the folder" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/plain-file/sub"
 expect lab-out-too-long 2 "--out: cannot create the folder" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/$(printf 'x%.0s' $(seq 300))"
-expect figure2-csv-fifo 2 "is not a regular file" -- "$f2" --csv "$tmp/traj-fifo" --svg "$tmp/f2.svg"
+expect figure2-csv-fifo 2 "is not a regular file" -- "$f2" --csv "$tmp/traj-fifo" --svg "$tmp/f2.svg" --replace
+
+# 4c. An output that exists already is replaced only when asked (--replace), else refused in one
+#     line before the work, naming the file and the flag; the file is left as it was.
+plot="$build/tools/viscera-plot/viscera-plot"
+echo earlier > "$tmp/earlier"; cp "$tmp/earlier" "$tmp/earlier.copy"
+expect hc-report-exists 2 "earlier: --report: exists already: pass --replace" -- "$hc" --report "$tmp/earlier" --duration 1
+expect plot-svg-exists 2 "earlier: --svg: exists already: pass --replace" -- "$plot" "$tmp/t.csv" --svg "$tmp/earlier"
+expect figure2-exists 2 "earlier: --csv: exists already: pass --replace" -- "$f2" --csv "$tmp/earlier" --svg "$tmp/f2-new.svg"
+expect resimulate-report-exists 2 "earlier: --report: exists already: pass --replace" -- "$replay" resimulate "$tmp/in.mcap" --report "$tmp/earlier"
+unchanged existing-outputs "$tmp/earlier" "$tmp/earlier.copy"
+mkdir -p "$tmp/full"; cp "$tmp/earlier" "$tmp/full/report.json"
+expect lab-out-holds-files 2 "full: --out: holds files already: pass --replace" -- "$lab" analyze "$src/data/titin-passive-muscle" --out "$tmp/full"
+expect sim-out-holds-files 2 "full: --out: holds files already: pass --replace" -- "$build/tools/viscera-sim/viscera-sim" --mesh "$src/data/meshes/liver.msh" --out "$tmp/full"
+unchanged existing-folder "$tmp/full/report.json" "$tmp/earlier.copy"
+mkdir -p "$tmp/reports"; cp "$tmp/earlier" "$tmp/reports/force-drill.json"
+expect trainer-report-exists 2 "force-drill.json: --report-dir: exists already: pass --replace" -- "$trainer" score "$tmp/ex/force-drill.json" "$tmp/x.mcap" --report-dir "$tmp/reports"
 
 # 5. Station names are DDS partitions: a wildcard would reach other stations' live sessions, and
 #    every program that joins a station checks the name before it touches the network.

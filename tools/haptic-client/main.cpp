@@ -21,6 +21,7 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/device_runner.hpp"
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
@@ -160,6 +161,7 @@ Options parse(viscera::common::CommandLine& cl) {
   o.tick_phase_us = cl.number_in("tick-phase", -1, 1e6);
   if (cl.has("report")) o.report = cl.text("report");
   if (!o.report.empty() && !o.trajectory_file.empty()) viscera::common::refuse_overwrite(o.report, {o.trajectory_file}, "--report");
+  if (!o.report.empty()) viscera::common::refuse_existing_output(o.report, cl.has("replace"), "--report");
   return o;
 }
 
@@ -315,7 +317,8 @@ int main(int argc, char** argv) {
                    "when the server goes away, wait for one to come back and claim the instrument again; "
                    "when the instrument is freed under this client, claim it again");
   cl.option_switch("quiet", "no live lines, only the summary");
-  cl.flag("report", "FILE.json", "write samples and statistics here");
+  cl.flag("report", "FILE.json", "write samples and statistics here (a new file; see --replace)");
+  cl.option_switch("replace", "replace the --report file if it exists (never through a symbolic link)");
   try {
     if (!cl.parse(argc, argv)) return 0;
     const Options o = parse(cl);

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/plot/svg_plot.hpp"
@@ -23,7 +24,10 @@ int main(int argc, char** argv) {
     cl.flag("svg", "PATH", "SVG plot output", "docs/figure2.svg");
     cl.flag("mechanisms", "L", "number of memory variables (standard linear solids), 1-8", "3");
     cl.flag("sample-rate", "HZ", "output samples per second", "250");
+    cl.option_switch("replace", "replace the CSV and the SVG if they exist (as when regenerating docs/figure2.*)");
     if (!cl.parse(argc, argv)) return 0;
+    refuse_existing_output(cl.text("csv"), cl.has("replace"), "--csv");
+    refuse_existing_output(cl.text("svg"), cl.has("replace"), "--svg");
     Figure2Options o;
     o.mechanisms = static_cast<int>(cl.integer("mechanisms"));
     o.sample_rate_hz = cl.number_in("sample-rate", 100, 10000);

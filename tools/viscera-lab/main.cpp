@@ -10,6 +10,7 @@
 #include <string>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
@@ -133,6 +134,7 @@ int main(int argc, char** argv) {
       "                          [--specimens TABLE] [--tare] [--zero-displacement] [--platens] [--compression-positive]");
   cl.flag("out", "DIR", "output folder (required)");
   cl.option_switch("quiet", "no progress lines");
+  cl.option_switch("replace", "analyze, predict: write into an --out folder that holds files already (its files of the same names are replaced)");
   cl.flag("mode", "MODE", "import: uniaxial | simple_shear", "uniaxial");
   cl.flag("control", "C", "import: strain (displacement imposed) | stress (force imposed)", "strain");
   cl.flag("length-m", "L", "import: specimen length [m] (the gauge under uniaxial load)");
@@ -175,7 +177,10 @@ int main(int argc, char** argv) {
     if (positional.size() >= 2) viscera::common::refuse_overwrite(out, {positional.back()}, "--out");
     // The folder made before the work: an analysis of minutes never fails at its end for want of it
     // (import makes its data set's folder itself, and refuses one that exists).
-    if (positional[0] != "import") viscera::common::create_output_folder(out, "--out");
+    if (positional[0] != "import") {
+      viscera::common::refuse_existing_folder(out, cl.has("replace"), "--out");
+      viscera::common::create_output_folder(out, "--out");
+    }
     if (positional[0] == "predict" && positional.size() == 3)
       for (const char* written : {"report.json", "model.json"}) viscera::common::refuse_overwrite(out + "/" + written, {positional[1]}, "--out");
     if (positional[0] == "analyze")

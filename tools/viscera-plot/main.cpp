@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/same_file.hpp"
@@ -57,10 +58,11 @@ int main(int argc, char** argv) {
                                   "a curve: the magnitude of the force [N] against the tip's depth below its first contact [mm]\n"
                                   "(--x depth: loading and unloading, a hysteresis loop for viscous tissue) or against time [s].\n"
                                   "Prints each report's peak force.");
-  cl.usage("viscera-plot REPORT.json[=LABEL]... --svg OUT.svg [--x depth|time] [--title TEXT]");
+  cl.usage("viscera-plot REPORT.json[=LABEL]... --svg OUT.svg [--replace] [--x depth|time] [--title TEXT]");
   cl.flag("svg", "PATH", "the SVG to write (required; never one of the reports)");
   cl.flag("x", "AXIS", "depth (below the first contact) or time", "depth");
   cl.flag("title", "TEXT", "the plot's title", "The same press on each tissue");
+  cl.option_switch("replace", "replace the --svg file if it exists (never through a symbolic link)");
   cl.allow_positional(8);
   try {
     if (!cl.parse(argc, argv)) return 0;
@@ -73,6 +75,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> paths;
     for (const std::string& arg : cl.positional()) paths.push_back(arg.substr(0, arg.find('=')));
     viscera::common::refuse_overwrite(svg, paths, "--svg");
+    viscera::common::refuse_existing_output(svg, cl.has("replace"), "--svg");
     viscera::plot::Figure fig{cl.text("title"), by_depth ? "depth below the first contact [mm]" : "time [s]", "force on the tool [N]", {}};
     const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf", "#7f7f7f"};
     for (const std::string& arg : cl.positional()) {

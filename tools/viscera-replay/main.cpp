@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
       "                         every force, event and surface frame. Exit 0: bit-identical; 1: diverged (the first\n"
       "                         divergence is named: tick, topic, field, recorded and recomputed values).\n"
       "Exit status 2: bad arguments or a recording that cannot be used (one line says why); 3: DDS or the server failed.");
-  cl.usage("viscera-replay play FILE.mcap [--rate R] [--loop] [--from S] [--to S] [--station NAME] | resimulate FILE.mcap [--report OUT.json]");
+  cl.usage("viscera-replay play FILE.mcap [--rate R] [--loop] [--from S] [--to S] [--station NAME] | resimulate FILE.mcap [--report OUT.json [--replace]]");
   cl.flag("rate", "R", "play: pace, times the original", "1");
   cl.option_switch("loop", "play: start again at --from after --to");
   cl.flag("from", "S", "play: from this time of the recording [s]", "0");
@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
   cl.flag("station", "NAME", "play: the station (DDS partition) to publish as, never a live server's", "viscera-replay");
   cl.flag("domain", "ID", "DDS domain (default: the recording's)");
   cl.option_switch("no-keys", "play: ignore the terminal's keys");
-  cl.flag("report", "OUT.json", "resimulate: write the report here");
+  cl.flag("report", "OUT.json", "resimulate: write the report here (a new file; see --replace)");
+  cl.option_switch("replace", "resimulate: replace the --report file if it exists (never through a symbolic link)");
   cl.flag("scene", "FILE", "resimulate: this scene file instead of the recorded one (same organ; material, model, damping may differ)");
   cl.flag("server", "PATH", "resimulate: the viscera-server program (default: the one beside this program)");
   cl.option_switch("quiet", "no progress lines");
@@ -72,6 +73,7 @@ int main(int argc, char** argv) {
     o.recording = args[1];
     if (cl.has("scene")) o.scene = cl.text("scene");
     if (cl.has("report")) o.report = cl.text("report");
+    o.replace_report = cl.has("replace");
     o.server = cl.has("server") ? cl.text("server") : viscera::process::find_program("viscera-server", "server/runtime");
     o.domain = domain;
     o.quiet = cl.has("quiet");

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "viscera/client/lockstep_driver.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
@@ -162,6 +163,7 @@ int resimulate(const ResimulateOptions& o, const std::atomic<bool>& stop) {
     std::vector<std::string> inputs{o.recording};
     if (o.scene) inputs.push_back(*o.scene);
     common::refuse_overwrite(*o.report, inputs, "--report");
+    common::refuse_existing_output(*o.report, o.replace_report, "--report");
   }
   rec::Recording recording(o.recording);
   const rec::LockstepPlan plan = rec::make_lockstep_plan(recording);

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/number_text.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
@@ -106,6 +107,7 @@ void declare_flags(viscera::common::CommandLine& cl) {
   cl.flag("frame-rate", "HZ", "VTU frames per simulated second", "30");
   cl.flag("out", "DIR", "output folder for frames (frame_NNNN.vtu + frames.pvd)", "viscera-sim-out");
   cl.option_switch("no-output", "write no frames");
+  cl.option_switch("replace", "write into an --out folder that holds files already (frames of the same names are replaced)");
 }
 
 /// The organ as the command line describes it: mesh, material, model, boundary conditions and the
@@ -235,6 +237,7 @@ int run(int argc, char** argv) {
   declare_flags(cl);
   if (!cl.parse(argc, argv)) return 0;
   const double duration = cl.number_in("duration", 0.0, 1e6), frame_rate = cl.number_in("frame-rate", 1e-3, 1e4);  // before the slow part
+  if (!cl.has("no-output")) viscera::common::refuse_existing_folder(cl.text("out"), cl.has("replace"), "--out");
   Organ organ = build(cl);
   simulate(organ, duration, frame_rate, cl.has("no-output") ? fs::path() : fs::path(cl.text("out")));
   return 0;

@@ -13,6 +13,7 @@
 #include "viscera/client/client.hpp"
 #include "viscera/client/stream_tap.hpp"
 #include "viscera/common/command_line.hpp"
+#include "viscera/common/existing_output.hpp"
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/same_file.hpp"
@@ -158,6 +159,7 @@ int main(int argc, char** argv) {
   cl.flag("seed", "N", "run: the seed that places the scene's drawn regions (a palpation's hidden nodule)");
   cl.flag("client-id", "N", "run: this client's id (non-zero)", "800");
   cl.flag("report-dir", "DIR", "write the report here as EXERCISE.json and EXERCISE.md", "");
+  cl.option_switch("replace", "replace the report's files if they exist (never through a symbolic link)");
   cl.allow_positional(3);
   try {
     if (!cl.parse(argc, argv)) return 0;
@@ -173,7 +175,10 @@ int main(int argc, char** argv) {
     }
     if (!cl.text("report-dir").empty())
       for (const auto& f : report_files(cl.text("report-dir"), exercise.name))
+      {
         viscera::common::refuse_overwrite(f, {args.begin() + 1, args.end()}, "--report-dir");
+        viscera::common::refuse_existing_output(f, cl.has("replace"), "--report-dir");
+      }
     if (args[0] == "score") {
       if (cl.has("seed")) throw UsageError("--seed is for run: a recording holds the place the nodule had");
       return score(exercise, args[2], cl.text("report-dir"));

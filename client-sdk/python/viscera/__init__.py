@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """viscera for Python: drive a session, read recordings into numpy and pandas, run the lab.
 
 Submodules:

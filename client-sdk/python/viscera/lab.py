@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """viscera-lab from Python: load a data set, analyze it, predict other data with the model.
 
     d = viscera.lab.read_dataset("data/titin-passive-muscle")

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Session recordings (MCAP, written by viscera-record) as pandas DataFrames and numpy arrays.
 
     rec = viscera.recording.Recording("session.mcap")

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A client of a running viscera-server over DDS (the C++ client SDK).
 
     client = viscera.session.Client(domain_id=0, client_id=42)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tissue core: an organ mesh with a material, a force model and an integrator.
 
 ``Organ(mesh, material=..., fixed_nodes=...)`` builds it as viscera-sim does; ``advance(seconds)``

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 from . import lab as lab, recording as recording, session as session, tissue as tissue
 
 class InputError(ValueError): ...

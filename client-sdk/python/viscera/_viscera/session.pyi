@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 from typing import ClassVar, Dict, List, Optional, Sequence
 
 import numpy as np

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The instructor console's page: the organ's surface live (three.js), the force over the last 30 s
 // (uPlot), health, instruments, events; session requests to the bridge. window.viscera holds what
 // the page has received, for people debugging it and for the browser tests.
