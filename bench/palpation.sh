@@ -9,7 +9,7 @@
 # table and writes bench/results/palpation.json.
 # Usage: [SEEDS="1 2 3 4 5 6"] bench/palpation.sh
 set -euo pipefail
-if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '3,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 [ $# -eq 0 ] || { echo "palpation.sh: no arguments expected (SEEDS in the environment); see --help" >&2; exit 2; }
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seeds="${SEEDS:-1 2 3 4 5 6}"

@@ -15,7 +15,7 @@
 #   BUILD=build                       the build to run
 # Exit status: 0 when the server ran throughout and every client and request succeeded.
 set -uo pipefail
-if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '3,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 minutes="${1:-60}"
 if ! [[ "$minutes" =~ ^[0-9]+([.][0-9]+)?$ ]] || [ "$(python3 -c "print(int($minutes > 0))")" != 1 ]; then

@@ -14,7 +14,7 @@
 # CLIENT_PRIO sets the haptic client's FIFO priority (default 49, one below the server's 50).
 # Usage: [RUNS=5] [SCENE=liver-12k] [REALTIME=1] [MESH_HZ=N] [CLIENT_PRIO=49] bench/station.sh [SECONDS]   (default 60 s)
 set -euo pipefail
-if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '3,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"; runs="${RUNS:-5}"; scene="${SCENE:-liver-12k}"
 [[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -ge 20 ] || { echo "station.sh: SECONDS: '$seconds' is not a whole number of at least 20 (the CPU is read over all but 15 s of it)" >&2; exit 2; }

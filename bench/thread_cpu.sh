@@ -7,7 +7,7 @@
 #   SCENE: a scene of data/scenes (default liver-12k); SECONDS: the window (default 10), which
 #   starts 6 s into the run (the organ built, the client connected).
 set -euo pipefail
-if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then sed -n '3,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 scene="${1:-liver-12k}"; window="${2:-10}"
 [ -f "$root/data/scenes/$scene.json" ] || { echo "thread_cpu.sh: no scene '$scene' in data/scenes" >&2; exit 2; }

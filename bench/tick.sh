@@ -4,7 +4,7 @@
 # (build/bench/tick_bench, Google Benchmark; 3 repetitions, medians), into bench/results/tick.json,
 # and the tables of docs/PERFORMANCE.md regenerated. Usage: bench/tick.sh [benchmark flags]
 set -euo pipefail
-if [ "${1:-}" = "--help" ]; then sed -n '2,4p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = "--help" ]; then sed -n '3,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/deploy/build.sh" "$root/build" > /dev/null
 mkdir -p "$root/bench/results"

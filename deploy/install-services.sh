@@ -19,7 +19,7 @@ while [ $# -gt 0 ]; do
     --build) build="$2"; shift 2 ;;
     --system) system=1; shift ;;
     --portable) portable=(-DVISCERA_NATIVE=OFF); shift ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '3,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-services: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -25,14 +25,18 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 # Only what the demo runs is installed and built (the tests are built by deploy/test.sh).
-DEPS=demo TARGETS="viscera-server viscera-record viscera-console haptic-client viscera-control viscera-plot viscera-replay _viscera" \
+DEPS=demo TARGETS="viscera-server viscera-record viscera-console haptic-client viscera-control viscera-plot viscera-replay" \
   "$root/deploy/build.sh" "$root/build"
+mkdir -p "$root/out"
+# The Python package is needed only at the end: it compiles while the session runs, on one core at
+# the lowest priority (the physics runs at 1 kHz beside it), and the demo waits for it there.
+CCACHE_BASEDIR="$root" CCACHE_NOHASHDIR=true nice -n 19 cmake --build "$root/build" -j 1 --target _viscera > "$root/out/python-build.log" 2>&1 &
+python_build=$!
 scene="${SCENE:-$root/data/scenes/liver.json}"
 duration="${DURATION:-8}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$root/deploy/dds/loopback.xml}"
 domain=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('domain_id', 0))" "$scene")
 bin="$root/build"
-mkdir -p "$root/out"
 recording="$root/out/demo.mcap"
 "$bin/tools/viscera-record/viscera-record" --out "$recording" --replace --domain "$domain" --quiet > >(sed -u 's/^/[record] /') 2>&1 &
 recorder=$!
@@ -46,7 +50,7 @@ token="$root/out/console-token"
 console_pid=$!
 # The console never logs its token; the demo, on this terminal, prints the address with it.
 echo "[demo] the instructor's console: open http://${LISTEN:-127.0.0.1:8080}/?token=$(cat "$token")"
-trap 'kill -INT "$server" "$recorder" "$console_pid" 2>/dev/null || true; wait "$server" "$recorder" "$console_pid" 2>/dev/null || true; sleep 0.2' EXIT
+trap 'kill -INT "$server" "$recorder" "$console_pid" "$python_build" 2>/dev/null || true; wait "$server" "$recorder" "$console_pid" 2>/dev/null || true; sleep 0.2' EXIT
 sleep 1  # the recorder discovers the server before the first command
 echo "[demo] probe 1 presses 3 cm into the liver and comes back (${duration} s)"
 "$bin/tools/haptic-client/haptic-client" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 \
@@ -92,6 +96,7 @@ echo "[demo] the session re-run on a fresh server in lockstep, compared bit for 
 "$bin/tools/viscera-replay/viscera-replay" resimulate "$recording" --report "$root/out/demo-resimulation.json" --replace --domain "$domain" 2>&1 \
   | sed -u 's/^/[replay] /' || echo "[demo] the re-simulation did not reproduce the session: see the first divergence above"
 echo "[demo] the same recording in Python (numpy, pandas, matplotlib): examples/python/analyse_session.py"
+wait "$python_build" || { echo "[demo] the Python package did not build: out/python-build.log"; tail -5 "$root/out/python-build.log"; }
 python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$bin/CMakeCache.txt")"
 PYTHONPATH="$bin/python" "${python:-python3}" "$root/examples/python/analyse_session.py" "$recording" --plot "$root/out/demo-session.png" 2>&1 \
   | sed -u 's/^/[python] /' || true

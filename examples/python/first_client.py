@@ -12,7 +12,7 @@ if scene is None or not client.claim(1, 5.0):
 x, y = ((a + b) / 2 for a, b in zip(scene.bounds_min_m[:2], scene.bounds_max_m[:2]))
 start = time.monotonic()
 for ms in range(4001):
-    z = scene.bounds_max_m[2] + 0.005 - 0.025 * min(ms, 4000 - ms) / 2000  # [m] down and back
+    z = scene.bounds_max_m[2] + 0.01 - 0.03 * min(ms, 4000 - ms) / 2000  # [m] down and back
     client.send_tip(1, (x, y, z))
     f = client.wait_force(1, 0.001)
     if f is not None and ms % 250 == 0:

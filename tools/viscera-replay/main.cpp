@@ -32,7 +32,9 @@ int main(int argc, char** argv) {
       "                         every force, event and surface frame. Exit 0: bit-identical; 1: diverged (the first\n"
       "                         divergence is named: tick, topic, field, recorded and recomputed values).\n"
       "Exit status 2: bad arguments or a recording that cannot be used (one line says why); 3: DDS or the server failed.");
-  cl.usage("viscera-replay play FILE.mcap [--rate R] [--loop] [--from S] [--to S] [--station NAME] | resimulate FILE.mcap [--report OUT.json [--replace]]");
+  cl.usage(
+      "viscera-replay play FILE.mcap [--rate R] [--loop] [--from S] [--to S] [--station NAME] | resimulate FILE.mcap [--report OUT.json "
+      "[--replace]]");
   cl.flag("rate", "R", "play: pace, times the original", "1");
   cl.option_switch("loop", "play: start again at --from after --to");
   cl.flag("from", "S", "play: from this time of the recording [s]", "0");

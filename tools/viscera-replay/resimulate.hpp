@@ -14,7 +14,7 @@ struct ResimulateOptions {
   std::string recording;
   std::optional<std::string> scene;  ///< a scene file in place of the recorded one (what-if)
   std::optional<std::string> report;  ///< JSON report
-  bool replace_report = false;        ///< replace an existing report (--replace); else refused
+  bool replace_report = false;  ///< replace an existing report (--replace); else refused
   std::string server;  ///< viscera-server program
   std::optional<std::uint32_t> domain;  ///< default: the recording's
   int window = 64;  ///< steps in flight

@@ -174,8 +174,7 @@ int main(int argc, char** argv) {
       if (ec || !std::filesystem::is_directory(dir)) throw viscera::common::InputError(dir, 0, "--report-dir", "is not a folder that can be written");
     }
     if (!cl.text("report-dir").empty())
-      for (const auto& f : report_files(cl.text("report-dir"), exercise.name))
-      {
+      for (const auto& f : report_files(cl.text("report-dir"), exercise.name)) {
         viscera::common::refuse_overwrite(f, {args.begin() + 1, args.end()}, "--report-dir");
         viscera::common::refuse_existing_output(f, cl.has("replace"), "--report-dir");
       }
