@@ -12,7 +12,7 @@
 # REPEAT=N alternates the two N times. Usage: [SCENE=liver] [REPEAT=1] bench/cutting.sh [SECONDS]   (default 60)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0; fi
+if [ "${1:-}" = --help ] || [ "${1:-}" = -h ]; then sed -n '3,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0; fi
 case "${1:-60}" in ''|*[!0-9]*|0) echo "$(basename "$0"): SECONDS: '${1:-}' is not a whole number of seconds above 0" >&2; exit 2;; esac
 seconds="${1:-60}"
 scene="${SCENE:-liver}"

@@ -21,7 +21,7 @@
 # Usage: [VISCERA_CONSOLE_HOSTS="console.lab 10.1.2.3"] deploy/dds/make-test-pki.sh OUT_DIR [STATION...]
 set -euo pipefail
 if [ $# -lt 1 ] || [ "$1" = "--help" ] || [ "$1" = "-h" ]; then
-  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'
+  sed -n '3,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'
   [ $# -ge 1 ]; exit $?
 fi
 out="$1"; shift
