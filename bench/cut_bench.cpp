@@ -1,4 +1,4 @@
-// Cutting (docs/CUTTING.md): one scalpel stroke across the liver at 1 kHz, 0.2 m/s, a 6 cm blade
+// Cutting (docs/CUTTING.md): one scalpel stroke across the liver at 1 kHz, 0.2 m/s, a 6 cm blade  // SPDX-License-Identifier: Apache-2.0
 // drawn through the organ's middle, on the 1.5k and the 12k liver in one run.
 //  - BM_CutStroke: each tick's sweep, the topology (MeshCutter::cut) and then the organ's force
 //    model following it in place (GpsModel::follow_edit, the scenes' viscoelastic model, its

@@ -1,4 +1,4 @@
-// viscera-lab's accuracy on data it has never seen (issue 23): data sets from tests/lab's
+// viscera-lab's accuracy on data it has never seen (issue 23): data sets from tests/lab's  // SPDX-License-Identifier: Apache-2.0
 // independent generator (lab_protocols.hpp), one truth each, at today's effect sizes and at 0.3x
 // and 0.1x; the lab sees only the folder. Prints the accuracy per truth and size, the confusion
 // between causes and the false-positive rate on the "none" sets, as Markdown (docs/LAB.md).

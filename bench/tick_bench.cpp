@@ -1,4 +1,4 @@
-// One physics tick of a bundled scene as viscera-server runs it: the scene's organ (model, mass
+// One physics tick of a bundled scene as viscera-server runs it: the scene's organ (model, mass  // SPDX-License-Identifier: Apache-2.0
 // scaling, fixed slab) advanced by one tick, 1 / physics_rate_hz, in the integrator's equal
 // sub-steps, with the internal forces on one thread and on the scene's threads. No DDS, no
 // instruments: what the tick costs before anything else shares the cores (docs/PERFORMANCE.md).

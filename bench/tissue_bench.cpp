@@ -1,4 +1,4 @@
-// Force evaluation and a full explicit step for liver2 at three refinement levels, for every model,
+// Force evaluation and a full explicit step for liver2 at three refinement levels, for every model,  // SPDX-License-Identifier: Apache-2.0
 // in one run; plus the machine's streaming read bandwidth for the same working-set sizes, so the
 // distance to the memory limit is visible (docs/PERFORMANCE.md). Run: bench/run.sh
 #include <algorithm>

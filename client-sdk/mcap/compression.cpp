@@ -1,4 +1,4 @@
-#include "viscera/mcap/compression.hpp"
+#include "viscera/mcap/compression.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <memory>

@@ -1,4 +1,4 @@
-#include <array>
+#include <array>  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/mcap/mcap_format.hpp"
 

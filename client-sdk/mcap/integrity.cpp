@@ -1,4 +1,4 @@
-#include "viscera/mcap/integrity.hpp"
+#include "viscera/mcap/integrity.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/common/input_error.hpp"
 

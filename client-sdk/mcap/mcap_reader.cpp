@@ -1,4 +1,4 @@
-#include "viscera/mcap/mcap_reader.hpp"
+#include "viscera/mcap/mcap_reader.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <map>

@@ -1,4 +1,4 @@
-#include "viscera/mcap/mcap_writer.hpp"
+#include "viscera/mcap/mcap_writer.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cerrno>
 #include <cstring>

@@ -1,4 +1,4 @@
-// recover(): a complete, indexed copy of every intact record of an MCAP file (McapReader::salvage_data
+// recover(): a complete, indexed copy of every intact record of an MCAP file (McapReader::salvage_data  // SPDX-License-Identifier: Apache-2.0
 // walks it, McapWriter writes the copy).
 #include <map>
 

@@ -1,4 +1,4 @@
-#include "viscera/process/child_process.hpp"
+#include "viscera/process/child_process.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <chrono>
 #include <csignal>

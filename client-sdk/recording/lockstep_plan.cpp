@@ -1,4 +1,4 @@
-#include "viscera/recording/lockstep_plan.hpp"
+#include "viscera/recording/lockstep_plan.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <tuple>

@@ -1,4 +1,4 @@
-#include "viscera/recording/payload_verification.hpp"
+#include "viscera/recording/payload_verification.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/protocol/streams.hpp"
 

@@ -1,4 +1,4 @@
-#include "viscera/recording/playback_clock.hpp"
+#include "viscera/recording/playback_clock.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <stdexcept>

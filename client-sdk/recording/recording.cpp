@@ -1,4 +1,4 @@
-#include "viscera/recording/recording.hpp"
+#include "viscera/recording/recording.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <future>

@@ -1,4 +1,4 @@
-#include "viscera/recording/recording_tables.hpp"
+#include "viscera/recording/recording_tables.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "viscera/recording/recording_writer.hpp"
+#include "viscera/recording/recording_writer.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <filesystem>
 

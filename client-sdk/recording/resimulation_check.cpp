@@ -1,4 +1,4 @@
-#include "viscera/recording/resimulation_check.hpp"
+#include "viscera/recording/resimulation_check.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <bit>
 #include <cstdint>

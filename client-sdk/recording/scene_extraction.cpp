@@ -1,4 +1,4 @@
-#include "viscera/recording/scene_extraction.hpp"
+#include "viscera/recording/scene_extraction.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <filesystem>

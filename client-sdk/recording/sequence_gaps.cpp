@@ -1,4 +1,4 @@
-#include "viscera/recording/sequence_gaps.hpp"
+#include "viscera/recording/sequence_gaps.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::recording {
 

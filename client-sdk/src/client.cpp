@@ -1,4 +1,4 @@
-#include "viscera/client/client.hpp"
+#include "viscera/client/client.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <atomic>

@@ -1,4 +1,4 @@
-#include "viscera/client/device_loop.hpp"
+#include "viscera/client/device_loop.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <chrono>

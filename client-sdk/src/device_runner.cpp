@@ -1,4 +1,4 @@
-#include "viscera/client/device_runner.hpp"
+#include "viscera/client/device_runner.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "viscera/client/force_slew_limit.hpp"
+#include "viscera/client/force_slew_limit.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/client/local_force_model.hpp"
+#include "viscera/client/local_force_model.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/client/lockstep_driver.hpp"
+#include "viscera/client/lockstep_driver.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <deque>
 #include <thread>

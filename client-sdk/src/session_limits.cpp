@@ -1,4 +1,4 @@
-#include "viscera/client/session_limits.hpp"
+#include "viscera/client/session_limits.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "viscera/client/stream_tap.hpp"
+#include "viscera/client/stream_tap.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <map>

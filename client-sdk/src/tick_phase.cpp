@@ -1,4 +1,4 @@
-#include "viscera/client/tick_phase.hpp"
+#include "viscera/client/tick_phase.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include <cmath>
+#include <cmath>  // SPDX-License-Identifier: Apache-2.0
 #include <utility>
 
 #include "viscera/common/input_error.hpp"

@@ -1,4 +1,4 @@
-#include "viscera/training/exercise_scorer.hpp"
+#include "viscera/training/exercise_scorer.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

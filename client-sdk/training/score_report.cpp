@@ -1,4 +1,4 @@
-#include "viscera/training/score_report.hpp"
+#include "viscera/training/score_report.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cstdio>
 

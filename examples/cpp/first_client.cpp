@@ -1,4 +1,4 @@
-// A first haptic client: claims probe 1, presses it 2 cm into the organ from above at 1 kHz, prints the force.
+// A first haptic client: claims probe 1, presses it 2 cm into the organ at 1 kHz, prints the force.  // SPDX-License-Identifier: Apache-2.0
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>

@@ -1,4 +1,4 @@
-#include "viscera/protocol/binary_schemas.hpp"
+#include "viscera/protocol/binary_schemas.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <array>

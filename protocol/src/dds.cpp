@@ -1,4 +1,4 @@
-#include "viscera/protocol/dds.hpp"
+#include "viscera/protocol/dds.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-// The names of the protocol's enumerations, as logs, events and the console show them.
+// The names of the protocol's enumerations, as logs, events and the console show them.  // SPDX-License-Identifier: Apache-2.0
 #include "viscera/protocol/messages.hpp"
 
 namespace viscera::protocol {

@@ -1,4 +1,4 @@
-#include "viscera/protocol/request_json.hpp"
+#include "viscera/protocol/request_json.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::protocol {
 

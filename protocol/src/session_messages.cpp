@@ -1,4 +1,4 @@
-// Encoding and verified decoding of the messages added with lockstep and recording (schema 7):
+// Encoding and verified decoding of the messages added with lockstep and recording (schema 7):  // SPDX-License-Identifier: Apache-2.0
 // the files a scene was built from, and the lockstep step and result.
 #include <cstdio>
 

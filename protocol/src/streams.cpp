@@ -1,4 +1,4 @@
-#include "viscera/protocol/streams.hpp"
+#include "viscera/protocol/streams.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/protocol/typed_reader.hpp"
 

@@ -1,4 +1,4 @@
-#include "viscera/protocol/surface_assembler.hpp"
+#include "viscera/protocol/surface_assembler.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <stdexcept>
 #include <string>

@@ -1,4 +1,4 @@
-// Encoding and verified decoding of the organ's surface on the wire: its topology, whole or as a
+// Encoding and verified decoding of the organ's surface on the wire: its topology, whole or as a  // SPDX-License-Identifier: Apache-2.0
 // patch of the one before (schema 16), and its frames.
 #include <cmath>
 

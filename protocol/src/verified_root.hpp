@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The one check every received payload passes before it is read: the FlatBuffers verifier, with
 // bounds on depth and table count, and the schema's file identifier.
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include <algorithm>
+#include <algorithm>  // SPDX-License-Identifier: Apache-2.0
 #include <cctype>
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscera/common/command_line.hpp"
+#include "viscera/common/command_line.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

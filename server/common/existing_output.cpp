@@ -1,4 +1,4 @@
-#include "viscera/common/existing_output.hpp"
+#include "viscera/common/existing_output.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <filesystem>
 #include <system_error>

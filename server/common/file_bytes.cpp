@@ -1,4 +1,4 @@
-#include "viscera/common/file_bytes.hpp"
+#include "viscera/common/file_bytes.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cerrno>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "viscera/common/input_error.hpp"
+#include "viscera/common/input_error.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cstdio>
 

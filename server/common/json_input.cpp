@@ -1,4 +1,4 @@
-#include "viscera/common/json_input.hpp"
+#include "viscera/common/json_input.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cerrno>

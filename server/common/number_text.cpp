@@ -1,4 +1,4 @@
-#include "viscera/common/number_text.hpp"
+#include "viscera/common/number_text.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <charconv>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/common/program_log.hpp"
+#include "viscera/common/program_log.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cerrno>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "viscera/common/same_file.hpp"
+#include "viscera/common/same_file.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <sys/stat.h>
 

@@ -1,4 +1,4 @@
-#include "viscera/lab/adequacy.hpp"
+#include "viscera/lab/adequacy.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/lab/analysis.hpp"
+#include "viscera/lab/analysis.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <chrono>

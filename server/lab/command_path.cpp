@@ -1,4 +1,4 @@
-#include "viscera/lab/command_path.hpp"
+#include "viscera/lab/command_path.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/lab/dataset.hpp"
+#include "viscera/lab/dataset.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <charconv>

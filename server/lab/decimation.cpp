@@ -1,4 +1,4 @@
-#include "viscera/lab/decimation.hpp"
+#include "viscera/lab/decimation.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

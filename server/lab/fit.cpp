@@ -1,4 +1,4 @@
-#include "viscera/lab/fit.hpp"
+#include "viscera/lab/fit.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <limits>

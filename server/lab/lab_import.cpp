@@ -1,4 +1,4 @@
-#include "viscera/lab/lab_import.hpp"
+#include "viscera/lab/lab_import.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <filesystem>

@@ -1,4 +1,4 @@
-#include "viscera/lab/material_export.hpp"
+#include "viscera/lab/material_export.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cstdio>
 #include <numbers>

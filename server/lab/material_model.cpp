@@ -1,4 +1,4 @@
-#include "viscera/lab/material_model.hpp"
+#include "viscera/lab/material_model.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/lab/model_file.hpp"
+#include "viscera/lab/model_file.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <fstream>
 

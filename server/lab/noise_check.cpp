@@ -1,4 +1,4 @@
-#include "viscera/lab/noise_check.hpp"
+#include "viscera/lab/noise_check.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

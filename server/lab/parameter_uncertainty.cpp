@@ -1,4 +1,4 @@
-#include "viscera/lab/parameter_uncertainty.hpp"
+#include "viscera/lab/parameter_uncertainty.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/lab/report_json.hpp"
+#include "viscera/lab/report_json.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/lab/specimen_check.hpp"
+#include "viscera/lab/specimen_check.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

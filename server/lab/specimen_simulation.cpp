@@ -1,4 +1,4 @@
-#include "viscera/lab/specimen_simulation.hpp"
+#include "viscera/lab/specimen_simulation.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "viscera/lab/stress_controlled.hpp"
+#include "viscera/lab/stress_controlled.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

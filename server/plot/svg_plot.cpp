@@ -1,4 +1,4 @@
-#include "viscera/plot/svg_plot.hpp"
+#include "viscera/plot/svg_plot.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/runtime/client_binding.hpp"
+#include "viscera/runtime/client_binding.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <iterator>
 

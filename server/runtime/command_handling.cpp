@@ -1,4 +1,4 @@
-// The commands of the simulation server: answered at once on the command thread, or in lockstep
+// The commands of the simulation server: answered at once on the command thread, or in lockstep  // SPDX-License-Identifier: Apache-2.0
 // from a recording's steps.
 #include "simulation_server_impl.hpp"
 

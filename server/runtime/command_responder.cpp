@@ -1,4 +1,4 @@
-#include "viscera/runtime/command_responder.hpp"
+#include "viscera/runtime/command_responder.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

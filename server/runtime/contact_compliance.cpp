@@ -1,4 +1,4 @@
-#include "viscera/runtime/contact_compliance.hpp"
+#include "viscera/runtime/contact_compliance.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <pthread.h>
 

@@ -1,4 +1,4 @@
-#include "viscera/runtime/server_endpoints.hpp"
+#include "viscera/runtime/server_endpoints.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::runtime {
 

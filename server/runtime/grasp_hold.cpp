@@ -1,4 +1,4 @@
-#include "viscera/runtime/grasp_hold.hpp"
+#include "viscera/runtime/grasp_hold.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::runtime {
 

@@ -1,4 +1,4 @@
-#include "viscera/runtime/instrument_table.hpp"
+#include "viscera/runtime/instrument_table.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::runtime {
 

@@ -1,4 +1,4 @@
-#include "viscera/runtime/material_regions.hpp"
+#include "viscera/runtime/material_regions.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

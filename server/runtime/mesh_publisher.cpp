@@ -1,4 +1,4 @@
-#include "viscera/runtime/mesh_publisher.hpp"
+#include "viscera/runtime/mesh_publisher.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <pthread.h>
 

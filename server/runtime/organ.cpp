@@ -1,4 +1,4 @@
-#include "viscera/runtime/organ.hpp"
+#include "viscera/runtime/organ.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <array>

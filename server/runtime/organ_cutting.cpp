@@ -1,4 +1,4 @@
-#include "viscera/runtime/organ_cutting.hpp"
+#include "viscera/runtime/organ_cutting.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "viscera/runtime/parallel_forces.hpp"
+#include "viscera/runtime/parallel_forces.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <chrono>

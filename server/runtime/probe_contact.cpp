@@ -1,4 +1,4 @@
-#include "viscera/runtime/probe_contact.hpp"
+#include "viscera/runtime/probe_contact.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// The server's scalpels (docs/CUTTING.md, "In the server"): after each step, a scalpel that cuts
+// The server's scalpels (docs/CUTTING.md, "In the server"): after each step, a scalpel that cuts  // SPDX-License-Identifier: Apache-2.0
 // sweeps its blade from where the last tick left it to where this one does, and the organ follows
 // the cut (organ_cutting.hpp). Physics thread, between the step and the snapshot.
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "viscera/runtime/scene_file.hpp"
+#include "viscera/runtime/scene_file.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// What the simulation server publishes: the scene state, the scene files, events, the snapshot the
+// What the simulation server publishes: the scene state, the scene files, events, the snapshot the  // SPDX-License-Identifier: Apache-2.0
 // command thread answers from, and forces.
 #include "viscera/runtime/build_info.hpp"
 

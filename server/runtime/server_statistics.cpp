@@ -1,4 +1,4 @@
-#include "viscera/runtime/server_statistics.hpp"
+#include "viscera/runtime/server_statistics.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "viscera/runtime/session_control.hpp"
+#include "viscera/runtime/session_control.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <atomic>
 #include <chrono>

@@ -1,4 +1,4 @@
-// Session requests the simulation server's physics thread takes between ticks: claims and
+// Session requests the simulation server's physics thread takes between ticks: claims and  // SPDX-License-Identifier: Apache-2.0
 // releases, pause, resume and reset, scenes, materials and rates built in the background, take
 // over and hand back, and the lease on silent owners.
 #include <chrono>

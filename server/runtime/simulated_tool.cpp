@@ -1,4 +1,4 @@
-#include "viscera/runtime/simulated_tool.hpp"
+#include "viscera/runtime/simulated_tool.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::runtime {
 

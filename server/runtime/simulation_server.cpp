@@ -1,4 +1,4 @@
-// The simulation server's organ and its tick, and the two loops that run it: at a fixed rate on
+// The simulation server's organ and its tick, and the two loops that run it: at a fixed rate on  // SPDX-License-Identifier: Apache-2.0
 // the wall clock with a command thread beside it (run), or step by step from a lockstep driver
 // (run_lockstep). What it publishes, the commands and the session requests are in files of their
 // own (simulation_server_impl.hpp).

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The simulation server's state and the work of its threads (private to server/runtime): the
 // organ and the tick (simulation_server.cpp), what the server publishes (server_publishing.cpp),
 // the commands the command thread answers (command_handling.cpp), and the session requests the

@@ -1,4 +1,4 @@
-#include "viscera/runtime/surface_exit.hpp"
+#include "viscera/runtime/surface_exit.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <limits>

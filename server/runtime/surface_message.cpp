@@ -1,4 +1,4 @@
-#include "viscera/runtime/surface_message.hpp"
+#include "viscera/runtime/surface_message.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <unordered_map>
 

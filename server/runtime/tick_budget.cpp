@@ -1,4 +1,4 @@
-#include "viscera/runtime/tick_budget.hpp"
+#include "viscera/runtime/tick_budget.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "viscera/runtime/tip_strain_window.hpp"
+#include "viscera/runtime/tip_strain_window.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

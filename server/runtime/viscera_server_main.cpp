@@ -1,4 +1,4 @@
-// viscera-server: owns the organ and its solver and serves instruments over DDS.
+// viscera-server: owns the organ and its solver and serves instruments over DDS.  // SPDX-License-Identifier: Apache-2.0
 #include <atomic>
 #include <csignal>
 #include <cstdio>

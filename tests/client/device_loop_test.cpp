@@ -1,4 +1,4 @@
-// The device loop's states (client-sdk/device_loop.hpp) driven by invented times, server states and
+// The device loop's states (client-sdk/device_loop.hpp) driven by invented times, server states and  // SPDX-License-Identifier: Apache-2.0
 // scene states, without a network: each way of losing the server or the instrument fades the
 // force the hand feels over the fade time (LocalForceRenderer's gain, checked against the time
 // the fade should take), and each way back drives again.

@@ -1,4 +1,4 @@
-// The slew limit on the force a device renders (client-sdk/force_slew_limit.hpp) against its
+// The slew limit on the force a device renders (client-sdk/force_slew_limit.hpp) against its  // SPDX-License-Identifier: Apache-2.0
 // definition: no change per period larger than the rate times one period, along the change, and
 // nothing changed where the force moves slower than that.
 #include "viscera/client/force_slew_limit.hpp"

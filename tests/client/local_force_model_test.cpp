@@ -1,4 +1,4 @@
-// The local force model against its definition: linear in the displacement, push-only, clamped.
+// The local force model against its definition: linear in the displacement, push-only, clamped.  // SPDX-License-Identifier: Apache-2.0
 #include "viscera/client/local_force_model.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The palpating search (tools/haptic-client/palpating_device.hpp) against a simple organ it was not
+// The palpating search (tools/haptic-client/palpating_device.hpp) against a simple organ it was not  // SPDX-License-Identifier: Apache-2.0
 // built on: a flat-topped slab whose indentation stiffness is k0 everywhere and (1 + A) k0 over a
 // hidden lump, falling off as a Gaussian of the distance from it (a lump felt through the tissue
 // above it), plus a slow trend across the organ (thicker on one side). The device is driven at

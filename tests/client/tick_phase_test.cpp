@@ -1,4 +1,4 @@
-// The client's phase lock to the server's physics ticks (client-sdk tick_phase.hpp), against a
+// The client's phase lock to the server's physics ticks (client-sdk tick_phase.hpp), against a  // SPDX-License-Identifier: Apache-2.0
 // simulated server: ticks at a fixed rate whose ends jitter, seen by a loop that starts at any phase.
 #include "viscera/client/tick_phase.hpp"
 

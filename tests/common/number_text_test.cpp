@@ -1,4 +1,4 @@
-// Numbers read from text, and the one wording of a bad one (server/common/number_text).
+// Numbers read from text, and the one wording of a bad one (server/common/number_text).  // SPDX-License-Identifier: Apache-2.0
 #include "viscera/common/number_text.hpp"
 
 #include <limits>

@@ -1,4 +1,4 @@
-// The programs' log (server/common/program_log): where each level goes, the line's form, the file
+// The programs' log (server/common/program_log): where each level goes, the line's form, the file  // SPDX-License-Identifier: Apache-2.0
 // appended to and never an input.
 #include "viscera/common/program_log.hpp"
 

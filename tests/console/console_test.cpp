@@ -1,4 +1,4 @@
-// The console bridge's parts that need no network: the token, browser requests, the outbox of a
+// The console bridge's parts that need no network: the token, browser requests, the outbox of a  // SPDX-License-Identifier: Apache-2.0
 // browser, the rate limit, the force decimation and the binary wire format, each against what it
 // must do by definition (an independent brute-force reference where there is one).
 #include <cmath>

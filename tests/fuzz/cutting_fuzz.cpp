@@ -1,4 +1,4 @@
-// libFuzzer target for cutting (docs/CUTTING.md): the bytes are a sequence of blade sweeps through
+// libFuzzer target for cutting (docs/CUTTING.md): the bytes are a sequence of blade sweeps through  // SPDX-License-Identifier: Apache-2.0
 // a 4 x 3 x 3 cm box of 216 tetrahedra. Blade ends are quantised to a quarter of the mesh spacing,
 // so sweeps go exactly through nodes, along edges and in the planes of faces, where a cutter's
 // arithmetic is weakest. After every sweep: the mesh is valid (positive volumes, no degenerate or

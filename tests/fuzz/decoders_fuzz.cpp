@@ -1,4 +1,4 @@
-// libFuzzer target for every message decoder: arbitrary bytes must be rejected or decoded, never
+// libFuzzer target for every message decoder: arbitrary bytes must be rejected or decoded, never  // SPDX-License-Identifier: Apache-2.0
 // crash, hang or read out of bounds (built with ASan + UBSan by tests/fuzz/run_fuzz.sh).
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Writes small, valid MCAP files into a directory, the seeds from which readers_fuzz mutates
+// Writes small, valid MCAP files into a directory, the seeds from which readers_fuzz mutates  // SPDX-License-Identifier: Apache-2.0
 // session recordings: each compression (zstd, lz4, none), several chunks, two channels, an
 // attachment and metadata, and one file cut short in its data section as a crash leaves it.
 // Usage: mcap_seeds DIR

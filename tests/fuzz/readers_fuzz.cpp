@@ -1,4 +1,4 @@
-// libFuzzer target for every reader of a file a user edits or hands over: scene, material,
+// libFuzzer target for every reader of a file a user edits or hands over: scene, material,  // SPDX-License-Identifier: Apache-2.0
 // data set (its dataset.json and its CSV), fitted model, the Gmsh, legacy VTK and VTU mesh
 // readers, the MCAP reader of session recordings (with the integrity judgement and recover) and the
 // trainer's exercise files; JSON nested past the bound (seeded 100,000 deep); and the rule for names

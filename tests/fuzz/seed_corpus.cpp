@@ -1,4 +1,4 @@
-// Writes one valid payload of every message (and of every session action) into a directory, the
+// Writes one valid payload of every message (and of every session action) into a directory, the  // SPDX-License-Identifier: Apache-2.0
 // fuzzer's seed corpus: mutating valid FlatBuffers reaches the range and finiteness checks behind
 // the Verifier, which random bytes seldom pass. Each seed must decode as its own type, or this fails.
 // Usage: seed_corpus DIR

@@ -1,4 +1,4 @@
-// Writes hostile payloads on the command and session topics: garbage, truncated commands,
+// Writes hostile payloads on the command and session topics: garbage, truncated commands,  // SPDX-License-Identifier: Apache-2.0
 // another schema, NaN positions, commands for an instrument the sender does not own, and commands
 // and releases for an instrument the scene does not have.
 // Usage: hostile_publisher DOMAIN SECONDS [--station NAME]

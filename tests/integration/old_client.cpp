@@ -1,4 +1,4 @@
-// A client compiled against schema 1 (tests/protocol/schema_v1), before ForceFeedback gained a
+// A client compiled against schema 1 (tests/protocol/schema_v1), before ForceFeedback gained a  // SPDX-License-Identifier: Apache-2.0
 // field: it must still claim an instrument of today's server, press the liver and feel it. It
 // uses only the schema-1 generated code and the DDS wrapper, as a client in the field would.
 // Usage: old_client DOMAIN CLIENT_ID INSTRUMENT SECONDS. Exit 0 when it received forces that

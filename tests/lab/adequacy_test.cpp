@@ -1,4 +1,4 @@
-// Whether the lab's final model explains the data (issue 36): the residual judged against the
+// Whether the lab's final model explains the data (issue 36): the residual judged against the  // SPDX-License-Identifier: Apache-2.0
 // noise, and the parameters' uncertainties.
 // - On data written here in closed form (a Kelvin-Voigt solid, E = 10 kPa, eta = 200 Pa s,
 //   ramp-and-hold tests with white noise of known SD): with the true model the residual is the

@@ -1,4 +1,4 @@
-// The baseline must reproduce its own family (issue 23): on data whose truth is linear
+// The baseline must reproduce its own family (issue 23): on data whose truth is linear  // SPDX-License-Identifier: Apache-2.0
 // Kelvin-Voigt, generated in closed form outside the lab with the protocols of a tissue lab, the
 // baseline's held-out error on every test is within 1.5x the noise of that test's measured
 // quantity (stress under strain control, strain under stress control).

@@ -1,4 +1,4 @@
-// Data-set reading: the real titin data, and every kind of bad input named by file, line, field.
+// Data-set reading: the real titin data, and every kind of bad input named by file, line, field.  // SPDX-License-Identifier: Apache-2.0
 #include <chrono>
 #include <cmath>
 #include <cstdio>

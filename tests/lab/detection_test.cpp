@@ -1,4 +1,4 @@
-// viscera-lab must find the effect hidden in synthetic data (or none), seeing only the folder.
+// viscera-lab must find the effect hidden in synthetic data (or none), seeing only the folder.  // SPDX-License-Identifier: Apache-2.0
 #include <cmath>
 #include <filesystem>
 #include <map>

@@ -1,4 +1,4 @@
-// viscera-lab on data it has never seen (issue 23): data sets from lab_protocols.hpp, whose
+// viscera-lab on data it has never seen (issue 23): data sets from lab_protocols.hpp, whose  // SPDX-License-Identifier: Apache-2.0
 // truths, protocols and forms were written outside the lab (linear damping on the strain rate;
 // symmetric polynomial stiffening, softening that recovers at rest and power-law relaxation
 // outside the lab's forms; creep-recovery under stress control; non-uniform sampling; no noise

@@ -1,4 +1,4 @@
-// From the data set to the organ (issue 36): the material file viscera-lab writes, read by the
+// From the data set to the organ (issue 36): the material file viscera-lab writes, read by the  // SPDX-License-Identifier: Apache-2.0
 // server's own material reader (tissue::read_material_file, tissue::make_viscoelastic, as an organ
 // is built), runs on the specimen (a block of the same material driven by the data set's
 // protocols) and must reproduce the lab's fitted law within 5% of the data's range on every test:

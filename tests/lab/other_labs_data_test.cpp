@@ -1,4 +1,4 @@
-// The lab on data shaped like other laboratories' (issue 38): the verdict stands on the honest
+// The lab on data shaped like other laboratories' (issue 38): the verdict stands on the honest  // SPDX-License-Identifier: Apache-2.0
 // gain, the noise is checked by a second path and survives quantised forces, and a specimen run
 // that cannot finish stops and says where. The data here come from a generator of their own (not the lab's synthetic one): a standard linear solid (a
 // spring beside one Maxwell arm, relaxation time 20 s) stretched in four ramp-and-hold tests to

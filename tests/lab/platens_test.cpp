@@ -1,4 +1,4 @@
-// The lab between platens (issue 38): a specimen compressed between plates it is not bonded to.
+// The lab between platens (issue 38): a specimen compressed between plates it is not bonded to.  // SPDX-License-Identifier: Apache-2.0
 // The platens close a gap before they load it (a toe) and cannot pull (contact is lost where the
 // tissue recovers slower than they retreat). The data come from a generator of their own, built on
 // neither of the lab's forms: a rough face whose gaps spread over a range, columns that recover

@@ -1,4 +1,4 @@
-// The MCAP writer and reader against the specification's own check values and against each
+// The MCAP writer and reader against the specification's own check values and against each  // SPDX-License-Identifier: Apache-2.0
 // other's independent halves: what is written is read back whole (every message, in order, on its
 // channel), chunk by chunk through the summary's index as through the data section; a file cut at
 // any byte gives exactly the messages of its complete chunks, and recover() makes it whole; a

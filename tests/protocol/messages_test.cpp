@@ -1,4 +1,4 @@
-// Every decoder against good, truncated, garbage, wrong-schema and out-of-range payloads.
+// Every decoder against good, truncated, garbage, wrong-schema and out-of-range payloads.  // SPDX-License-Identifier: Apache-2.0
 #include "viscera/protocol/messages.hpp"
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Schema evolution: a field added at the end of a table (ForceFeedback.penetration_m, schema 2)
+// Schema evolution: a field added at the end of a table (ForceFeedback.penetration_m, schema 2)  // SPDX-License-Identifier: Apache-2.0
 // must not break clients compiled against schema 1, and messages of schema-1 writers must still
 // decode. Schema 1 is the frozen copy in tests/protocol/schema_v1 (namespace viscera::wire_v1).
 #include <gtest/gtest.h>

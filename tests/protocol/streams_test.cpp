@@ -1,4 +1,4 @@
-// The table of streams (protocol/streams.hpp) against what the rest of the protocol says of each
+// The table of streams (protocol/streams.hpp) against what the rest of the protocol says of each  // SPDX-License-Identifier: Apache-2.0
 // stream: its topic and name, its binary schema, its decoder; and the typed reader over a real
 // DDS domain in this process, which hands over what decodes and counts, with a reason, what does not.
 #include "viscera/protocol/streams.hpp"

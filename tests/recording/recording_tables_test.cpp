@@ -1,4 +1,4 @@
-// A recording's streams as tables (recording_tables.hpp) without a network: a file written by the
+// A recording's streams as tables (recording_tables.hpp) without a network: a file written by the  // SPDX-License-Identifier: Apache-2.0
 // recorder's writer from messages made here, read back; every column holds what was sent, in
 // log-time order, named with its unit; a payload that does not decode is counted, not tabulated;
 // frames of one mesh are one array, a frame of another size is dropped and counted.

@@ -1,4 +1,4 @@
-// Session recordings without a network: the writer's file read back by the reader and checked
+// Session recordings without a network: the writer's file read back by the reader and checked  // SPDX-License-Identifier: Apache-2.0
 // against the FlatBuffers reflection of the schemas it carries (an independent decoder), drops
 // counted from sequence numbers, the replay clock on made-up time, the lockstep plan and the
 // re-simulation check on a synthetic session whose inputs and ticks are known by construction.

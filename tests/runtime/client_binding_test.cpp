@@ -1,4 +1,4 @@
-// A client id belongs to the DDS participant that uses it while that participant keeps talking
+// A client id belongs to the DDS participant that uses it while that participant keeps talking  // SPDX-License-Identifier: Apache-2.0
 // (and, under DDS Security, to its certificate): on a made-up clock (ClientBinding), and through
 // the whole server in one process, where a second participant reusing a client's id can neither
 // steer nor release that client's instrument until the holder has been silent for the lease.

@@ -1,4 +1,4 @@
-// The grasper's hold against closed form: a ring of held nodes resists a twist of the tool with
+// The grasper's hold against closed form: a ring of held nodes resists a twist of the tool with  // SPDX-License-Identifier: Apache-2.0
 // torque -k N r^2 sin(theta) and no net force; a lift off-centre gives force -k d and the moment
 // of that force about the tip; only the nodes within the grasp radius are held; the forces on the
 // tissue are the opposite of the tool's; during a step each spring acts at the extension the step

@@ -1,4 +1,4 @@
-// Instrument ownership without DDS, on a made-up clock: claims, releases, commands in order, the
+// Instrument ownership without DDS, on a made-up clock: claims, releases, commands in order, the  // SPDX-License-Identifier: Apache-2.0
 // lease that takes an instrument from a silent owner, and the hand-over between two clients.
 #include "viscera/runtime/instrument_table.hpp"
 

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The lockstep harness of the lockstep tests: one SimulationServer in lockstep in this process, its
 // endpoints in memory, driven through a script of steps on the bundled liver scene.
 #include <atomic>

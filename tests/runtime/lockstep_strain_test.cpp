@@ -1,4 +1,4 @@
-// The tissue's strain that every force carries, from a lockstep server in this process: the organ's
+// The tissue's strain that every force carries, from a lockstep server in this process: the organ's  // SPDX-License-Identifier: Apache-2.0
 // largest edge strain of the force's tick, and the strain at the instrument (Force.tip_strain),
 // which stays as the mesh is refined where the largest edge strain grows.
 #include <cmath>

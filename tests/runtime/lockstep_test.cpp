@@ -1,4 +1,4 @@
-// Lockstep (SimulationServer::run_lockstep): the same steps give the same bits, run after run and
+// Lockstep (SimulationServer::run_lockstep): the same steps give the same bits, run after run and  // SPDX-License-Identifier: Apache-2.0
 // on one physics thread or two; a change of one command by a micrometre shows (the comparison can
 // fail); and the steps do what they say: the claim, the press, the material change and the pause
 // take effect at the ticks named, with the recording's clock. The whole server in one process,

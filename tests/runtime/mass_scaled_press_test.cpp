@@ -1,4 +1,4 @@
-// Selective mass scaling and contact damping on the liver scenes, pressed 3 cm by a probe and held
+// Selective mass scaling and contact damping on the liver scenes, pressed 3 cm by a probe and held  // SPDX-License-Identifier: Apache-2.0
 // (no DDS: the scene's organ, the probe contact and 1 ms ticks, as the server steps them). With 5%
 // added mass the 12k liver stays stable and the held force is the unscaled organ's (mass does not
 // enter statics; the two differ only by the inertia of the added mass), and a probe resting on the

@@ -1,4 +1,4 @@
-// Material regions: laid out on the mesh as stated, calibrated per element (a two-material bar in
+// Material regions: laid out on the mesh as stated, calibrated per element (a two-material bar in  // SPDX-License-Identifier: Apache-2.0
 // series against its closed form; a region over the whole organ against the organ made of the
 // region's material), drawn centres that keep their promises (checked by point location in the
 // mesh, not by the code that drew them), and scene-file errors that name the field.

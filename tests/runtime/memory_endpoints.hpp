@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The server's endpoints in memory instead of DDS, for tests of the whole server in one process:
 // the test pushes commands, requests and lockstep steps; the server's writes are kept.
 #include <atomic>

@@ -1,4 +1,4 @@
-// The surface on its way out (mesh_publisher.hpp): after cuts the publisher sends patches only,
+// The surface on its way out (mesh_publisher.hpp): after cuts the publisher sends patches only,  // SPDX-License-Identifier: Apache-2.0
 // and the whole surface when a reader joins, so that a reader whose history holds nothing but
 // patches still assembles the surface; checked by the readers' assembler on what was written.
 #include "viscera/runtime/mesh_publisher.hpp"

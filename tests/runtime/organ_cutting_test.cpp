@@ -1,4 +1,4 @@
-// A scalpel's cut through the server's organ (organ_cutting.hpp): the bundled liver scene cut by a
+// A scalpel's cut through the server's organ (organ_cutting.hpp): the bundled liver scene cut by a  // SPDX-License-Identifier: Apache-2.0
 // blade drawn through its top, as the server does it tick by tick. Checked against conservation
 // (rest volume, mass), the boundary extracted from the whole cut mesh, and rest: an organ cut at
 // rest has the cut mesh as its rest shape, so it stays where it is, on the scene's own integrator.

@@ -1,4 +1,4 @@
-// Forces on several threads against the one-thread evaluation (an independent path through the
+// Forces on several threads against the one-thread evaluation (an independent path through the  // SPDX-License-Identifier: Apache-2.0
 // same model): equal to rounding, memory variables advanced the same, deterministic bit for bit
 // whatever the threads' timing, instability (NaN) still reported, and models that do not split
 // (corotational FE) still whole. An explicit run on two threads follows the one-thread run.

@@ -1,4 +1,4 @@
-// Probe contact against closed form on a flat, finely triangulated plate: one spring k at the
+// Probe contact against closed form on a flat, finely triangulated plate: one spring k at the  // SPDX-License-Identifier: Apache-2.0
 // deepest penetration whatever the number of triangles under the tip, pushing out along the
 // normal even when the tip centre has passed below the surface (no tunnelling), nothing out of
 // reach, and the broad phase still finds the contact on a plate stretched well beyond rest.

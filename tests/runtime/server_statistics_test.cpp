@@ -1,4 +1,4 @@
-// The server's figures against their definitions: the rate is ticks per window, the percentiles
+// The server's figures against their definitions: the rate is ticks per window, the percentiles  // SPDX-License-Identifier: Apache-2.0
 // are the sorted samples' elements at rank floor(p (n - 1)), and the telemetry and status line
 // carry the counts as they are.
 #include "viscera/runtime/server_statistics.hpp"

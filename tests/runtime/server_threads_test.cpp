@@ -1,4 +1,4 @@
-// The whole server in one process, its endpoints in memory instead of DDS: the physics thread, the
+// The whole server in one process, its endpoints in memory instead of DDS: the physics thread, the  // SPDX-License-Identifier: Apache-2.0
 // command thread answering every command from the newest snapshot, and session control building a
 // new material in the background, all at once while a client presses. Run under ThreadSanitizer
 // by deploy/test.sh (the snapshot hand-over, the instrument table, the run-time control), and

@@ -1,4 +1,4 @@
-// Session control without organs or DDS: builders that the test controls stand in for the organ's
+// Session control without organs or DDS: builders that the test controls stand in for the organ's  // SPDX-License-Identifier: Apache-2.0
 // (a promise each), so the outcomes, the one-at-a-time rule, failures and the never-waiting stop
 // are checked directly.
 #include "viscera/runtime/session_control.hpp"

@@ -1,4 +1,4 @@
-// The simulated tool against its definition: it follows the command at most at the speed limit,
+// The simulated tool against its definition: it follows the command at most at the speed limit,  // SPDX-License-Identifier: Apache-2.0
 // a grasper grasps below 0.1 rad and lets go above 0.2 rad (not between), and a contact ends only
 // after 50 ms of simulated time without touching.
 #include "viscera/runtime/simulated_tool.hpp"

@@ -1,4 +1,4 @@
-// The way out of an organ at any depth (server/runtime/surface_exit.hpp) against the closed form of
+// The way out of an organ at any depth (server/runtime/surface_exit.hpp) against the closed form of  // SPDX-License-Identifier: Apache-2.0
 // a box: inside exactly where the box is; a ray from inside crosses the face the geometry says, at
 // its distance, and a tip that leaves along it ends one radius beyond that face, even where another
 // face is nearer; the contact found from inside pushes along the crossed face's normal with the

@@ -1,4 +1,4 @@
-// The surface on the wire after cuts (surface_message.hpp, schema 16): the liver scene cut by a
+// The surface on the wire after cuts (surface_message.hpp, schema 16): the liver scene cut by a  // SPDX-License-Identifier: Apache-2.0
 // blade as the server cuts it, and after every change of its boundary the patch against what a
 // reader holds, applied by the readers' assembler (protocol/surface_assembler.hpp, another code
 // path), must give the whole surface the server would have sent, bit for bit; and the patches'

@@ -1,4 +1,4 @@
-// What a tick may cost, against the explicit step's closed form: the stable step of a linear
+// What a tick may cost, against the explicit step's closed form: the stable step of a linear  // SPDX-License-Identifier: Apache-2.0
 // material scales as sqrt(density / E), a tick of 1/rate takes ceil(1 / (rate dt)) sub-steps, and a
 // scene or material whose tick needs more than the budget allows is refused before it runs, with
 // the step, the sub-steps and the limit in the message.

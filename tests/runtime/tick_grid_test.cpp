@@ -1,4 +1,4 @@
-// The physics loop's schedule against what a fixed 1 kHz grid means, worked out by hand for each
+// The physics loop's schedule against what a fixed 1 kHz grid means, worked out by hand for each  // SPDX-License-Identifier: Apache-2.0
 // case, and over long runs of made-up tick costs against the grid's two invariants: no tick starts
 // before its slot (no bursts), and every slot that has ended holds a tick or is counted missed.
 #include "viscera/runtime/tick_grid.hpp"

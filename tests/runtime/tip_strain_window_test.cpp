@@ -1,4 +1,4 @@
-// The strain at an instrument spread over a window of ticks (runtime/tip_strain_window.hpp), against
+// The strain at an instrument spread over a window of ticks (runtime/tip_strain_window.hpp), against  // SPDX-License-Identifier: Apache-2.0
 // the whole ball's average computed at once (tissue::BallStrain::at): on positions that do not
 // change, the window's strain is the ball's; it holds between windows, fixes its ball where the
 // window began, and says 0 out of contact.

@@ -1,4 +1,4 @@
-// A tool that appears inside the tissue (claimed there, or held there while the organ is reset to
+// A tool that appears inside the tissue (claimed there, or held there while the organ is reset to  // SPDX-License-Identifier: Apache-2.0
 // rest) must not strike it with the contact's whole force in one step. The reference is another
 // path to the same pose: the same probe pressed in from above the organ at the scene's speed
 // limit, 0.5 m/s, the speed at which a withdrawn tool enters (the held force depends on the entry

@@ -1,4 +1,4 @@
-// The tissue's strain averaged over a ball (tissue/element/ball_strain.hpp), against closed forms:
+// The tissue's strain averaged over a ball (tissue/element/ball_strain.hpp), against closed forms:  // SPDX-License-Identifier: Apache-2.0
 // a uniform deformation, whose strain every mesh must give exactly; the ball's elements against a
 // search over all of them; a smooth local dent against the ball average of its analytic strain,
 // computed by quadrature, on three meshes of a box.

@@ -1,4 +1,4 @@
-// A beam in pure bending against its exact 3D elasticity solution, converging under refinement.
+// A beam in pure bending against its exact 3D elasticity solution, converging under refinement.  // SPDX-License-Identifier: Apache-2.0
 // Beam along z, bending about y with curvature kappa: sigma_zz = E kappa x, all other stresses
 // zero, and (Saint-Venant) u_x = -kappa (z^2 + nu (x^2 - y^2)) / 2, u_y = -kappa nu x y,
 // u_z = kappa x z, exact on any prismatic section with a traction-free lateral surface. Both end

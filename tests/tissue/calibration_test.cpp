@@ -1,4 +1,4 @@
-// The GPS equals linear FE at small strain (docs/MODEL.md section 1), and the paper's calibration
+// The GPS equals linear FE at small strain (docs/MODEL.md section 1), and the paper's calibration  // SPDX-License-Identifier: Apache-2.0
 // route agrees with the pseudo-inverse route.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Free flight and free vibration: momentum is conserved exactly by central edge forces under
+// Free flight and free vibration: momentum is conserved exactly by central edge forces under  // SPDX-License-Identifier: Apache-2.0
 // symplectic Euler; the energy-consistent GPS conserves energy, the paper form does not.
 #include <gtest/gtest.h>
 

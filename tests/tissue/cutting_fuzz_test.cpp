@@ -1,4 +1,4 @@
-// Random strokes through the liver (docs/CUTTING.md, "Tests"): after every sweep the mesh is
+// Random strokes through the liver (docs/CUTTING.md, "Tests"): after every sweep the mesh is  // SPDX-License-Identifier: Apache-2.0
 // valid and conforming, volume and mass are kept, and the boundary surface brought along the cut
 // in place is the one extracted from the whole cut mesh; each cut organ then runs on both
 // integrators.

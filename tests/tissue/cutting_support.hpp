@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What the cutting tests check on a cut mesh (cutting_test.cpp, cutting_fuzz_test.cpp).
 #include <map>
 #include <numeric>

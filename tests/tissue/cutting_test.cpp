@@ -1,4 +1,4 @@
-// Cutting (docs/CUTTING.md): a blade's swept surface splits the tetrahedra it crosses, the nodes
+// Cutting (docs/CUTTING.md): a blade's swept surface splits the tetrahedra it crosses, the nodes  // SPDX-License-Identifier: Apache-2.0
 // along it are duplicated where the mesh comes apart, and nothing is lost. Checked against
 // geometry (which side of the cut every tetrahedron lies on), conservation, linear FE on the cut
 // mesh, rigid motions, and a model that lived its whole history on the cut mesh.

@@ -1,4 +1,4 @@
-// The implicit integrator (CHOLMOD) following a cut in place (docs/CUTTING.md, "The implicit
+// The implicit integrator (CHOLMOD) following a cut in place (docs/CUTTING.md, "The implicit  // SPDX-License-Identifier: Apache-2.0
 // path"): against an integrator built afresh on the cut mesh from the same state, the pattern
 // analysed once per edit and never per step, and every node of the cut organ stiff.
 #include <algorithm>

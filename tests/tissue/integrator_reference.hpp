@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Independent references for the integrator tests (integrator_test, mass_scaling_test): the dense
 // global stiffness of linear FE, its lowest mode and true critical step, the liver fixture.
 #include <Eigen/Dense>

@@ -1,4 +1,4 @@
-// Integrators against theory: the computed stable step versus the true global limit 2/omega_max,
+// Integrators against theory: the computed stable step versus the true global limit 2/omega_max,  // SPDX-License-Identifier: Apache-2.0
 // instability detected at the limit, backward Euler against a dense solve, static equilibrium.
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// A tetrahedron pushed through inversion: the plain GPS cannot see it (a mirrored tet has the
+// A tetrahedron pushed through inversion: the plain GPS cannot see it (a mirrored tet has the  // SPDX-License-Identifier: Apache-2.0
 // same edge lengths) and stays inverted; the signed-volume term brings it back.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Hand-edited JSON files: whatever the bytes, one InputError naming the file, the line or the
+// Hand-edited JSON files: whatever the bytes, one InputError naming the file, the line or the  // SPDX-License-Identifier: Apache-2.0
 // field, never a library exception (a number overflow used to abort the server).
 #include "viscera/common/json_input.hpp"
 

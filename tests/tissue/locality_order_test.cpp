@@ -1,4 +1,4 @@
-// The locality order (mesh/locality_order.hpp) against the mesh it renumbers: the same tetrahedra
+// The locality order (mesh/locality_order.hpp) against the mesh it renumbers: the same tetrahedra  // SPDX-License-Identifier: Apache-2.0
 // on the same points with the same orientation and element sets, deterministic and idempotent;
 // and what it does, against the order it replaces and a shuffled one: consecutive tetrahedra are
 // neighbours, and the nodes of a contiguous range of them (a force chunk) lie in a narrower range,

@@ -1,4 +1,4 @@
-// Selective mass scaling (mass_scaling.hpp) against theory: the added mass as stated, the true
+// Selective mass scaling (mass_scaling.hpp) against theory: the added mass as stated, the true  // SPDX-License-Identifier: Apache-2.0
 // stable step it reaches, the weight kept physical, the lowest frequency as the Rayleigh quotient of
 // the unscaled mode predicts, on a box and on the server's 12k liver.
 #include "viscera/tissue/integrator/mass_scaling.hpp"

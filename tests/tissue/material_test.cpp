@@ -1,4 +1,4 @@
-// Elasticity matrices against their defining compliances.
+// Elasticity matrices against their defining compliances.  // SPDX-License-Identifier: Apache-2.0
 #include <gtest/gtest.h>
 
 #include "viscera/common/input_error.hpp"

@@ -1,4 +1,4 @@
-// Mesh readers on the real organ meshes, in every supported format, and on malformed files.
+// Mesh readers on the real organ meshes, in every supported format, and on malformed files.  // SPDX-License-Identifier: Apache-2.0
 #include <filesystem>
 #include <sstream>
 

@@ -1,4 +1,4 @@
-// Boundary extraction and 1:8 refinement, checked against topology and geometry identities.
+// Boundary extraction and 1:8 refinement, checked against topology and geometry identities.  // SPDX-License-Identifier: Apache-2.0
 #include <map>
 #include <set>
 

@@ -1,4 +1,4 @@
-// Patch test: a homogeneous strain imposed on the boundary of an irregular mesh gives a uniform
+// Patch test: a homogeneous strain imposed on the boundary of an irregular mesh gives a uniform  // SPDX-License-Identifier: Apache-2.0
 // stress inside, solved by the implicit machinery (static Newton + CHOLMOD).
 #include <gtest/gtest.h>
 

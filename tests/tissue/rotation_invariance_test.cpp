@@ -1,4 +1,4 @@
-// Rigid rotations: the GPS and corotational FE produce no force and rotate their forces with the
+// Rigid rotations: the GPS and corotational FE produce no force and rotate their forces with the  // SPDX-License-Identifier: Apache-2.0
 // body; linear FE produces spurious forces, exactly -K (R - I) X.
 #include <gtest/gtest.h>
 

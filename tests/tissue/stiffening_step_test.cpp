@@ -1,4 +1,4 @@
-// The explicit step of a strain-stiffening tissue: the GPS's bound on how much stiffer than at rest
+// The explicit step of a strain-stiffening tissue: the GPS's bound on how much stiffer than at rest  // SPDX-License-Identifier: Apache-2.0
 // its tangent grows (GpsModel::stiffness_growth) against the closed-form slope of the edge law and
 // against the element tangents' eigenvalues (another code path), and the integrator that shortens
 // its sub-steps by it: the shipped fitted passive-muscle material (Fung B = 17.5) stretched by 30%

@@ -1,4 +1,4 @@
-// Element tangents against central finite differences of the forces (an independent path).
+// Element tangents against central finite differences of the forces (an independent path).  // SPDX-License-Identifier: Apache-2.0
 #include <gtest/gtest.h>
 
 #include "viscera/tissue/fem/finite_element_model.hpp"

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Helpers shared by the tissue tests: random well-shaped tetrahedra, the bundled organ meshes.
 #include <filesystem>
 #include <fstream>

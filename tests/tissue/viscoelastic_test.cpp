@@ -1,4 +1,4 @@
-// Constant-Q viscoelasticity against theory: the fitted Q(f), closed-form relaxation and creep of a
+// Constant-Q viscoelasticity against theory: the fitted Q(f), closed-form relaxation and creep of a  // SPDX-License-Identifier: Apache-2.0
 // homogeneous GPS element with memory variables, hysteresis loops, Figure 2, explicit stability.
 #include <cmath>
 #include <random>

@@ -1,4 +1,4 @@
-// The trainer's scoring without a network: synthetic sessions whose metrics are known in closed
+// The trainer's scoring without a network: synthetic sessions whose metrics are known in closed  // SPDX-License-Identifier: Apache-2.0
 // form (hold times, time above a limit, path length, the mark's distance to a sphere), fed as the
 // payloads a session's streams carry; the same numbers whatever the arrival order; exercise files
 // whose errors name the file and the field.

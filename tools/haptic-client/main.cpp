@@ -1,4 +1,4 @@
-// haptic-client: a haptic device client of viscera-server. It claims an instrument, samples its
+// haptic-client: a haptic device client of viscera-server. It claims an instrument, samples its  // SPDX-License-Identifier: Apache-2.0
 // device at the device rate (a virtual device: a scripted gesture or a trajectory file; real
 // devices implement viscera::client::Device), streams the tip to the server, renders the
 // server's local force model back to the device, prints force and round-trip latency live and

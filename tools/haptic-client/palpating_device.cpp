@@ -1,4 +1,4 @@
-#include "palpating_device.hpp"
+#include "palpating_device.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

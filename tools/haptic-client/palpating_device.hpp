@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A virtual device that palpates the organ from above to find what is stiffer inside it, as a
 // trainee's hand would: at each point of a grid over the organ's top (2 cm apart, then 1 cm apart
 // around the stiffest), it comes down until it touches, presses DEPTH / 2 further and holds still

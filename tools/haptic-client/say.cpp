@@ -1,4 +1,4 @@
-#include "say.hpp"
+#include "say.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cstdarg>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The haptic client's lines on standard output, written by a thread of their own once
 // start_saying() was called: the device loop, which renders the force the hand feels, never waits
 // for a terminal whose output was stopped (Ctrl-S) or for a pipe nobody reads. Before it (and in

@@ -1,4 +1,4 @@
-#include "scripted_device.hpp"
+#include "scripted_device.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A virtual device that plays a scripted gesture relative to the organ (its bounds from the
 // scene state) and reacts to contact the way a hand does: it moves down from 1 cm above the
 // organ's top centre until the force says "contact", then

@@ -1,4 +1,4 @@
-#include "trajectory_device.hpp"
+#include "trajectory_device.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <sstream>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A virtual device that plays a trajectory file (docs/PROTOCOL.md): CSV with a header row,
 // columns time_s, x_m, y_m, z_m and optionally jaw_rad and buttons; times strictly increasing
 // from 0. Positions are in the scene frame, or relative to the organ's top centre (the centre of

@@ -1,4 +1,4 @@
-#include "viscera/console/access_token.hpp"
+#include "viscera/console/access_token.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cstdio>

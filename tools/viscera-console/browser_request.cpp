@@ -1,4 +1,4 @@
-#include "viscera/console/browser_request.hpp"
+#include "viscera/console/browser_request.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <array>
 #include <cmath>

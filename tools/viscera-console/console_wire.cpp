@@ -1,4 +1,4 @@
-#include "viscera/console/console_wire.hpp"
+#include "viscera/console/console_wire.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cstring>
 

@@ -1,4 +1,4 @@
-#include "viscera/console/force_decimator.hpp"
+#include "viscera/console/force_decimator.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

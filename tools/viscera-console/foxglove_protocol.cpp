@@ -1,4 +1,4 @@
-#include "viscera/console/foxglove_protocol.hpp"
+#include "viscera/console/foxglove_protocol.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include <cstring>
+#include <cstring>  // SPDX-License-Identifier: Apache-2.0
 
 #include <boost/beast/core/detect_ssl.hpp>
 #include <boost/beast/websocket.hpp>

@@ -1,4 +1,4 @@
-// viscera-console: the instructor's console in the browser. A client of the DDS domain (through
+// viscera-console: the instructor's console in the browser. A client of the DDS domain (through  // SPDX-License-Identifier: Apache-2.0
 // the client SDK) that serves the console page and a WebSocket to browsers: the organ's surface
 // live, instruments, forces, health and events out; pause, resume, reset, load a scene, change the
 // material, annotate and bookmark in (docs/CONSOLE.md).

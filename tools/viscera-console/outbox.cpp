@@ -1,4 +1,4 @@
-#include "viscera/console/outbox.hpp"
+#include "viscera/console/outbox.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <utility>

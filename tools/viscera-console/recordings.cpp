@@ -1,4 +1,4 @@
-#include "viscera/console/recordings.hpp"
+#include "viscera/console/recordings.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cctype>

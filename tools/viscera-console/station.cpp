@@ -1,4 +1,4 @@
-#include "station.hpp"
+#include "station.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <chrono>

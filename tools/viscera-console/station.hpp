@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // One trainee station: a server on the domain in a DDS partition of its own. Its streams are
 // taken on a thread of the station's (client SDK's StreamTap), decoded, thinned to what a page
 // needs and handed to the bridge as ready-to-send messages; requests from browsers are carried out

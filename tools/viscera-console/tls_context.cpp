@@ -1,4 +1,4 @@
-#include "viscera/console/tls_context.hpp"
+#include "viscera/console/tls_context.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <boost/asio/buffer.hpp>
 #include <openssl/ssl.h>

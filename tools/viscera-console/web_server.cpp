@@ -1,4 +1,4 @@
-#include "web_server.hpp"
+#include "web_server.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <atomic>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The bridge's side toward browsers: an HTTP server (Boost.Beast, over TLS where given a
 // certificate) that serves the page's files and a WebSocket at /ws. Access needs the token (in the address, ?token=..., or the cookie the
 // page is given), checked before anything is served or upgraded. Each browser has a bounded

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What the console's web server shares between its files (not a public header): the server's
 // state (one io thread), the connection that reads HTTP requests, and the start of a browser's
 // WebSocket session, over plain TCP (loopback) or TLS.

@@ -1,4 +1,4 @@
-// viscera-control: session control of a running viscera-server from the command line, as an
+// viscera-control: session control of a running viscera-server from the command line, as an  // SPDX-License-Identifier: Apache-2.0
 // instructor's console does it: pause, resume, reset the organ, load another scene, change the
 // material or the physics rate, show the scene state, watch the server's health, follow the
 // session's events, or annotate the session.

@@ -1,4 +1,4 @@
-// viscera-figure2: regenerates the paper's Figure 2 (docs/figure2.csv, docs/figure2.svg).
+// viscera-figure2: regenerates the paper's Figure 2 (docs/figure2.csv, docs/figure2.svg).  // SPDX-License-Identifier: Apache-2.0
 #include <cstdio>
 #include <fstream>
 #include <sstream>

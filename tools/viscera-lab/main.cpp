@@ -1,4 +1,4 @@
-// viscera-lab: confronts viscera's tissue model with measured data.
+// viscera-lab: confronts viscera's tissue model with measured data.  // SPDX-License-Identifier: Apache-2.0
 //   viscera-lab analyze DATASET_DIR --out OUT_DIR
 //   viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR
 //   viscera-lab import EXPORT... --out DATASET_DIR --length-m L --width-m W --thickness-m T --time COL --force COL --displacement COL

@@ -1,4 +1,4 @@
-#include "report.hpp"
+#include "report.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <filesystem>
 #include <fstream>

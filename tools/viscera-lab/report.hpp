@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Writes OUT_DIR/report.json, report.md (with SVG plots per test) and model.json.
 #include <string>
 

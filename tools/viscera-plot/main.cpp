@@ -1,4 +1,4 @@
-// viscera-plot: the force a haptic client felt, from its reports (haptic-client --report), several
+// viscera-plot: the force a haptic client felt, from its reports (haptic-client --report), several  // SPDX-License-Identifier: Apache-2.0
 // in one SVG: the same press on two tissues side by side, against the tip's depth below its first
 // contact or against time.
 #include <algorithm>

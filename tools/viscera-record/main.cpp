@@ -1,4 +1,4 @@
-// viscera-record: records a session (every viscera stream of a DDS domain and partition) to MCAP;
+// viscera-record: records a session (every viscera stream of a DDS domain and partition) to MCAP;  // SPDX-License-Identifier: Apache-2.0
 // recovers a recording cut short; prints what a recording holds. docs/RECORDING.md.
 #include <algorithm>
 #include <atomic>

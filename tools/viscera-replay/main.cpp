@@ -1,4 +1,4 @@
-// viscera-replay: plays a recorded session back onto a DDS partition of its own, or re-simulates
+// viscera-replay: plays a recorded session back onto a DDS partition of its own, or re-simulates  // SPDX-License-Identifier: Apache-2.0
 // it in lockstep and compares every force and frame (docs/RECORDING.md).
 #include <atomic>
 #include <csignal>

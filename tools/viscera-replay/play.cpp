@@ -1,4 +1,4 @@
-#include "play.hpp"
+#include "play.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <chrono>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // viscera-replay play: a recording published again onto a DDS partition of its own at its
 // original pace times a rate, so consoles and other clients see the session again; paused,
 // resumed and sought from the terminal or by session requests sent to the replayer.

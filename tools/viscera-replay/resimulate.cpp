@@ -1,4 +1,4 @@
-#include "resimulate.hpp"
+#include "resimulate.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cerrno>
 #include <chrono>

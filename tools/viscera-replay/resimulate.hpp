@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // viscera-replay resimulate: a fresh lockstep server on the recorded scene, fed the recorded
 // commands and requests at the ticks the original applied them, every force, event and frame
 // compared (client-sdk/recording: lockstep_plan.hpp, resimulation_check.hpp).

@@ -1,4 +1,4 @@
-// viscera-sim: loads an organ mesh and a material, fixes a region, runs it under gravity and
+// viscera-sim: loads an organ mesh and a material, fixes a region, runs it under gravity and  // SPDX-License-Identifier: Apache-2.0
 // writes VTU frames (ParaView), printing progress and the step rate.
 #include <algorithm>
 #include <chrono>

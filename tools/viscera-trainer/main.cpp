@@ -1,4 +1,4 @@
-// viscera-trainer: runs a training exercise on a live session and scores it, or scores a recorded
+// viscera-trainer: runs a training exercise on a live session and scores it, or scores a recorded  // SPDX-License-Identifier: Apache-2.0
 // session afterwards with the same numbers (docs/TRAINING.md).
 #include <atomic>
 #include <chrono>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The submodules of viscera's extension module (_viscera), one file each.
 #include <pybind11/pybind11.h>
 

@@ -1,4 +1,4 @@
-// viscera._viscera.lab: viscera-lab's data sets, analysis and prediction, with the report as the
+// viscera._viscera.lab: viscera-lab's data sets, analysis and prediction, with the report as the  // SPDX-License-Identifier: Apache-2.0
 // program writes it (report_json.hpp), parsed into Python objects by the package.
 #include <chrono>
 #include <filesystem>

@@ -1,4 +1,4 @@
-// _viscera: the extension module under the viscera Python package (client-sdk/python/viscera),
+// _viscera: the extension module under the viscera Python package (client-sdk/python/viscera),  // SPDX-License-Identifier: Apache-2.0
 // a submodule per part: recording, tissue, lab, session. docs/PYTHON.md.
 #include <pybind11/pybind11.h>
 

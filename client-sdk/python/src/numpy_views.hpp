@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // numpy arrays over C++ buffers without copying them: the array owns the vector it views (moved
 // into a capsule), or views memory of an object that it keeps alive. Read-only either way.
 #include <memory>

@@ -1,4 +1,4 @@
-// viscera._viscera.recording: a recording opened by viscera's reader, its streams read into
+// viscera._viscera.recording: a recording opened by viscera's reader, its streams read into  // SPDX-License-Identifier: Apache-2.0
 // columns (recording_tables.hpp) handed to numpy without copying.
 #include <pybind11/stl.h>
 

@@ -1,4 +1,4 @@
-// viscera._viscera.session: the client SDK (viscera::client::Client) for Python. Calls that wait
+// viscera._viscera.session: the client SDK (viscera::client::Client) for Python. Calls that wait  // SPDX-License-Identifier: Apache-2.0
 // release the interpreter lock; no Python code ever runs on a DDS thread (state is polled), so a
 // DDS callback can never wait for the lock that the main thread holds.
 #include <pybind11/chrono.h>

@@ -1,4 +1,4 @@
-// viscera._viscera.tissue: an organ for researchers, built as viscera-sim builds it (mesh,
+// viscera._viscera.tissue: an organ for researchers, built as viscera-sim builds it (mesh,  // SPDX-License-Identifier: Apache-2.0
 // material file or isotropic parameters, a force model, fixed nodes, an integrator), stepped from
 // Python; positions and velocities are numpy views of the state, never copies.
 #include <algorithm>

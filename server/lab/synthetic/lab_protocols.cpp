@@ -1,4 +1,4 @@
-#include "viscera/lab/lab_protocols.hpp"
+#include "viscera/lab/lab_protocols.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/lab/synthetic_data.hpp"
+#include "viscera/lab/synthetic_data.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <functional>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/cutting/blade_sweep.hpp"
+#include "viscera/tissue/cutting/blade_sweep.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/cutting/boundary_update.hpp"
+#include "viscera/tissue/cutting/boundary_update.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <unordered_set>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/cutting/mesh_cutter.hpp"
+#include "viscera/tissue/cutting/mesh_cutter.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

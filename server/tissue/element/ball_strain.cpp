@@ -1,4 +1,4 @@
-#include "viscera/tissue/element/ball_strain.hpp"
+#include "viscera/tissue/element/ball_strain.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/element/tet_geometry.hpp"
+#include "viscera/tissue/element/tet_geometry.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 namespace viscera::tissue {
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/fem/finite_element_model.hpp"
+#include "viscera/tissue/fem/finite_element_model.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/fem/polar_decomposition.hpp"
+#include "viscera/tissue/fem/polar_decomposition.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/gps/gps_calibration.hpp"
+#include "viscera/tissue/gps/gps_calibration.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>

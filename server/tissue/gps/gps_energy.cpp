@@ -1,4 +1,4 @@
-// The GPS's elastic energy, whole or one element's (docs/TISSUE.md): 0.5 dL^T H dL over the
+// The GPS's elastic energy, whole or one element's (docs/TISSUE.md): 0.5 dL^T H dL over the  // SPDX-License-Identifier: Apache-2.0
 // elements, with the edge map's stiffening where it has an energy, plus the volume term; and how
 // much stiffer than at rest the energy's curvature grows with the edge strain.
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/gps/gps_mechanisms.hpp"
+#include "viscera/tissue/gps/gps_mechanisms.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-// GpsModel after cutting: the memory of tetrahedra cut from others (memory_from), and following an
+// GpsModel after cutting: the memory of tetrahedra cut from others (memory_from), and following an  // SPDX-License-Identifier: Apache-2.0
 // edit of the mesh in place (follow_edit).
 #include <algorithm>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/gps/gps_model.hpp"
+#include "viscera/tissue/gps/gps_model.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

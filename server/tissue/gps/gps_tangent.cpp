@@ -1,4 +1,4 @@
-// The GPS's element tangent (docs/TISSUE.md): -df/dx of one element, elastic or over a
+// The GPS's element tangent (docs/TISSUE.md): -df/dx of one element, elastic or over a  // SPDX-License-Identifier: Apache-2.0
 // viscoelastic step of dt (the memory variables' relaxed share, first-load softening from the
 // memory's extremes), with the edge map's stiffening and the volume term; the implicit integrator
 // and the contact compliance assemble it.

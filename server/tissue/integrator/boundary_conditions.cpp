@@ -1,4 +1,4 @@
-#include "viscera/tissue/integrator/boundary_conditions.hpp"
+#include "viscera/tissue/integrator/boundary_conditions.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/integrator/explicit_integrator.hpp"
+#include "viscera/tissue/integrator/explicit_integrator.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/integrator/implicit_integrator.hpp"
+#include "viscera/tissue/integrator/implicit_integrator.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

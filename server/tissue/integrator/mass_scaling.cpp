@@ -1,4 +1,4 @@
-#include "viscera/tissue/integrator/mass_scaling.hpp"
+#include "viscera/tissue/integrator/mass_scaling.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

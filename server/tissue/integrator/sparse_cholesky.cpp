@@ -1,4 +1,4 @@
-#include "viscera/tissue/integrator/sparse_cholesky.hpp"
+#include "viscera/tissue/integrator/sparse_cholesky.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cstring>

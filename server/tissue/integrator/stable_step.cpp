@@ -1,4 +1,4 @@
-#include "viscera/tissue/integrator/stable_step.hpp"
+#include "viscera/tissue/integrator/stable_step.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

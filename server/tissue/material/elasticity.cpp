@@ -1,4 +1,4 @@
-#include "viscera/tissue/material/elasticity.hpp"
+#include "viscera/tissue/material/elasticity.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <sstream>

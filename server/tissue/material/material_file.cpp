@@ -1,4 +1,4 @@
-#include "viscera/tissue/material/material_file.hpp"
+#include "viscera/tissue/material/material_file.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/common/json_input.hpp"

@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/boundary_surface.hpp"
+#include "viscera/tissue/mesh/boundary_surface.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <map>

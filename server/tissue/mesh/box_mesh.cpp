@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/box_mesh.hpp"
+#include "viscera/tissue/mesh/box_mesh.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <stdexcept>
 

@@ -1,4 +1,4 @@
-// Gmsh .msh readers: legacy v1 ($NOD/$ELM), ASCII v2 ($MeshFormat 2.x) and ASCII v4.1. The
+// Gmsh .msh readers: legacy v1 ($NOD/$ELM), ASCII v2 ($MeshFormat 2.x) and ASCII v4.1. The  // SPDX-License-Identifier: Apache-2.0
 // tetrahedra's physical groups become the mesh's element sets: v1's physical region, v2's first
 // tag, v4.1's volume entity's physical tags (from $Entities); names from $PhysicalNames.
 #include <cstdlib>

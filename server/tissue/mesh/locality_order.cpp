@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/locality_order.hpp"
+#include "viscera/tissue/mesh/locality_order.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <array>

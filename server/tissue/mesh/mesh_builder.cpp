@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/mesh_builder.hpp"
+#include "viscera/tissue/mesh/mesh_builder.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 

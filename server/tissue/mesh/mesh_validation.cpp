@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/mesh_validation.hpp"
+#include "viscera/tissue/mesh/mesh_validation.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/refinement.hpp"
+#include "viscera/tissue/mesh/refinement.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <unordered_map>
 

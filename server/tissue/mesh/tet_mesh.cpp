@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/tet_mesh.hpp"
+#include "viscera/tissue/mesh/tet_mesh.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/tissue/element/tet_geometry.hpp"
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/text_cursor.hpp"
+#include "viscera/tissue/mesh/text_cursor.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

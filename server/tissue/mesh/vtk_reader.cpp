@@ -1,4 +1,4 @@
-// VTK readers: legacy ASCII unstructured grid (.vtk, versions 2-4 "CELLS n size" layout and
+// VTK readers: legacy ASCII unstructured grid (.vtk, versions 2-4 "CELLS n size" layout and  // SPDX-License-Identifier: Apache-2.0
 // 5.1 "OFFSETS/CONNECTIVITY" layout) and ASCII XML unstructured grid (.vtu).
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/mesh/vtu_writer.hpp"
+#include "viscera/tissue/mesh/vtu_writer.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cstdio>
 #include <sstream>

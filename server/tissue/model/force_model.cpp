@@ -1,4 +1,4 @@
-#include "viscera/tissue/model/force_model.hpp"
+#include "viscera/tissue/model/force_model.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 

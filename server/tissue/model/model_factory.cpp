@@ -1,4 +1,4 @@
-#include "viscera/tissue/model/model_factory.hpp"
+#include "viscera/tissue/model/model_factory.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/tissue/fem/finite_element_model.hpp"

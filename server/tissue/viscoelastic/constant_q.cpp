@@ -1,4 +1,4 @@
-#include "viscera/tissue/viscoelastic/constant_q.hpp"
+#include "viscera/tissue/viscoelastic/constant_q.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/viscoelastic/constant_q_fit.hpp"
+#include "viscera/tissue/viscoelastic/constant_q_fit.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "viscera/tissue/viscoelastic/figure2.hpp"
+#include "viscera/tissue/viscoelastic/figure2.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/viscoelastic/shear_layer.hpp"
+#include "viscera/tissue/viscoelastic/shear_layer.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "viscera/tissue/viscoelastic/standard_linear_solids.hpp"
+#include "viscera/tissue/viscoelastic/standard_linear_solids.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <algorithm>
 #include <cmath>

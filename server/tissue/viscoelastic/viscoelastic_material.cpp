@@ -1,4 +1,4 @@
-#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
+#include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"  // SPDX-License-Identifier: Apache-2.0
 
 #include <cmath>
 #include <sstream>

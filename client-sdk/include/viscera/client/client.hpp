@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // viscera's client SDK: find a server's scene, claim an instrument, stream poses, receive forces,
 // measure the command-to-force round trip. Built on protocol/ (the only DDS wrapper).
 //

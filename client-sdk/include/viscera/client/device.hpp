@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The interface between a haptic client and a device. A client samples the device at its rate,
 // sends the pose to the server, and commands the device with the force rendered from the
 // server's local model. A real device (a Phantom/Touch through OpenHaptics, a Falcon through

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What a haptic device's loop does each period, as a state machine with no clock and no network
 // of its own: the caller tells it the time, the server's state and (every 0.1 s) what the scene
 // state says of the instrument, and it says what to do this period. It holds the local force

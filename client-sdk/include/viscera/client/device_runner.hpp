@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The whole loop of a haptic device on a viscera server, for any Device: at the device rate it
 // reads the device, sends the tip, renders the server's local force model back, keeps its commands
 // in phase after the server's physics ticks, claims the instrument again after a scene load, stands

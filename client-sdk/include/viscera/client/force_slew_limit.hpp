@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The last guard between the server and a hand: the force commanded to a device changes by at most
 // a set amount per device period, whatever arrives from the local force model (docs/FAULTS.md, "The
 // force on the hand"). A step the server or the network makes (a reset under a deep press, a

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Rendering the server's local contact model at the device rate (docs/HAPTICS.md section 2): between
 // server updates and across network delay the client renders F(x) = F0 - K (x - x0), with x0 the
 // tip position the server computed F0 for and K = -dF/dx, pushing only out of the tissue (along

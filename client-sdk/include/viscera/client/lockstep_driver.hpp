@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The driver's side of lockstep (viscera-server --lockstep, docs/RECORDING.md): sends the ticks
 // (LockstepStep) and takes what each produced (LockstepResult), over DDS in the partition the
 // server was started in. Reliable and keep-all both ways: steps run in the order sent, none lost.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What a console may ask of a server, checked before it is sent: the material parameters with
 // their ranges, and scene names. viscera-control (command line) and viscera-console (browser)
 // check with these, so both refuse the same values with the same words.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Every sample of chosen streams as it came off the wire, for recorders: payloads undecoded, each
 // writer's sequence numbers kept (to count what was lost), and a deep history, so that a 1 kHz
 // stream read a few milliseconds late loses nothing. And its counterpart for players: payloads

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Keeps a client's periodic loop (a haptic device at the server's physics rate) at a fixed phase
 // after the server's physics ticks, so that its command, the server's immediate answer and the
 // network threads on both sides run in the server's idle time between ticks, and every tick takes

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The schema of each stream's payloads as a binary FlatBuffers schema (flatc --binary --schema,
 // the reflection format), embedded at build time: recordings carry it (MCAP schema encoding
 // "flatbuffer"), so other people's tools decode viscera's messages without viscera's code.

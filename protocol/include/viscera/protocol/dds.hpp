@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The one wrapper of Cyclone DDS's C API in viscera: RAII entities, the envelope topic per
 // stream with its QoS (docs/PROTOCOL.md), and typed writes/takes of FlatBuffer payloads. No other
 // code calls dds_* directly.

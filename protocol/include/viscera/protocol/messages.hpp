@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Plain C++ views of the protocol's messages, and their encoding and verified decoding. Every
 // received payload goes through decode_*: the FlatBuffers Verifier, then ranges and finiteness;
 // a payload that fails returns nullopt and says why (the receiver counts and drops it).

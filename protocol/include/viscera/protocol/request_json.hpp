@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A session request as JSON, for what people read and tools re-run: the material and rate changes
 // a scene went through (SceneFiles settings), and reports. Field names are the schema's.
 #include <optional>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The table of streams: for each, its name (the DDS topic is "viscera_" + name), the FlatBuffers
 // root table of its payloads, its QoS, and what the code that handles streams in general needs
 // to know (is it state, may a sample be lost, how to check a payload). dds.cpp makes the topics

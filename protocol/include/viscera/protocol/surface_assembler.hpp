@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Whole surfaces from the SurfaceTopology stream (schema 16): after a cut the server sends a patch
 // of the surface before it, bounded by what the cut changed, and a whole surface every few
 // patches. A reader keeps the whole surface and applies each patch to it, so that it always holds

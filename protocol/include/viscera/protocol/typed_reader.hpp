@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A reader of one stream that hands over decoded messages: every payload goes through the
 // stream's decoder (messages.hpp), and those that fail are counted with the newest reason, so a
 // receiver never decodes by hand and a rejected payload is never silent.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Little-endian encoding of MCAP record fields, both ways. ByteReader checks every read against
 // the bytes it has, so a truncated or corrupt record throws FormatError instead of reading past
 // its end.

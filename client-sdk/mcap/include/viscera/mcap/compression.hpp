@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Chunk compression as MCAP names it: "zstd" (Zstandard frame, Debian's libzstd), "lz4" (LZ4
 // frame, Debian's liblz4) or "" (none).
 #include <cstdint>

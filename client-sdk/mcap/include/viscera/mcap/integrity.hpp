@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The one judgement of an MCAP file's integrity that every tool shares (viscera-record info
 // --verify, recover): every record of the data section parses and its CRC holds, the summary reads,
 // and every chunk, attachment and metadata record its indexes point to reads and checks.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The MCAP container format (mcap.dev, "MCAP Format Specification", major version 0): the records
 // viscera writes and reads, as plain structs. A file is the magic, a Header, the data section
 // (schemas, channels and messages inside chunks; attachments and metadata beside them; a message

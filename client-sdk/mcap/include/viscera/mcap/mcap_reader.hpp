@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Reads MCAP files, strictly: every record is checked against the bytes there are, a chunk's
 // records against its CRC and size, a message against its channel. read_data() walks the data
 // section in file order (schemas, channels, messages of each chunk, attachments, metadata) and

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Writes an MCAP file as the specification defines a complete, indexed one: messages in chunks
 // (closed at a size or a span of log time, compressed), a message index after each chunk, the
 // schemas and channels inside the chunk where they are first used (so that every chunk can be read

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A child process (the lockstep viscera-server of a re-simulation, a replay the console opens):
 // started with its output in a log file, stopped with SIGTERM (then SIGKILL), its last lines at
 // hand for an error message.

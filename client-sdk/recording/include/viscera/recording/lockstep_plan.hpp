@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What re-simulating a recorded session takes, read from the recording alone (no network): the
 // lockstep steps that give a fresh server the recorded instrument commands and session requests
 // at the ticks at which the original server applied them, and what each tick must reproduce.

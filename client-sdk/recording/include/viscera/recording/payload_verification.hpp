@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A recorded payload checked by viscera's own decoder of its stream: the FlatBuffers verifier,
 // then every range and finiteness check a live receiver applies (`viscera-record info --verify`).
 #include <cstdint>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Where a replay is in its recording: recording time runs at `rate` times wall time from where it
 // was started or sought, and stands still while paused. No clock of its own: the caller passes
 // the wall time (steady clock), so tests run it on made-up time.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A session recording opened for reading (the replayer, the trainer, viscera-record info): checked
 // to be a complete viscera recording of a schema this build reads, its channels mapped back to
 // their streams and keys, its scenes' files at hand. Errors are one line naming the file.

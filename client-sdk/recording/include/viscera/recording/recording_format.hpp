@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // How viscera lays a session out in MCAP (docs/RECORDING.md), shared by the recorder, the
 // replayer and the trainer:
 // - a channel per (stream, writer, key): topic = the DDS topic, message encoding "flatbuffer",

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A recording's streams as tables of columns (one row per message, in log-time order), for
 // analysis in other tools (the Python package's DataFrames): each column named with its unit
 // ("force_x_n", "tip_x_m"), each row decoded by the protocol's own verified decoders. Surface

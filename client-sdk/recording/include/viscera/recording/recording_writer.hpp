@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A session into an MCAP file, sample by sample as a StreamTap delivers them (no network here:
 // the recorder feeds it, tests feed it their own samples). Channels, schemas, attachments and
 // metadata as recording_format.hpp lays them out; each writer's gaps counted.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A re-simulation compared with its recording, tick by tick: every recorded force (all its
 // physics: contact, force, torque, contact point and normal, penetration, the organ's largest edge strain; not the wall-clock
 // stamps), every server event (kind, instrument, client, request, simulated time), every surface

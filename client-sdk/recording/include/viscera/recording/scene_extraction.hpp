@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The scenes of a recording back on disk, so a server can load them again: each recorded scene's
 // mesh and material from its attachments (checked against their SHA-256), and its scene file
 // with organ.mesh and organ.material pointing at them, named by the scene's own name (what

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Drops, counted and never hidden: every writer numbers its samples 1, 2, 3, ... (the envelope's
 // seq), so the numbers a recorder did not receive between the first and the last it did are the
 // samples it lost. Counted per writer. DDS keeps each instance's (key's) samples in order, but a

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A training exercise (docs/TRAINING.md): the scene it runs on, the task, the limits a safe
 // performance keeps and the thresholds that pass it. Read from a JSON exercise file; every error
 // names the file and the field.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Scores a performance of an exercise from the session's streams (docs/TRAINING.md): the same
 // class reads a live session (the trainer's stream tap) and a recording, so both give the same
 // numbers. Forces are joined with the commands they answer (by instrument, client and sequence

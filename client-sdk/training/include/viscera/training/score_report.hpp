@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The score of one performance: the metrics (docs/TRAINING.md gives each formula), each pass
 // criterion with its value and threshold, and why it failed; as JSON and as a short Markdown
 // summary for the trainee's record.

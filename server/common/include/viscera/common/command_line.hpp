@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A small, strict command-line parser shared by viscera's programs: every flag is declared with
 // its help text; unknown flags, missing values and bad numbers give one clear line.
 #include <cstdint>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // An output that exists already is replaced only when the user asked for it (`--replace`, as for
 // recordings); otherwise the program stops before its work with one line naming the file and the
 // flag. Checked before the work, so a long run never ends in a refusal.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Whole files as bytes, for what is stored or sent verbatim (the files a scene was built from, in
 // recordings). Errors are InputErrors naming the file.
 #include <cstdint>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Errors at the boundaries of every program and library (files, configuration, arguments) carry where the
 // bad value came from, so that a user can act on a single line of text.
 #include <stdexcept>

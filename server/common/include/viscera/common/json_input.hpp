@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Reading hand-edited JSON files (scenes, materials, data sets, models, exercises) so that no
 // input can crash a program: the file must be a regular file of bounded size, every syntax error
 // and number overflow becomes one InputError naming the file and line, a key given twice is an

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Numbers read from text (command lines, CSV and mesh files, recordings' metadata), and the one
 // wording of what is wrong with one, so that every program says it the same way:
 //   'abc' is not a number        'nan' is not a finite number

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The p-quantile of samples (the element at rank floor(p (n - 1)) in sorted order, no
 // interpolation): step times, jitter and round trips are reported this way everywhere.
 #include <algorithm>

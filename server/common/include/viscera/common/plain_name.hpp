@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Names that become parts of paths (scene names, exercise names): letters, digits, '.', '_' and
 // '-', 1 to 64 of them, not starting with '.'. No separator, no "..", no NUL, nothing a terminal
 // would act on. And text that is printed: no control characters.

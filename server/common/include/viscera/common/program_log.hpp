@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A program's log, for the long-running programs (the server, the recorder, the console): spdlog
 // lines with the time, the level and the program's name,
 //   2026-11-26 17:20:01.123 info viscera-server: scene liver: 1,493 tets ...

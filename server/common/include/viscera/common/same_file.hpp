@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // No program writes over a file it reads: an output is compared with the inputs by device and
 // inode, so a hard link, a symbolic link or another spelling of an input's path is caught too.
 #include <string>

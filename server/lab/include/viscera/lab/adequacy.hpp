@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Whether a fitted model explains the data: its residual (data - model, the model fitted to all
 // tests) judged against the data's noise, test by test, and what the residual looks like where it
 // does not. Real tissue and real instruments hold effects outside the lab's four causes (permanent

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // viscera-lab's method (docs/MODEL.md section 4): fit the baseline, show where it is wrong (per test,
 // on held-out tests), name the cause from candidate mechanisms whose held-out gain is clearly
 // above the noise of the data, extend the model, refit and measure the gain on held-out tests.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A lab's test follows a command that is piecewise linear in time (ramps, holds, triangles), but
 // its changes of slope fall between samples. Taken as linear from sample to sample, a ramp that
 // starts between two samples gets a slope that is neither the hold's nor the ramp's, and a

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The lines and cells of a delimited text file (a data set's CSV, a test machine's export): lines
 // one at a time with a UTF-8 byte-order mark (spreadsheet exports) taken off, cells with the
 // spaces, carriage returns and double quotes around them taken off.

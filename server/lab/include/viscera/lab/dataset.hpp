@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A measured data set (README "The data a user brings"): a folder with dataset.json and one CSV
 // per test (time_s, strain, stress_pa[, stress_sd_pa]). SI units: seconds, engineering strain,
 // pascals. Reading checks everything a file can get wrong and names file, line and field.

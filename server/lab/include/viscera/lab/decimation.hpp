@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Large tests made small enough to fit: a test of a million rows (a logger at 10 kHz) carries no
 // more shape than a few thousand well-placed samples, and every fit and held-out evaluation costs
 // time in proportion to the rows. decimate() keeps measured samples (never averages, so the noise

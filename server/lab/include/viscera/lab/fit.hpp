@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Fitting the lab's material models: non-negative least squares for the linear parameters
 // (Lawson-Hanson), a log-grid search refined by golden sections for each nonlinear parameter
 // (variable projection), and leave-one-test-out prediction for held-out errors.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Figures into the lab's sentences: printf's format with up to three numbers.
 #include <cstdio>
 #include <string>

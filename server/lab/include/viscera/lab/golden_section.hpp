@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Golden-section search for the minimum of a unimodal function of one variable: the interval
 // shrinks by the golden ratio per evaluation. Used for every nonlinear parameter the lab fits.
 #include <cmath>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // viscera-lab import: a test machine's export (force against displacement over time, in the
 // machine's own units and column names) turned into a data set (dataset.hpp). The conversion to
 // strain and stress, and the units it assumed, are written into dataset.json ("import"), so that

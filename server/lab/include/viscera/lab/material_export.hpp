@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // From the data set to the organ: the material file (docs/MATERIAL.md) that carries a fitted law
 // into the server's GPS as it is, every mechanism with its 3D calibration: the unrelaxed modulus
 // and the relaxation spectrum as weights of it, the Kelvin-Voigt time, first-load softening, and

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The lab's family of 1D constitutive laws (a homogeneous specimen: uniaxial or simple shear),
 // built as the tissue core builds its GPS: an elastic shape s(eps) and a relaxation operator on it,
 //     sigma(t) = E s(t) + eta ds/dt + sum_l E_l h_l(t),   h_l = int exp(-(t-u)/tau_l) ds(u),

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // model.json: a fitted lab model, readable by `viscera-lab predict`.
 #include <string>
 

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A test's noise, by two independent paths. The first (noise_level_measured) from the second
 // differences of every sample; the second the spread of the measured quantity in the holds, about a running
 // mean. Second differences see only the noise that changes from one sample to the next: noise

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // How well the data determine a fitted model's parameters: a bootstrap over tests. The tests are
 // drawn with replacement (as many as the data set holds), the model's structure (its mechanisms,
 // forms and relaxation times) is fitted again to each draw, and each parameter's spread over the

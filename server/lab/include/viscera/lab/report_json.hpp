@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // report.json: every figure of an analysis (or of a prediction), as viscera-lab writes it and the
 // Python package returns it; and the organ's material files the analysis hands over.
 #include <string>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A model run on the tetrahedral specimen (viscera's GPS, implicit, inertia) beside its
 // material-point law, test by test, as viscera-lab analyze reports it: each test within a bounded
 // wall time with a progress line, where the specimen first leaves the law, and, when the specimen

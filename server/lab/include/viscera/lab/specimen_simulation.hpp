@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A test simulated on the specimen itself: the specimen meshed with tetrahedra, the boundary
 // conditions of the mode, the measured loading history, inertia included, viscera's GPS with
 // memory variables, the implicit integrator (backward Euler, CHOLMOD) stepping between samples

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Stress-controlled tests (creep, creep-recovery) simulated as what they are: the measured stress
 // history imposed on the model and the strain computed, so that a model is judged on the quantity
 // the test measured. The law (material_model.hpp) in terms of its elastic shape s,

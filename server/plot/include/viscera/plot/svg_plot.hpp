@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Minimal line plots as SVG (no dependency): axes with ticks, labelled series, a legend.
 #include <string>
 #include <vector>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Which sender speaks for each client id on the instruments. Every message names its client id,
 // and the server used to believe it: a second process started with another's id took over that
 // client's instrument. Now the first DDS participant to command, claim, release, take over or hand

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // How commands are answered: the command thread answers every command the moment it arrives with
 // the reaction at the commanded pose on the newest published state (a Snapshot), so the round trip
 // never waits for a physics step; the physics thread publishes a snapshot after every tick. The

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The organ's compliance at its surface nodes, for the local force model's stiffness
 // (docs/HAPTICS.md section 2): a client renders F(x) = F0 - K (x - x0) between server updates, and K
 // must be the contact's stiffness, the tissue in series with the contact penalty, not the penalty

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The tissue held by a grasper's closed jaws (docs/HAPTICS.md, "Grasper"): the surface nodes within the
 // grasp radius of the tip when the jaws closed, each tied by a spring of stiffness k to the point
 // it had in the tool's frame then. The points move and turn with the tool, so lifting pulls the

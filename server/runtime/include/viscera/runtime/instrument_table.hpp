@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Who owns which instrument, and each owner's newest command: claims, releases, commands, the
 // lease that takes an instrument from a silent owner, and the hand-over of an instrument from
 // one client to another (an instructor taking over, and handing back). No DDS and no clock of its

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Material regions laid out on an organ's mesh (docs/SCENE.md, "Material regions"): each element
 // whose centroid lies inside a region's sphere or box, or that the mesh file tagged into the
 // region's element set, takes the region's material (a later region over an earlier one). A sphere whose centre is drawn from a seed lands where it

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Publishes the organ's deformed surface at 30-60 Hz from a thread of its own, so that encoding
 // and writing 100 kB-1 MB frames never delays the physics loop (docs/PROTOCOL.md: never write from
 // the physics thread). The physics thread only offers its state: when a frame is due, it copies

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The organ of a scene: its mesh, boundary surface, material, force model, explicit integrator
 // and contact compliance, all built from a scene file, and rebuilt with another material while
 // the server runs (session control). Building reads files and factorises; the server does it

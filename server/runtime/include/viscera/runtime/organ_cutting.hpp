@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A scalpel's cut through the running organ (docs/CUTTING.md, "In the server"): the blade's sweep
 // over one tick cuts the mesh in place (tissue::MeshCutter), and the force model, the explicit
 // integrator, the boundary surface and the contacts' surface follow it, all on the physics thread

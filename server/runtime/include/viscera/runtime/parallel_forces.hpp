@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Internal forces of a tissue model on several threads. The elements are cut into a fixed number
 // of chunks; the calling thread computes chunk 0 straight into the force array, and it and the
 // helper threads take the other chunks as they come, each into the chunk's own buffer. The

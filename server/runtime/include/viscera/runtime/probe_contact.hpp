@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Contact of a sphere-tipped probe with the organ's boundary triangles (docs/HAPTICS.md, "Probe").
 // For every triangle, the closest point q to the tip centre c and the signed distance
 // s = (c - q) . n along the triangle's outward normal; the tip penetrates by r - s when s < r

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Scene files (JSON, docs/SCENE.md): the organ (mesh, scale, material, model, fixed region),
 // the instruments, rates and the DDS domain. Paths are relative to the scene file. Errors name
 // the file and the field.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What the server reads from its clients and writes to them, as payloads (FlatBuffers, verified
 // by the server). DdsEndpoints is the real one, over Cyclone DDS (protocol/); a test passes its
 // own, so the server's logic runs without a network. In lockstep a driver sends the ticks and

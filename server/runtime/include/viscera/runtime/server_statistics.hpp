@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The server's figures: ticks, late ticks and missed slots, the step time's and the wake-up
 // jitter's percentiles over each reporting window (about a second), rejected messages by reason,
 // forces sent, mesh frames. From them the telemetry report and the one-line status.

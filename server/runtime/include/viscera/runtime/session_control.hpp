@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Session control at run time (docs/PROTOCOL.md): a scene or a material is built on a thread of
 // its own while the physics goes on, one at a time; the physics thread takes it once ready and
 // swaps it in between ticks; an organ no longer used is destroyed on a thread of its own (a

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // One instrument as the physics thread moves it (docs/SCENE.md, "Simulated tools"): the tool follows
 // its owner's newest commanded tip at most at the scene's speed limit in simulated time, so a
 // server slower than real time (or a jumping device) never drives it through the tissue in one

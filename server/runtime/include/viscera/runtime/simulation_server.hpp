@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The simulation server: owns the organ and its solver, runs the physics at a fixed rate, takes
 // instrument commands and session requests from its endpoints (DDS in viscera-server) and
 // publishes forces (each command's sequence and stamp echoed), the scene state, events, telemetry

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The way out of the organ for a point inside it, at any depth. The contact (ProbeContact) looks
 // only at triangles within its depth limit of the tip, so that the far side of the organ never
 // pulls; a tool that finds itself deeper than that (the organ reset or reloaded under a deep

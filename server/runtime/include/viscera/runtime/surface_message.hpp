@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The organ's boundary surface as the SurfaceTopology stream carries it: whole, or, after a cut,
 // as a patch of the surface its readers hold (schema 16, protocol/surface_assembler.hpp), whose
 // size is bounded by what changed, not by the organ.

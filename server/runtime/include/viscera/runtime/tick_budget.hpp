@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What one physics tick may cost. The explicit integrator takes ceil(1 / (rate dt)) sub-steps per
 // tick, and a stiffer material or a finer mesh shortens dt without bound: Young's modulus 1e20 Pa
 // on the bundled liver gives dt = 2.8e-12 s, hundreds of millions of sub-steps per tick. The

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The physics loop's fixed-rate schedule: tick k owns the slot [S_k, S_k + period), and the slots
 // follow each other on a grid fixed at the start, so simulated time stays locked to wall time.
 //

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The strain at an instrument (Force.tip_strain), spread over the ticks of a window: one tissue
 // strain average over the scene's strain radius (tissue::BallStrain) costs 86 us on the 12k liver
 // (786 tetrahedra in a 2 cm ball, docs/PERFORMANCE.md), too much for every tick of the physics

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The console's access token: read from a file given at start, compared in constant time.
 #include <string>
 #include <string_view>

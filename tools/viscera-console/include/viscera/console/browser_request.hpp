@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What a browser may ask of the console, checked like every other input: one JSON object per
 // WebSocket text message, a known "type", only the fields that type takes, values in range (the
 // material ranges and scene names are viscera-control's). Anything else is refused with one line

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What the bridge sends a browser (docs/CONSOLE.md): the surface topology and the mesh frames as
 // binary WebSocket messages (little-endian, float32 positions the page views without copying),
 // everything else as small JSON objects with a "type".

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The 1 kHz forces cut down to what a plot needs: per instrument, one summary per period with the
 // period's peak force magnitude kept (a short spike is never averaged or sampled away), the last
 // force vector, contact, and the tissue-damage proxy's peak.

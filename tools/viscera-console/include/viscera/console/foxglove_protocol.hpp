@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The Foxglove WebSocket protocol (subprotocol "foxglove.websocket.v1"), the server's side, so
 // that Foxglove or Lichtblick attach to a live session as they open its MCAP recordings: each
 // stream is a channel advertised with its binary FlatBuffers schema (as the recorder stores it,

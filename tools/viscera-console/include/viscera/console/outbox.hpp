@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What waits to go to one browser, bounded, so that a slow browser never holds the bridge or the
 // server back and never makes it grow: the newest mesh frame only (a frame not yet sent is
 // replaced by the next one, counted as skipped), then messages in order up to a byte budget;

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A token bucket: `rate` requests a second on average, bursts of up to `burst`.
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The session recordings a browser may open for replay: files of one folder, named plainly (no
 // path can be given, so a browser cannot make the bridge read an arbitrary file).
 #include <string>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The console's TLS side: the certificate chain and private key it serves HTTPS and WSS with.
 #include <memory>
 #include <string>

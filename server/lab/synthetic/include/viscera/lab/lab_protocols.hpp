@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Data sets shaped like a tissue lab's, generated outside the lab's own code (issue 23): ramp-holds
 // at three rates (one ramp 0.05 s) and one in compression, triangular cycles of growing amplitude
 // through tension and compression, a creep-recovery test under stress control with 0.05 s stress

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Synthetic data sets with one hidden effect (or none), chosen by a seed, for testing viscera-lab.
 // The truth is computed on a different code path from the lab's: closed-form hereditary integrals
 // of piecewise-linear strain histories (strain control), and a finely integrated ODE (stress

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The surface a scalpel's blade sweeps between two ticks. The blade is a segment; from (a0, b0)
 // at the previous tick to (a1, b1) now it sweeps a bilinear patch, taken as the two triangles
 // (a0, b0, b1) and (a0, b1, a1). Between two ticks at 1 kHz the blade moves a fraction of a

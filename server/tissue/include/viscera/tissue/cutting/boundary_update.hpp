@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The organ's boundary surface brought along a cut in place: only the faces of the tetrahedra the
 // cut changed or made are looked at again (their faces before and after), so the work grows with
 // the cut region and a pass over the surface's triangles, not with the organ.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Cutting a tetrahedral mesh with the surface a blade sweeps (docs/CUTTING.md).
 //
 // The method, in three steps per sweep:

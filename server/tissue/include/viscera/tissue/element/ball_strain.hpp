@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The tissue's strain at a length scale, for trainers' damage limits (docs/TRAINING.md, "Tissue
 // strain at the instrument"). The largest edge strain |L - L0| / L0 of any one tetrahedron
 // depends on the mesh: a finer mesh resolves the peak under a probe that a coarse one spreads

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Geometry of one linear tetrahedron: volume, shape-function gradients, the linear FE
 // strain-displacement matrix and the edge-elongation Jacobian of docs/MODEL.md section 1.
 //

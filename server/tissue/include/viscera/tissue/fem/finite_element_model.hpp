@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Linear-tetrahedron finite elements, the two comparison models of docs/MODEL.md section 1:
 //  - linear:       small-strain FE, f = -K (x - X). Not rotation invariant.
 //  - corotational: f = -R K (R^T x - X), R the rotation of the polar decomposition of F.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Rotation part of the polar decomposition F = R S (R a proper rotation, S symmetric), used by
 // corotational FE.
 #include <Eigen/Core>

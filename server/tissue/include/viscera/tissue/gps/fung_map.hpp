@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Fung's exponential stiffening of an edge strain e (docs/MODEL.md section 4), in two forms:
 //  - the edge map g(e) = (exp(B e) - 1) / B (the published QLV elastic response, applied to each
 //    edge: exact in 1D, but in a tetrahedron t = H g is not the gradient of an energy);

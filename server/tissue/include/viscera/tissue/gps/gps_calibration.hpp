@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Calibration of the generalized particle system's 36 constants per tetrahedron from linear FE
 // (docs/MODEL.md section 1; the paper, section 3). Edge tensions t = C dL with C = diag(1/L0) H.
 #include <array>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // What a GPS model is composed of beyond its linear elastic law (docs/MODEL.md sections 1-3):
 // four independent parts, each with its own validity rule, and the two rules between them.
 //

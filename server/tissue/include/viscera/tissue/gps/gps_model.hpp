@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The generalized particle system (the paper's Eq. (1), docs/MODEL.md section 1): every edge of a
 // tetrahedron carries a tension that depends on all six edge elongations,
 //     t = C dL,   C = diag(1/L0) H   (36 constants per tet, calibrated to linear FE),

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Loads and constraints shared by the integrators: lumped masses, gravity, fixed nodes and nodes
 // whose position is prescribed as a function of rest position and time.
 #include <functional>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Explicit symplectic Euler (docs/MODEL.md section 2): v += dt M^-1 (f_int + f_ext);
 // v *= exp(-alpha dt) (mass-proportional damping, integrated exactly); x += dt v.
 // The step is the computed critical step times a safety factor, never a guess.

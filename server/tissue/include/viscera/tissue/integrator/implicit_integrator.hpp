@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Implicit backward Euler with full Newton iterations (docs/MODEL.md section 2): each step solves
 //   r(x) = M (1 + alpha dt) / dt^2 (x - x_n) - M v_n / dt - f_int(x) - f_ext = 0
 // on the free degrees of freedom with the symmetrised tangent M (1 + alpha dt) / dt^2 + K(x),

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Selective mass scaling: the explicit step is set by the few smallest, stiffest elements
 // (slivers left by meshing and refinement), not by the organ. Giving just those elements more
 // mass lengthens the stable step for a small, stated amount of added mass, as explicit FE codes

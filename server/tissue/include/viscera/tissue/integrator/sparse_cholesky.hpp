@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A symmetric positive definite sparse matrix with a fixed pattern (upper triangle, compressed
 // columns) and its CHOLMOD Cholesky factorisation. The symbolic analysis (fill-reducing ordering)
 // is done once; each factorize() redoes only the numeric part.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Linear elasticity matrices D (6x6, Voigt order xx yy zz yz xz xy, engineering shear),
 // the material input of every model. Moduli in pascals.
 #include <string>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Material files (JSON), documented in docs/MATERIAL.md:
 //   { "density_kg_m3": 1060,
 //     "elasticity": { "type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45 } }

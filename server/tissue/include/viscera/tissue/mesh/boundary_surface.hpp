@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The boundary of a tetrahedral mesh: faces that belong to exactly one tetrahedron, oriented
 // so that (b - a) x (c - a) points out of the mesh.
 #include <array>

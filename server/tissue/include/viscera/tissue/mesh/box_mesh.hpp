@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 #include "viscera/tissue/mesh/tet_mesh.hpp"
 
 namespace viscera::tissue {

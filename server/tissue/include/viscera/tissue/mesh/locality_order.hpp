@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Tetrahedra in the order of a space-filling curve through their centroids, and nodes numbered in
 // the order those tetrahedra last touch them: consecutive elements then share vertices, and the
 // nodes of the elements from any one onwards to the end are exactly the highest-numbered ones (so

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Collects nodes by their file ids and tetrahedra by node ids, then resolves them into a
 // TetMesh with contiguous indices, and the
 // tetrahedra's group tags into element sets. Used by every reader, so that id errors read the same.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Reading tetrahedral meshes: Gmsh .msh (legacy v1, ASCII v2 and v4.1), legacy VTK ASCII
 // unstructured grids (.vtk) and ASCII VTU (.vtu). Only linear tetrahedra are volume elements;
 // surface and line elements are ignored, other volume elements are an error. Every mesh that is

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A tetrahedral mesh: rest positions (metres) and vertex indices of each tetrahedron,
 // positively oriented (signed volume > 0, see element/tet_geometry.hpp).
 #include <array>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A whitespace tokenizer over a whole text file that knows its line numbers, so that every
 // parse error names the file, the line and the field.
 #include <string>

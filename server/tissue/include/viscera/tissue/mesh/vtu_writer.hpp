@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Writes simulation frames as ASCII VTU (ParaView) and a .pvd collection for time series.
 #include <span>
 #include <string>

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The one interface the integrators use: internal elastic forces, the potential energy, and
 // per-element tangent stiffness blocks. A model is immutable after construction, so the same
 // positions give the same forces bit for bit (no hidden state).

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Builds a force model by name, the names used by tools, scenes and benchmarks.
 #include <memory>
 #include <string>

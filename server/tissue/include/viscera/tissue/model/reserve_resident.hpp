@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Room reserved in a vector and written once, so that its pages are resident: a vector that later
 // grows into it takes no page faults. A cut of the 12k liver grows the model's lanes, the memory
 // variables and the mesh into fresh pages at nearly every sweep, and in a virtual machine each

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Kjartansson's (1979) exact constant-Q model (docs/MODEL.md section 3): complex modulus
 // M(w) = M0 (i w / w0)^(2 gamma), gamma = arctan(1/Q) / pi, so that tan(delta) = 1/Q at every
 // frequency. M0 = |M| at the reference frequency w0.

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // Fit of L standard linear solids (memory variables) to a constant Q over a frequency band
 // (docs/MODEL.md section 3). Relaxation frequencies and weights are both optimised, for the smallest
 // largest relative error of Q over the band, so that 3 mechanisms reach about +-17% and 4 about

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // The paper's Figure 2 (docs/MODEL.md section 3): a block 10 cm thick (rho = 1e3 kg/m^3,
 // |G| = 1e3 Pa at 2 Hz, Q = 4.8), base fixed, top sheared by a constant traction for 1 s, then
 // released. Top displacement per pascal of traction, 0-4 s, from:

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // A layer of thickness H in simple shear (the paper's Figure 2): base fixed, top loaded by a
 // uniform shear traction tau(t), shear waves travelling between the faces. Two solutions:
 //  - exact, for any linear viscoelastic material given by its modulus M(s) in the Laplace variable

@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // L standard linear solids in parallel, written with memory variables (Emmerich & Korn 1987;
 // docs/MODEL.md section 3):
 //     sigma = M_U (eps - sum_l Y_l zeta_l),   d zeta_l / dt = w_l (eps - zeta_l).

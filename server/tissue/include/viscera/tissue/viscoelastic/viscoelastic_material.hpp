@@ -1,4 +1,4 @@
-#pragma once
+#pragma once  // SPDX-License-Identifier: Apache-2.0
 // From what a user states (elastic constants at a reference frequency, Q in shear and in bulk,
 // the band, the number of mechanisms) to what the GPS needs: the unrelaxed elasticity and the
 // memory-variable weights, shear and bulk sharing the relaxation frequencies. Also the
