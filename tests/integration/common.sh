@@ -12,6 +12,8 @@ failures=0; passed=0; failed_names=
 # A CI log keeps only the first lines of a failing test's output: what the script prints goes to a
 # file, and show_output (in the script's EXIT trap, and by `finish`, its last command) prints the
 # verdict and the failures' reasons first, then the whole output, then the verdict again.
+# A test killed at its timeout prints only the line below: its output stays in that file.
+echo "$(basename "$0" .sh): output in $tmp/output.log, printed when the script ends"
 exec 3>&1 4>&2 > "$tmp/output.log" 2>&1
 output_shown=
 show_output() {
