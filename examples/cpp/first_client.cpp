@@ -10,7 +10,10 @@ int main(int argc, char** argv) {
   using namespace std::chrono;
   viscera::client::Client client(argc > 1 ? std::atoi(argv[1]) : 0, 42);  // DDS domain, this client's id
   const auto scene = client.wait_for_scene(seconds(10));
-  if (!scene || !client.claim(1, seconds(5))) return 1;
+  if (!scene || !client.claim(1, seconds(5))) {
+    std::fputs("no viscera-server on this domain, or its probe 1 is taken\n", stderr);
+    return 1;
+  }
   const auto &lo = scene->bounds_min, &hi = scene->bounds_max;
   auto next = steady_clock::now();
   for (int ms = 0; ms <= 4000; ++ms, next += milliseconds(1)) {
