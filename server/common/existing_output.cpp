@@ -18,6 +18,8 @@ void refuse_existing_folder(const std::string& dir, bool replace, const std::str
   const auto status = std::filesystem::symlink_status(dir, ec);
   if (replace || !std::filesystem::exists(status)) return;
   if (std::filesystem::is_directory(status) && std::filesystem::directory_iterator(dir, ec) == std::filesystem::directory_iterator()) return;
+  if (std::filesystem::is_symlink(status))
+    throw InputError(dir, 0, flag, "is a symbolic link: pass --replace to write into the folder it names, or name a new folder");
   throw InputError(dir, 0, flag, "holds files already: pass --replace to write into it (files of the same names are replaced), or name a new folder");
 }
 

@@ -9,7 +9,7 @@ namespace viscera::common {
 /// Throws InputError naming `path` and `flag` if something is at `path` (a file, a link, a folder)
 /// and `replace` is false.
 void refuse_existing_output(const std::string& path, bool replace, const std::string& flag);
-/// A folder of outputs: throws InputError naming `dir` and `flag` if it exists and holds anything
+/// A folder of outputs: throws InputError naming `dir` and `flag` if it holds anything or is a link
 /// and `replace` is false (an empty folder, or none, is written into).
 void refuse_existing_folder(const std::string& dir, bool replace, const std::string& flag);
 
