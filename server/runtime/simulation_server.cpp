@@ -353,9 +353,13 @@ ServerStats SimulationServer::run(const std::atomic<bool>& stop, double duration
     statistics.tick(1e-3 * static_cast<double>(step_ns), std::chrono::duration<double, std::micro>(tick_start - next).count());
     const auto t1 = clock::now();
     if (t1 - last_report >= std::chrono::seconds(1)) {
+      // Stamped when its counts were taken (the end of this tick), not when it is written: a stall
+      // between the two (a busy machine) made a report's ticks and missed slots lag its stamp by
+      // 15 ms, and the slots of the grid between two reports no longer added up.
+      const std::int64_t counted_ns = proto::now_ns();
       statistics.close_window(std::chrono::duration<double>(t1 - last_report).count(), s.stats);
       s.collect_counts();
-      s.endpoints.write_telemetry(proto::encode(telemetry_report(s.stats, proto::now_ns())));
+      s.endpoints.write_telemetry(proto::encode(telemetry_report(s.stats, counted_ns)));
       if (status) status(s.status_now());
       last_report = t1;
     }
