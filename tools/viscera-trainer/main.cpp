@@ -48,11 +48,9 @@ int conclude(const ScoreReport& r, const std::string& dir) {
   const std::string md = to_markdown(r);
   std::printf("%s", md.c_str());
   if (!dir.empty()) {
-    std::filesystem::create_directories(dir);
-    const std::string base = dir + "/" + r.exercise;
-    const std::string json = to_json(r).dump(2) + "\n";
-    viscera::common::write_file_bytes(base + ".json", std::span(reinterpret_cast<const std::uint8_t*>(json.data()), json.size()));
-    viscera::common::write_file_bytes(base + ".md", std::span(reinterpret_cast<const std::uint8_t*>(md.data()), md.size()));
+    const std::string base = dir + "/" + r.exercise;  // the folder was made before the work (main)
+    viscera::common::write_file_text(base + ".json", to_json(r).dump(2) + "\n");
+    viscera::common::write_file_text(base + ".md", md);
     std::printf("report: %s.json, %s.md\n", viscera::common::printable(base, 200).c_str(), viscera::common::printable(base, 200).c_str());
   }
   return r.passed ? 0 : 1;
@@ -167,17 +165,15 @@ int main(int argc, char** argv) {
     if (args.empty() || !((args[0] == "run" && args.size() == 2) || (args[0] == "score" && args.size() == 3)))
       throw UsageError("expected: run EXERCISE.json | score EXERCISE.json FILE.mcap (see --help)");
     const Exercise exercise = viscera::training::read_exercise_file(args[1]);
-    // Before the work: the report never replaces a file this run reads.
-    if (const std::string dir = cl.text("report-dir"); !dir.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(dir, ec);
-      if (ec || !std::filesystem::is_directory(dir)) throw viscera::common::InputError(dir, 0, "--report-dir", "is not a folder that can be written");
-    }
-    if (!cl.text("report-dir").empty())
+    // Before the work: the folder made, and the report never replaces a file this run reads, nor
+    // an earlier report unless asked.
+    if (!cl.text("report-dir").empty()) {
+      viscera::common::create_output_folder(cl.text("report-dir"), "--report-dir");
       for (const auto& f : report_files(cl.text("report-dir"), exercise.name)) {
         viscera::common::refuse_overwrite(f, {args.begin() + 1, args.end()}, "--report-dir");
         viscera::common::refuse_existing_output(f, cl.has("replace"), "--report-dir");
       }
+    }
     if (args[0] == "score") {
       if (cl.has("seed")) throw UsageError("--seed is for run: a recording holds the place the nodule had");
       return score(exercise, args[2], cl.text("report-dir"));
