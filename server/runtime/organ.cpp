@@ -8,6 +8,7 @@
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
 #include "viscera/runtime/organ_cutting.hpp"
+#include "viscera/runtime/stiffening_limit.hpp"
 #include "viscera/tissue/mesh/locality_order.hpp"
 #include "viscera/tissue/mesh/mesh_reader.hpp"
 #include "viscera/tissue/mesh/refinement.hpp"
@@ -50,8 +51,10 @@ Box fixed_slab(const SceneSpec& s, const Box& bounds) {
 
 /// Model, integrator and compliance of `organ` from its scene, material and mesh, once a tick at
 /// `rate_hz` is known to fit the budget (a step that cannot run is refused before any is taken).
-/// `field` names what the user chose (the material file, or the parameter changed).
-void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const std::string& source, const std::string& field) {
+/// `field` names what the user chose (the material file, or the parameter changed);
+/// `material_source` where the material's stiffening was given.
+void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const std::string& source, const std::string& field,
+                   const std::string& material_source) {
   const SceneSpec& s = organ.scene;
   const Material& material = organ.material;
   Mat6 D = material.elasticity;
@@ -96,6 +99,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   // The compliance predicts the simulated response, so it sees the same inertia.
   organ.substep_cost_s = time_substep(organ);
   check_tick_budget(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget, source, field);
+  check_stiffening(ve, s.largest_edge_strain, allowed_substep_growth(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget), material_source);
   enable_cutting(organ);  // before the compliance's worker reads the model
   organ.compliance = std::make_unique<ContactCompliance>(*organ.model, organ.integrator->mass_scaling().density_kg_m3, bc);
   // The worker reads the model while it factorises the uncut organ: a cuttable organ is ready once
@@ -204,7 +208,7 @@ std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& bud
   organ->boundary = extract_boundary(*organ->mesh);
   organ->regions = lay_out_regions(scene.regions, *organ->mesh, organ->boundary, fixed_slab(scene, organ->bounds), scene.source);
   for (const RegionSpec& r : scene.regions) organ->region_materials.push_back(read_material_file(r.material));
-  build_physics(*organ, scene.physics_rate_hz, budget, scene.source, "organ.material");
+  build_physics(*organ, scene.physics_rate_hz, budget, scene.source, "organ.material", scene.material);
   return organ;
 }
 
@@ -245,7 +249,7 @@ std::unique_ptr<Organ> rebuild_with_material(const Organ& organ, const protocol:
                         : change.density_kg_m3     ? "density_kg_m3"
                         : change.shear_q           ? "shear_q"
                                                    : "damping_per_s";
-  build_physics(*next, rate_hz, budget, source, changed);
+  build_physics(*next, rate_hz, budget, source, changed, source);
   return next;
 }
 

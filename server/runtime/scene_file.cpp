@@ -100,7 +100,7 @@ SceneSpec read_scene_file(const std::string& path) {
   const JsonObject o = top.object("organ");
   o.require_known({"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction", "physics_threads", "volume_term",
                    "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab",
-                   "regions", "strain_radius_m"});
+                   "regions", "strain_radius_m", "largest_edge_strain"});
   s.mesh = (dir / o.text("mesh")).string();
   s.material = (dir / o.text("material")).string();
   s.model = o.choice("model", {"gps", "gps_energy", "corotational", "linear"}, "gps_energy");
@@ -116,6 +116,7 @@ SceneSpec read_scene_file(const std::string& path) {
   s.grasp_stiffness_n_per_m = o.number("grasp_stiffness_n_per_m", 1e-3, 1e7, 100.0);
   s.contact_damping_s_per_m = o.number("contact_damping_s_per_m", 0, 1e4, 0.0);
   s.strain_radius_m = o.number("strain_radius_m", 0.001, 0.05, 0.02);
+  s.largest_edge_strain = o.number("largest_edge_strain", 0.01, 1.5, 0.4);
   if (o.has("fix_slab")) {
     const json& f = o.array("fix_slab");
     if (f.size() != 3 || !f[0].is_string() || !f[1].is_string() || !f[2].is_number())

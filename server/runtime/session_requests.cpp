@@ -6,6 +6,7 @@
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/protocol/request_json.hpp"
+#include "viscera/runtime/stiffening_limit.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 
 #include "simulation_server_impl.hpp"
@@ -113,6 +114,10 @@ bool SimulationServer::Impl::control(const proto::SessionRequest& req, const Sta
       return refuse("physics rate " + common::short_number(req.physics_rate_hz) + " Hz: whole hertz only");
     try {
       check_tick_budget(organ->integrator->dt_s(), organ->substep_cost_s, req.physics_rate_hz, budget, "set_physics_rate", "physics_rate_hz");
+      // A slower rate takes more sub-steps a tick: the stiffened ones may no longer fit it.
+      check_stiffening(organ->model_recipe.mechanisms, scene.largest_edge_strain,
+                       allowed_substep_growth(organ->integrator->dt_s(), organ->substep_cost_s, req.physics_rate_hz, budget),
+                       "set_physics_rate " + common::short_number(req.physics_rate_hz) + " Hz (material " + organ->material.name + ")");
     } catch (const InputError& e) {
       return refuse(e.what());
     }

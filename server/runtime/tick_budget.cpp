@@ -10,9 +10,6 @@ namespace viscera::runtime {
 using common::InputError;
 using common::short_number;
 
-using common::InputError;
-using common::short_number;
-
 long substeps_per_tick(double dt_s, double rate_hz) {
   // As ExplicitIntegrator::advance divides a tick: equal sub-steps no longer than dt.
   const double n = std::ceil(1.0 / (rate_hz * dt_s) * (1 - 1e-12));

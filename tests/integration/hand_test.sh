@@ -10,7 +10,8 @@
 # (the client claims again in the new scene, its tip still deep); the organ paused under a press
 # that goes on deeper (the frozen organ must not let the tip through: the force never falls to
 # zero while the tip is in it); a scalpel's cut button released with the blade 2 cm in the tissue
-# (it leaves the cut touching nothing).
+# (it leaves the cut touching nothing); the stiffest material the server takes pressed 3 cm (no
+# physics reset), a stiffer one refused.
 # Usage: hand_test.sh BUILD_DIR SOURCE_DIR
 set -u
 build="$1"; src="$2"
@@ -130,8 +131,40 @@ CSV
 "$hc" --domain "$domain" --client-id 1 --instrument 4 --trajectory "$tmp/release.csv" --frame organ-top --duration 4.8 --quiet \
   --report "$tmp/release.json" > "$tmp/hc-release.log" 2>&1
 rc_client=$?
-stop_server
 cat "$tmp/hc-release.log"
+
+# --- The stiffest stiffening the server takes, pressed 3 cm into the 1.5k liver; a stiffer one is
+# refused with its reason (server/runtime/stiffening_limit.hpp: B up to 18.8 in this form). ---
+"$ctl" load liver --domain "$domain" > "$tmp/ctl-stiff.log" 2>&1
+stiff() {  # B: a material file of the liver's elasticity with Fung's exponential in the energy form
+  printf '{"name": "stiff liver %s", "density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45},
+ "viscoelasticity": {"model": "constant_q", "shear_q": 4.8, "bulk_q": 4.8, "band_hz": [0.01, 10], "mechanisms": 3,
+ "reference_frequency_hz": 2, "qlv_stiffening": %s, "qlv_form": "energy"}}' "$1" "$1" > "$tmp/stiff-$1.json"
+}
+stiff 20; stiff 18.7
+"$ctl" material --file "$tmp/stiff-20.json" --domain "$domain" >> "$tmp/ctl-stiff.log" 2>&1; rc_refused=$?
+"$ctl" material --file "$tmp/stiff-18.7.json" --domain "$domain" >> "$tmp/ctl-stiff.log" 2>&1; rc_taken=$?
+cat "$tmp/ctl-stiff.log"
+check "stiff: B = 20 refused naming the field and the largest B (rc $rc_refused)" \
+  "[ $rc_refused -eq 1 ] && grep -q 'viscoelasticity.qlv_stiffening' '$tmp/ctl-stiff.log' && grep -q 'B up to 18.8' '$tmp/ctl-stiff.log'"
+check "stiff: B = 18.7 taken (rc $rc_taken)" "[ $rc_taken -eq 0 ] && grep -q 'material stiff liver 18.7' '$tmp/ctl-stiff.log'"
+"$hc" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 --duration 6 --quiet --report "$tmp/stiff.json" \
+  > "$tmp/hc-stiff.log" 2>&1
+rc_client=$?
+stop_server
+cat "$tmp/hc-stiff.log"
+check "stiff: the 3 cm press ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
+check "stiff: no physics reset on the server" "! grep -q 'physics: ' '$tmp/server.log'"
+pycheck "$tmp/stiff.json" <<'PY'
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+s = r["samples"]
+mag = lambda x: math.sqrt(sum(c * c for c in x["rendered_force_n"]))
+worst = max(abs(mag(b) - mag(a)) for a, b in zip(s, s[1:]) if b["t_s"] - a["t_s"] <= 1.05e-3)
+print(f"[ figure ] stiffest accepted material pressed 3 cm: peak {max(mag(x) for x in s):.3f} N, largest 1 ms change {worst:.3f} N")
+assert max(mag(x) for x in s) > 0.5, "the probe never pressed"
+assert worst <= r["slew_limit"]["n_per_ms"] + 1e-9, f"the force changed by {worst:.3f} N in one sample"
+PY
 check "scalpel: the client ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
 check "scalpel: no physics reset on the server" "! grep -q 'physics: ' '$tmp/server.log'"
 pycheck "$tmp/release.json" <<'PY'

@@ -1,6 +1,6 @@
 // The GPS's elastic energy, whole or one element's (docs/TISSUE.md): 0.5 dL^T H dL over the  // SPDX-License-Identifier: Apache-2.0
 // elements, with the edge map's stiffening where it has an energy, plus the volume term; and how
-// much stiffer than at rest the energy's curvature grows with the edge strain.
+// much stiffer than at rest the energy's curvature grows with the edge strain (GpsMechanisms).
 #include <algorithm>
 #include <cmath>
 
@@ -42,17 +42,18 @@ double GpsModel::energy(std::span<const Vec3> x) const {
   return sum;
 }
 
-double GpsModel::stiffness_growth(double edge_strain) const {
-  const GpsMechanisms& mech = options_.mechanisms;
-  if (!mech.stiffening.active() && !mech.asymmetry.active()) return 1.0;
+double GpsModel::stiffness_growth(double edge_strain) const { return options_.mechanisms.stiffness_growth(edge_strain); }
+
+double GpsMechanisms::stiffness_growth(double edge_strain) const {
+  if (!stiffening.active() && !asymmetry.active()) return 1.0;
   // h h' is the edge map g in both forms, so h'^2 + h h'' = g' (the published form's tangent
   // H diag(g')); the curvature grows monotonically in |e| for every shape, so its ends bound it.
-  const double b = mech.stiffening.b, r = mech.asymmetry.compression_ratio, e = std::abs(edge_strain);
+  const double b = stiffening.b, r = asymmetry.compression_ratio, e = std::abs(edge_strain);
   const auto curvature = [&](double strain) {
-    const FungEnergyMap f = edge_energy_map(b, r, strain, mech.stiffening.shape);
+    const FungEnergyMap f = edge_energy_map(b, r, strain, stiffening.shape);
     return f.dh * f.dh + std::abs(f.h * f.d2h);
   };
-  const double rest = edge_energy_map(b, r, 0.0, mech.stiffening.shape).dh;
+  const double rest = edge_energy_map(b, r, 0.0, stiffening.shape).dh;
   return std::max({1.0, curvature(e) / (rest * rest), curvature(-e) / (rest * rest)});
 }
 

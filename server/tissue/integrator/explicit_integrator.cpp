@@ -138,18 +138,9 @@ void ExplicitIntegrator::step_with(State& state, double dt) {
 }
 
 double ExplicitIntegrator::stiffened_step_s() const {
-  // The strain the next sub-step starts from is near the last one's; a tenth more (and 0.002)
-  // covers its rise over a sub-step where the tissue is pulled fast.
-  return dt_ / std::sqrt(model_.stiffness_growth(1.1 * last_edge_strain_ + 0.002));
+  // The strain the next sub-step starts from is near the last one's.
+  return dt_ / std::sqrt(model_.stiffness_growth(headroom_strain(last_edge_strain_)));
 }
-
-namespace {
-
-// More sub-steps than this per step of dt_s() and the tissue is past what an explicit step can
-// follow (a run away, not a stiffening organ): reported as an instability.
-constexpr double kMaxStiffenedSubSteps = 64;
-
-}  // namespace
 
 long ExplicitIntegrator::advance(State& state, double duration_s) {
   if (!(duration_s > 0)) return 0;
@@ -161,7 +152,7 @@ long ExplicitIntegrator::advance(State& state, double duration_s) {
   const auto sub_steps = [this](double duration, double longest) {
     if (!(longest * kMaxStiffenedSubSteps >= dt_))
       throw SimulationError("explicit integration went unstable: at edge strain " + short_number(last_edge_strain_) + " the tissue is " +
-                            short_number(model_.stiffness_growth(1.1 * last_edge_strain_ + 0.002)) + " times as stiff as at rest, its stable step " +
+                            short_number(model_.stiffness_growth(headroom_strain(last_edge_strain_))) + " times as stiff as at rest, its stable step " +
                             short_number(longest) + " s is below dt / " + short_number(kMaxStiffenedSubSteps));
     return std::max(1L, static_cast<long>(std::ceil(duration / longest * (1 - 1e-12))));
   };

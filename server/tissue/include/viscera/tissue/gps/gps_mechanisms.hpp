@@ -81,6 +81,9 @@ struct GpsMechanisms {
   bool energy_map() const { return stiffening.form == GpsStiffening::Form::energy && (stiffening.active() || asymmetry.active()); }
   /// Whether elements keep state between steps (the model's memory).
   bool has_memory() const { return viscous.active() || softening.active(); }
+  /// How many times stiffer than at rest an edge's response is at edge strains up to |edge_strain|
+  /// (>= 1): the growth of the stiffening and the asymmetry (GpsModel::stiffness_growth).
+  double stiffness_growth(double edge_strain) const;
   /// Each part's rule, then the rules between parts: the asymmetry lives in the energy form only,
   /// and the energy form relaxes the whole elastic tension, so bulk and shear must relax alike.
   void validate() const;

@@ -54,6 +54,13 @@ class ExplicitIntegrator {
   /// The longest sub-step the model's stiffening allows after the last force evaluation [s]
   /// (dt_s() for a model without stiffening).
   double stiffened_step_s() const;
+  /// The edge strain a sub-step's length is chosen for, after one whose force evaluation saw
+  /// `edge_strain`: a tenth more (and 0.002) covers its rise over a sub-step where the tissue is
+  /// pulled fast.
+  static double headroom_strain(double edge_strain) { return 1.1 * edge_strain + 0.002; }
+  /// More sub-steps than this per step of dt_s() and the tissue is past what an explicit step can
+  /// follow (a run away, not a stiffening organ): advance() throws SimulationError.
+  static constexpr double kMaxStiffenedSubSteps = 64;
   /// Asked between the sub-steps of advance(): true stops it (a program that must stop at once).
   void set_interruption(std::function<bool()> interrupted) { interrupted_ = std::move(interrupted); }
 
