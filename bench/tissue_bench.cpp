@@ -142,9 +142,9 @@ void read_bandwidth(benchmark::State& st, std::size_t bytes) {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   for (const Level& level : levels()) {
-    for (const std::string m : {"gps", "gps_energy", "corotational", "linear"})
+    for (const std::string m : {"gps", "gps_energy", "gps_large_strain", "corotational", "linear"})
       benchmark::RegisterBenchmark(("Force/" + m + "/" + level.name).c_str(), force, m, &level)->Unit(benchmark::kMicrosecond);
-    for (const std::string m : {"gps", "gps_energy", "corotational", "linear", "gps_visco3", "scene"})
+    for (const std::string m : {"gps", "gps_energy", "gps_large_strain", "corotational", "linear", "gps_visco3", "scene"})
       benchmark::RegisterBenchmark(("Step/" + m + "/" + level.name).c_str(), step, m, &level)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("TipStrain/" + level.name).c_str(), tip_strain, &level)->Unit(benchmark::kMicrosecond);
   }

@@ -103,7 +103,7 @@ SceneSpec read_scene_file(const std::string& path) {
                    "regions", "strain_radius_m", "largest_edge_strain"});
   s.mesh = (dir / o.text("mesh")).string();
   s.material = (dir / o.text("material")).string();
-  s.model = o.choice("model", {"gps", "gps_energy", "corotational", "linear"}, "gps_energy");
+  s.model = o.choice("model", {"gps", "gps_energy", "gps_large_strain", "corotational", "linear"}, "gps_energy");
   s.scale_m_per_unit = o.number("scale_m_per_unit", 1e-6, 1e3, 1.0);
   s.damping_per_s = o.number("damping_per_s", 0, 1e4, 0.0);
   s.gravity_m_s2 = o.number("gravity_m_s2", 0, 100, 9.81);

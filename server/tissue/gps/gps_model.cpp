@@ -30,15 +30,28 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
     throw std::invalid_argument("GpsModel: volume_stiffness_fraction must lie in [0, 1)");
   with_volume_ = options_.volume_stiffness_fraction > 0.0;
   options_.mechanisms.validate();
+  if (options_.large_strain) {
+    if (options_.variant != GpsVariant::energy_consistent) throw std::invalid_argument("the large-strain GPS is energy-consistent");
+    if (with_volume_) throw std::invalid_argument("the large-strain GPS has no volume term: its backbone holds the volume");
+    if (options_.mechanisms.has_memory())
+      throw std::invalid_argument(
+          "the large-strain GPS is elastic for now: with memory variables the 1.5k liver pressed 35 mm went unstable (docs/TISSUE.md, \"Large "
+          "strain\")");
+    if (options_.mechanisms.energy_map())
+      throw std::invalid_argument("the large-strain GPS takes the stiffening in its edge-map form only (not \"qlv_form\": \"energy\")");
+  }
   const GpsViscous& viscous = options_.mechanisms.viscous;
   mechanisms_ = viscous.mechanisms();
   materials_ = std::move(materials);
   material_of_tet_ = std::move(material_of_tet);
   kappa_.resize(materials_.size());
   for (std::size_t m = 0; m < materials_.size(); ++m) kappa_[m] = options_.volume_stiffness_fraction * reuss_bulk_modulus(materials_[m]);
+  if (options_.large_strain)
+    for (const Mat6& D : materials_) backbone_.push_back(neo_hookean_of(D));
   const std::size_t n = element_count();
   blocks_.resize((n + L - 1) / L);
   if (viscous.bulk_differs()) bulk_.resize(blocks_.size());
+  if (options_.large_strain) neo_.resize(blocks_.size());
   for (std::size_t slot = 0; slot < blocks_.size() * L; ++slot) write_lane(slot);
 }
 
@@ -83,9 +96,19 @@ void GpsModel::write_lane(std::size_t slot) {
     for (int c = r; c < 6; ++c) b.H[k++][j] = H(r, c);
   b.rest_volume[j] = V0;
   b.kappa[j] = (with_volume_ && !padding) ? kappa_[m] : 0.0;
+  if (!neo_.empty()) {
+    NeoBlock& nb = neo_[slot / L];
+    const Mat3 dm_inv = rest_shape_inverse(rest);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) nb.dm_inv[3 * r + c][j] = dm_inv(r, c);
+    nb.mu[j] = padding ? 0.0 : backbone_[m].mu;
+    nb.lam[j] = padding ? 0.0 : backbone_[m].lam;
+    nb.alpha[j] = padding ? 1.0 : backbone_[m].alpha();
+  }
 }
 
 std::string_view GpsModel::name() const {
+  if (options_.large_strain) return "gps_large_strain";
   if (options_.variant == GpsVariant::paper) return with_volume_ ? "gps_volume" : "gps";
   return with_volume_ ? "gps_energy_volume" : "gps_energy";
 }
@@ -195,6 +218,12 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         nan_probe[j] += dL[k][j];  // a NaN anywhere survives in the sum; max() would drop it
       }
     }
+    double raw[6][L];  // the large-strain GPS: the elongations before any map or memory
+    const bool large = !neo_.empty();
+    if (large)
+      for (int k = 0; k < 6; ++k)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) raw[k][j] = dL[k][j];
     double strain[6][L];  // first-load softening: the edge strains before any map
     if constexpr (kMemory)
       if (softening > 0)
@@ -305,7 +334,13 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         }
       }
     }
-    if (!qlv_energy) apply_h(dL);
+    // The large-strain GPS of an elastic material without stiffening: its edges carry nothing.
+    const bool edges_idle = large && !kMemory && !(qlv > 0);
+    if (large)  // the linear edge response is the backbone's: the edges keep what departs from it
+      for (int k = 0; k < 6; ++k)
+#pragma omp simd
+        for (int j = 0; j < L; ++j) dL[k][j] -= raw[k][j];
+    if (!qlv_energy && !edges_idle) apply_h(dL);
     if constexpr (kMemory) {
       if (!bulk_.empty()) {  // + (K/V0) hv (hv . (a_b - a_s))
         const BulkBlock& bb = bulk_[bi];
@@ -317,12 +352,12 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         }
       }
     }
-    for (int k = 0; k < 6; ++k)
+    for (int k = 0; k < 6 && !edges_idle; ++k)
 #pragma omp simd
       for (int j = 0; j < L; ++j) t[k][j] *= kEnergyConsistent ? 1.0 / len[k][j] : b.inv_rest_length[k][j];
     // Vertex forces: +t Y on a, -t Y on b, plus the signed-volume term.
     double fv[4][3][L] = {};
-    for (int k = 0; k < 6; ++k) {
+    for (int k = 0; k < 6 && !edges_idle; ++k) {
       const int a = kTetEdges[k][0], c = kTetEdges[k][1];
       for (int d = 0; d < 3; ++d)
 #pragma omp simd
@@ -352,6 +387,41 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
           fv[2][d][j] += scale * g2[d];
           fv[3][d][j] += scale * g3[d];
           fv[0][d][j] -= scale * (g1[d] + g2[d] + g3[d]);
+        }
+      }
+    }
+    if (large) {
+      // The backbone: P = mu F + lam (J - alpha) cof(F), F = Ds Dm^-1; vertex forces -V0 P Dm^-T.
+      const NeoBlock& nb = neo_[bi];
+#pragma omp simd
+      for (int j = 0; j < L; ++j) {
+        double ds[3][3], F[3][3], dm[3][3];
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            ds[r][c] = p[c + 1][r][j] - p[0][r][j];
+            dm[r][c] = nb.dm_inv[3 * r + c][j];
+          }
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) F[r][c] = ds[r][0] * dm[0][c] + ds[r][1] * dm[1][c] + ds[r][2] * dm[2][c];
+        // cof(F), column by column: F1 x F2, F2 x F0, F0 x F1 (Fc: column c).
+        double C[3][3];
+        for (int c = 0; c < 3; ++c) {
+          const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+          C[0][c] = F[1][c1] * F[2][c2] - F[2][c1] * F[1][c2];
+          C[1][c] = F[2][c1] * F[0][c2] - F[0][c1] * F[2][c2];
+          C[2][c] = F[0][c1] * F[1][c2] - F[1][c1] * F[0][c2];
+        }
+        const double J = F[0][0] * C[0][0] + F[1][0] * C[1][0] + F[2][0] * C[2][0];
+        const double s = nb.lam[j] * (J - nb.alpha[j]), V0 = b.rest_volume[j];
+        for (int r = 0; r < 3; ++r) {
+          const double P0 = nb.mu[j] * F[r][0] + s * C[r][0], P1 = nb.mu[j] * F[r][1] + s * C[r][1], P2 = nb.mu[j] * F[r][2] + s * C[r][2];
+          double sum = 0.0;
+          for (int v = 0; v < 3; ++v) {  // -V0 (P Dm^-T)_{r v}: the force on vertex v + 1
+            const double h = -V0 * (P0 * dm[v][0] + P1 * dm[v][1] + P2 * dm[v][2]);
+            fv[v + 1][r][j] += h;
+            sum += h;
+          }
+          fv[0][r][j] -= sum;
         }
       }
     }

@@ -156,6 +156,26 @@ Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness
     const double V = signed_volume(p[0], p[1], p[2], p[3]);
     K += (kappa / V0) * g * g.transpose() + kappa * (V / V0 - 1.0) * volume_hessian(p);
   }
+  if (options_.large_strain) {
+    // The backbone's tangent in place of the linear edge response's, 0.5 dL^T H dL unscaled.
+    const Mat6 H1 = packed_hessian(e);
+    Vec6 raw;
+    for (int k = 0; k < 6; ++k) raw(k) = len(k) - edge_length(e, k);
+    const Vec6 t1 = H1 * raw;
+    for (int k = 0; k < 6; ++k) {
+      const int a = kTetEdges[k][0], b = kTetEdges[k][1];
+      const Eigen::Matrix<double, 1, 12> dt = (H1.row(k) * G - t1(k) / len(k) * G.row(k)) / len(k);
+      K.block<3, 12>(3 * a, 0) += Y.col(k) * dt;
+      K.block<3, 12>(3 * b, 0) -= Y.col(k) * dt;
+      const Mat3 I = (t1(k) / len(k)) * Mat3::Identity();
+      K.block<3, 3>(3 * a, 3 * a) -= I;
+      K.block<3, 3>(3 * a, 3 * b) += I;
+      K.block<3, 3>(3 * b, 3 * a) += I;
+      K.block<3, 3>(3 * b, 3 * b) -= I;
+    }
+    const auto rest = gather(mesh_->nodes, e);
+    K += neo_hookean_tangent(backbone(e), p, rest_shape_inverse(rest), signed_volume(rest[0], rest[1], rest[2], rest[3]));
+  }
   return K;
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "viscera/tissue/gps/gps_mechanisms.hpp"
+#include "viscera/tissue/gps/neo_hookean_backbone.hpp"
 #include "viscera/tissue/model/force_model.hpp"
 
 namespace viscera::tissue {
@@ -26,6 +27,16 @@ struct GpsOptions {
   double volume_stiffness_fraction = 0.0;
   /// Viscous part, stiffening, asymmetry and softening (gps_mechanisms.hpp).
   GpsMechanisms mechanisms;
+  /// The large-strain GPS (docs/TISSUE.md, "Large strain"): the elastic response is the stable
+  /// neo-Hookean solid of the material's moduli (gps/neo_hookean_backbone.hpp), and the edges carry
+  /// what the mechanisms add to or take from the linear edge response 0.5 dL^T H dL (the
+  /// relaxation, the edge map's stiffening): E = E_GPS - 0.5 dL^T H dL + V0 Psi(F). At small
+  /// strain the two edge terms cancel and the backbone is linear FE, so the sum is the GPS's as
+  /// before. Needs the energy-consistent variant, no volume term (the backbone holds the volume),
+  /// isotropic materials and the edge-map form of the stiffening; no memory variables yet (the
+  /// relaxation subtracts from a linear edge response the backbone no longer has: on the 1.5k
+  /// liver it went unstable under a 35 mm press).
+  bool large_strain = false;
 };
 
 class GpsModel final : public ForceModel {
@@ -78,6 +89,8 @@ class GpsModel final : public ForceModel {
   std::size_t memory_size_for(std::size_t elements) const;
   /// The paper's 36 constants C = diag(1/L0) H of element e (the volume term excluded).
   Mat6 paper_constants(std::size_t e) const;
+  /// The large-strain GPS's backbone of element e, its Dm^-1 and rest volume.
+  NeoHookean backbone(std::size_t e) const { return backbone_[material_of(e)]; }
   /// H of element e (symmetric 6x6) as used by the model.
   Mat6 edge_hessian(std::size_t e) const;
   /// Element e's index into the materials (0 without per-element materials).
@@ -93,6 +106,12 @@ class GpsModel final : public ForceModel {
     double H[21][kLanes];  ///< upper triangle of H, row by row
     double rest_volume[kLanes];
     double kappa[kLanes];  ///< signed-volume stiffness [Pa] (0 when the term is off)
+  };
+
+  /// Per block, for the large-strain GPS: each lane's backbone (padding lanes: all zero).
+  struct NeoBlock {
+    double dm_inv[9][kLanes];  ///< Dm^-1, row by row
+    double mu[kLanes], lam[kLanes], alpha[kLanes];
   };
 
   /// Per block, for bulk weights that differ from the shear weights: H_vol = s hv hv^T.
@@ -131,6 +150,8 @@ class GpsModel final : public ForceModel {
   bool with_volume_ = false;
   std::vector<Block> blocks_;  ///< padding lanes have H = 0 and copy a real element
   std::vector<BulkBlock> bulk_;  ///< only when bulk and shear relax differently
+  std::vector<NeoBlock> neo_;  ///< only for the large-strain GPS
+  std::vector<NeoHookean> backbone_;  ///< per material, for the large-strain GPS
   std::size_t mechanisms_ = 0;
   std::vector<Mat6> materials_;
   std::vector<std::uint16_t> material_of_tet_;  ///< empty: all material 0

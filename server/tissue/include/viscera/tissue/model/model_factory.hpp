@@ -9,7 +9,9 @@
 
 namespace viscera::tissue {
 
-/// "gps" (paper form), "gps_energy" (energy-consistent), "corotational", "linear".
+/// "gps" (paper form), "gps_energy" (energy-consistent), "gps_large_strain" (energy-consistent
+/// with the neo-Hookean backbone, GpsOptions::large_strain; it takes no volume term and ignores
+/// volume_fraction), "corotational", "linear".
 /// `material_of_tet`: each element's index into `materials` (empty: all the first).
 /// volume_fraction > 0 adds the signed-volume term to the GPS variants; the mechanisms (memory
 /// variables, Kelvin-Voigt, stiffening, asymmetry, softening) need a GPS variant (InputError otherwise).
