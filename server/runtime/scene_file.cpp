@@ -152,8 +152,8 @@ SceneSpec read_scene_file(const std::string& path) {
     spec.tip_radius_m = i.number("tip_radius_m", 1e-4, 0.05, spec.kind == InstrumentKind::scalpel ? 0.001 : 0.005);
     spec.blade_length_m = i.number("blade_length_m", 1e-3, 0.1, 0.02);
     spec.cut_force_n = i.number("cut_force_n", 0.01, 50.0, 0.0);
-    if (spec.kind == InstrumentKind::scalpel && s.model != "gps" && s.model != "gps_energy")
-      i.fail("kind", "scalpel: the organ's model '" + s.model + "' cannot follow a cut (gps and gps_energy can)");
+    if (spec.kind == InstrumentKind::scalpel && s.model != "gps" && s.model != "gps_energy" && s.model != "gps_large_strain")
+      i.fail("kind", "scalpel: the organ's model '" + s.model + "' cannot follow a cut (gps, gps_energy and gps_large_strain can)");
     s.instruments.push_back(spec);
   }
   return s;

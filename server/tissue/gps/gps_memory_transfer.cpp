@@ -72,6 +72,7 @@ std::vector<double> GpsModel::memory_from(const GpsModel& before, std::span<cons
 void GpsModel::reserve_elements(std::size_t elements) {
   reserve_resident(blocks_, (elements + kLane - 1) / kLane);
   if (!bulk_.empty()) reserve_resident(bulk_, (elements + kLane - 1) / kLane);
+  if (!neo_.empty()) reserve_resident(neo_, (elements + kLane - 1) / kLane);
 }
 
 std::size_t GpsModel::memory_size_for(std::size_t elements) const {
@@ -130,6 +131,7 @@ void GpsModel::follow_edit(const MeshEdit& edit, std::vector<double>& memory) {
   // Grow the blocks, rewrite the changed lanes and the last block's padding.
   blocks_.resize((n + kLane - 1) / kLane);
   if (!bulk_.empty()) bulk_.resize(blocks_.size());
+  if (!neo_.empty()) neo_.resize(blocks_.size());
   for (const std::int32_t e : changed) write_lane(static_cast<std::size_t>(e));
   for (std::size_t slot = n; slot < blocks_.size() * kLane; ++slot) write_lane(slot);
   if (!with_memory) return;
