@@ -99,7 +99,8 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   // The compliance predicts the simulated response, so it sees the same inertia.
   organ.substep_cost_s = time_substep(organ);
   check_tick_budget(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget, source, field);
-  check_stiffening(ve, s.largest_edge_strain, allowed_substep_growth(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget), material_source);
+  check_stiffening(ve, s.largest_edge_strain, allowed_substep_growth(organ.integrator->dt_s(), organ.substep_cost_s, rate_hz, budget),
+                   material_source);
   enable_cutting(organ);  // before the compliance's worker reads the model
   organ.compliance = std::make_unique<ContactCompliance>(*organ.model, organ.integrator->mass_scaling().density_kg_m3, bc);
   // The worker reads the model while it factorises the uncut organ: a cuttable organ is ready once

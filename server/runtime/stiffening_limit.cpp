@@ -70,13 +70,15 @@ void check_stiffening(const GpsMechanisms& mech, double largest_edge_strain, dou
   const double strain = ExplicitIntegrator::headroom_strain(largest_edge_strain);
   const double growth = std::sqrt(mech.stiffness_growth(strain));
   const std::string at = "at edge strain " + figure(strain) + " (organ.largest_edge_strain " + short_number(largest_edge_strain) + " + headroom)";
-  const std::string limit = "at most " + figure(allowed) +
-                            (allowed < ExplicitIntegrator::kMaxStiffenedSubSteps ? " fit this tick's budget (viscera-server --max-tick-ms)"
-                                                                                 : ": past that the integrator calls the organ unstable and resets it");
+  const std::string limit =
+      "at most " + figure(allowed) +
+      (allowed < ExplicitIntegrator::kMaxStiffenedSubSteps ? " fit this tick's budget (viscera-server --max-tick-ms)"
+                                                           : ": past that the integrator calls the organ unstable and resets it");
   const double largest = largest_stiffening(mech, largest_edge_strain, allowed);
   if (!mech.stiffening.active() || largest == 0)
-    throw InputError(source, 0, "viscoelasticity.compression_ratio",
-                     short_number(mech.asymmetry.compression_ratio) + " needs " + figure(growth) + " times the explicit sub-steps " + at + "; " + limit);
+    throw InputError(
+        source, 0, "viscoelasticity.compression_ratio",
+        short_number(mech.asymmetry.compression_ratio) + " needs " + figure(growth) + " times the explicit sub-steps " + at + "; " + limit);
   const std::string lower = "; this organ takes B up to " + short_number(std::floor(largest * 10) / 10) + " in this form and shape";
   if (growth > allowed)
     throw InputError(source, 0, "viscoelasticity.qlv_stiffening",

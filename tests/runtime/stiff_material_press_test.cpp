@@ -41,7 +41,9 @@ Press press(const SceneSpec& spec, double depth_m) {
   const Box& b = organ->bounds;
   Vec3 tool(0.5 * (b.lo.x() + b.hi.x()), 0.5 * (b.lo.y() + b.hi.y()), b.hi.z() + 0.002), tool_velocity = Vec3::Zero();
   ContactResult last;
-  organ->integrator->boundary_conditions().force_field = [&](const BoundaryConditions::FieldEvaluation& e) { last = probe.apply(tool, tool_velocity, e); };
+  organ->integrator->boundary_conditions().force_field = [&](const BoundaryConditions::FieldEvaluation& e) {
+    last = probe.apply(tool, tool_velocity, e);
+  };
   State state = State::at_rest(*organ->mesh);
   Press r;
   double contact_z = NAN;
@@ -69,8 +71,8 @@ SceneSpec scene_with(const std::string& stiffening_json, const std::string& name
   std::ofstream(path) << R"({"name": ")" << name
                       << R"(", "density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45},
   "viscoelasticity": {"model": "constant_q", "shear_q": 4.8, "bulk_q": 4.8, "band_hz": [0.01, 10], "mechanisms": 3,
-  "reference_frequency_hz": 2, )" << stiffening_json
-                      << "}}";
+  "reference_frequency_hz": 2, )"
+                      << stiffening_json << "}}";
   SceneSpec spec = read_scene_file(kScene);
   spec.material = path;
   return spec;

@@ -2,13 +2,14 @@
 // against its closed forms: the stiffness growth of each shape (gps/fung_map.hpp: g'(e) =
 // exp(B e), 1 + B^2 e^2 / 2) at the 64-sub-step cap, and the edge map's compressive secant
 // (1 - exp(-B e)) / (B e) at one half; and what its refusals say.
+#include "viscera/runtime/stiffening_limit.hpp"
+
 #include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "viscera/common/input_error.hpp"
-#include "viscera/runtime/stiffening_limit.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 
 using namespace viscera::runtime;
@@ -16,7 +17,7 @@ using namespace viscera::tissue;
 
 namespace {
 
-constexpr double kStrain = 0.4;                     // the scene's default largest_edge_strain
+constexpr double kStrain = 0.4;  // the scene's default largest_edge_strain
 constexpr double kHeadroom = 1.1 * kStrain + 0.002;  // the integrator's, written out
 constexpr double kCap = 64;
 
@@ -40,7 +41,8 @@ std::string refusal(const GpsMechanisms& m, double allowed = kCap) {
 TEST(StiffeningLimit, TheEnergyFormsLargestBIsWhereTheGrowthMeetsTheCap) {
   // exponential: the curvature g'(e) = exp(B e) is largest in tension; sqrt(exp(B e)) = 64.
   const double exponential = 2 * std::log(kCap) / kHeadroom;
-  EXPECT_NEAR(largest_stiffening(stiffening(GpsStiffening::Form::energy, StiffeningShape::exponential), kStrain, kCap), exponential, 2e-3 * exponential);
+  EXPECT_NEAR(largest_stiffening(stiffening(GpsStiffening::Form::energy, StiffeningShape::exponential), kStrain, kCap), exponential,
+              2e-3 * exponential);
   EXPECT_NEAR(largest_stiffening(stiffening(GpsStiffening::Form::energy, StiffeningShape::odd_exponential), kStrain, kCap), exponential,
               2e-3 * exponential);
   // odd_polynomial: g'(e) = 1 + B^2 e^2 / 2 = 64^2.
@@ -67,7 +69,7 @@ TEST(StiffeningLimit, TheEdgeMapsLargestBIsWhereACompressedEdgeCarriesHalfTheLin
 TEST(StiffeningLimit, TheAllowedGrowthIsTheCapOrTheTicksBudget) {
   // dt 0.25 ms: 4 sub-steps a 1 ms tick at rest.
   EXPECT_DOUBLE_EQ(allowed_substep_growth(0.25e-3, 0, 1000, TickBudget{}), kCap);
-  EXPECT_DOUBLE_EQ(allowed_substep_growth(0.25e-3, 0, 1000, TickBudget{0.1, 100}), 25.0);             // 100 sub-steps a tick
+  EXPECT_DOUBLE_EQ(allowed_substep_growth(0.25e-3, 0, 1000, TickBudget{0.1, 100}), 25.0);  // 100 sub-steps a tick
   EXPECT_DOUBLE_EQ(allowed_substep_growth(0.25e-3, 100e-6, 1000, TickBudget{10e-3, 10'000}), 25.0);  // 10 ms of 100 us sub-steps
   EXPECT_DOUBLE_EQ(ExplicitIntegrator::headroom_strain(kStrain), kHeadroom);
 }

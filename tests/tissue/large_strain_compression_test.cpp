@@ -84,8 +84,9 @@ Compression compress(const ForceModel& model, const TetMesh& mesh, double to) {
       r.compression.push_back(s.time_s);
       r.nominal_pa.push_back(reaction / (kSide * kSide));
       for (const Tet& t : mesh.tets)
-        r.smallest_volume_ratio = std::min(r.smallest_volume_ratio, signed_volume(s.x[t[0]], s.x[t[1]], s.x[t[2]], s.x[t[3]]) /
-                                                                        signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]));
+        r.smallest_volume_ratio =
+            std::min(r.smallest_volume_ratio, signed_volume(s.x[t[0]], s.x[t[1]], s.x[t[2]], s.x[t[3]]) /
+                                                  signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]));
     }
     for (int k = steps - 1; k >= 0; --k) {
       s.time_s = 0.01 * k;
@@ -152,8 +153,9 @@ TEST(LargeStrainCompression, TheGpsOfThePaperAndCorotationalFeSoftenBeside) {
       std::snprintf(b, sizeof b, " %.0f%%: %.2f", 100 * r.compression[k], r.nominal_pa[k] / neo_hookean_nominal(1 - r.compression[k]));
       line += b;
     }
-    std::printf("[ figure ] %s, nominal stress / neo-Hookean's:%s%s\n", std::string(m->name()).c_str(), line.c_str(),
-                r.stopped.empty() ? "" : (" (no equilibrium past " + std::to_string(static_cast<int>(100 * r.compression.back() + 0.5)) + "%)").c_str());
+    std::printf(
+        "[ figure ] %s, nominal stress / neo-Hookean's:%s%s\n", std::string(m->name()).c_str(), line.c_str(),
+        r.stopped.empty() ? "" : (" (no equilibrium past " + std::to_string(std::lround(100 * r.compression.back())) + "%)").c_str());
   }
 }
 
@@ -179,6 +181,7 @@ TEST(LargeStrainShear, SimpleShearToOneIsTheNeoHookeansMuGamma) {
     for (auto i : top) reaction -= solver.last_internal_forces()[i].x();
     const double shear = reaction / (kSide * kSide), reference = kMu * s.time_s;
     EXPECT_NEAR(shear / reference, 1.0, 0.10) << "gamma " << s.time_s;
-    if (k == 10) std::printf("[ figure ] simple shear to gamma 1: %.1f Pa, neo-Hookean mu gamma %.1f Pa (%.4f)\n", shear, reference, shear / reference);
+    if (k == 10)
+      std::printf("[ figure ] simple shear to gamma 1: %.1f Pa, neo-Hookean mu gamma %.1f Pa (%.4f)\n", shear, reference, shear / reference);
   }
 }

@@ -43,7 +43,8 @@ NeoHookean neo_hookean_of(const Mat6& D) {
     if (!near(D(i, i), lambda + 2 * mu) || !near(D(i + 3, i + 3), mu))
       throw std::invalid_argument("the large-strain GPS needs an isotropic material (its neo-Hookean backbone)");
     for (int j = 0; j < 3; ++j)
-      if (i != j && !near(D(i, j), lambda)) throw std::invalid_argument("the large-strain GPS needs an isotropic material (its neo-Hookean backbone)");
+      if (i != j && !near(D(i, j), lambda))
+        throw std::invalid_argument("the large-strain GPS needs an isotropic material (its neo-Hookean backbone)");
   }
   if (!(mu > 0 && lambda + mu > 0)) throw std::invalid_argument("the large-strain GPS needs positive shear and lambda + mu");
   return {mu, lambda + mu};

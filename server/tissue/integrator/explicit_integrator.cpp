@@ -152,8 +152,9 @@ long ExplicitIntegrator::advance(State& state, double duration_s) {
   const auto sub_steps = [this](double duration, double longest) {
     if (!(longest * kMaxStiffenedSubSteps >= dt_))
       throw SimulationError("explicit integration went unstable: at edge strain " + short_number(last_edge_strain_) + " the tissue is " +
-                            short_number(model_.stiffness_growth(headroom_strain(last_edge_strain_))) + " times as stiff as at rest, its stable step " +
-                            short_number(longest) + " s is below dt / " + short_number(kMaxStiffenedSubSteps));
+                            short_number(model_.stiffness_growth(headroom_strain(last_edge_strain_))) +
+                            " times as stiff as at rest, its stable step " + short_number(longest) + " s is below dt / " +
+                            short_number(kMaxStiffenedSubSteps));
     return std::max(1L, static_cast<long>(std::ceil(duration / longest * (1 - 1e-12))));
   };
   if (state.time_s != last_step_end_s_) last_edge_strain_ = 0.0;  // a state not left by the last step (reset, reloaded)

@@ -15,7 +15,7 @@
 namespace viscera::tissue {
 
 struct NeoHookean {
-  double mu = 0.0;   ///< shear modulus [Pa]
+  double mu = 0.0;  ///< shear modulus [Pa]
   double lam = 0.0;  ///< lambda_Lame + mu [Pa]
   double alpha() const { return 1.0 + mu / lam; }
 };
