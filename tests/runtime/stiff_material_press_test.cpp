@@ -117,7 +117,7 @@ INSTANTIATE_TEST_SUITE_P(Forms, StiffestAccepted,
                          ::testing::Values(Form{"edge_map", R"("qlv_form": "edge_map", )"}, Form{"energy_exponential", R"("qlv_form": "energy", )"},
                                            Form{"energy_odd_exponential", R"("qlv_form": "energy", "qlv_shape": "odd_exponential", )"},
                                            Form{"energy_odd_polynomial", R"("qlv_form": "energy", "qlv_shape": "odd_polynomial", )"}),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         [](const ::testing::TestParamInfo<Form>& param) { return std::string(param.param.name); });
 
 TEST(StiffMaterialPress, TheLabsTitinFitHoldsAThreeCentimetrePress) {
   SceneSpec spec = read_scene_file(kScene);

@@ -153,9 +153,8 @@ TEST(LargeStrainCompression, TheGpsOfThePaperAndCorotationalFeSoftenBeside) {
       std::snprintf(b, sizeof b, " %.0f%%: %.2f", 100 * r.compression[k], r.nominal_pa[k] / neo_hookean_nominal(1 - r.compression[k]));
       line += b;
     }
-    std::printf(
-        "[ figure ] %s, nominal stress / neo-Hookean's:%s%s\n", std::string(m->name()).c_str(), line.c_str(),
-        r.stopped.empty() ? "" : (" (no equilibrium past " + std::to_string(std::lround(100 * r.compression.back())) + "%)").c_str());
+    std::printf("[ figure ] %s, nominal stress / neo-Hookean's:%s%s\n", std::string(m->name()).c_str(), line.c_str(),
+                r.stopped.empty() ? "" : (" (no equilibrium past " + std::to_string(std::lround(100 * r.compression.back())) + "%)").c_str());
   }
 }
 
