@@ -19,7 +19,7 @@ def main(path):
     caches = ", ".join(f"L{c['level']} {c['size']//1024} KiB" for c in ctx.get("caches", []))
     print(f"machine: {ctx.get('num_cpus')} CPUs at {ctx.get('mhz_per_cpu')} MHz" + (f", caches {caches}" if caches else ", caches not reported"))
     meshes = ["liver2_1.5k", "liver2_12k", "liver2_96k"]
-    models = ["gps", "gps_energy", "corotational", "linear"]
+    models = ["gps", "gps_energy", "gps_large_strain", "corotational", "linear"]
     for kind in ["Force", "Step"]:
         print(f"\n{kind}: ns per tet (median) and tet updates per second per core\n")
         print("| mesh | tets | " + " | ".join(models) + " | gps / corotational speed-up |")
