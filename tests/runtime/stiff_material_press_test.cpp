@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 
 #include <gtest/gtest.h>
 
@@ -82,6 +83,9 @@ struct Form {
   const char* name;
   const char* json;  ///< the form and shape, before "qlv_stiffening"
 };
+
+/// Its name in test names (gtest prints a parameter's bytes otherwise).
+void PrintTo(const Form& f, std::ostream* os) { *os << f.name; }
 
 class StiffestAccepted : public ::testing::TestWithParam<Form> {};
 
