@@ -27,7 +27,7 @@ double edge_map_compression_share(double b, double e) {
 }
 
 /// Three significant digits.
-std::string figure(double v) {
+std::string three_digits(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", v);
   return b;
@@ -69,23 +69,23 @@ void check_stiffening(const GpsMechanisms& mech, double largest_edge_strain, dou
   if (stiffening_runs(mech, largest_edge_strain, allowed)) return;
   const double strain = ExplicitIntegrator::headroom_strain(largest_edge_strain);
   const double growth = std::sqrt(mech.stiffness_growth(strain));
-  const std::string at = "at edge strain " + figure(strain) + " (organ.largest_edge_strain " + short_number(largest_edge_strain) + " + headroom)";
+  const std::string at = "at edge strain " + three_digits(strain) + " (organ.largest_edge_strain " + short_number(largest_edge_strain) + " + headroom)";
   const std::string limit =
-      "at most " + figure(allowed) +
+      "at most " + three_digits(allowed) +
       (allowed < ExplicitIntegrator::kMaxStiffenedSubSteps ? " fit this tick's budget (viscera-server --max-tick-ms)"
                                                            : ": past that the integrator calls the organ unstable and resets it");
   const double largest = largest_stiffening(mech, largest_edge_strain, allowed);
   if (!mech.stiffening.active() || largest == 0)
     throw InputError(
         source, 0, "viscoelasticity.compression_ratio",
-        short_number(mech.asymmetry.compression_ratio) + " needs " + figure(growth) + " times the explicit sub-steps " + at + "; " + limit);
+        short_number(mech.asymmetry.compression_ratio) + " needs " + three_digits(growth) + " times the explicit sub-steps " + at + "; " + limit);
   const std::string lower = "; this organ takes B up to " + short_number(std::floor(largest * 10) / 10) + " in this form and shape";
   if (growth > allowed)
     throw InputError(source, 0, "viscoelasticity.qlv_stiffening",
-                     short_number(mech.stiffening.b) + " needs " + figure(growth) + " times the explicit sub-steps " + at + ", " + limit + lower);
+                     short_number(mech.stiffening.b) + " needs " + three_digits(growth) + " times the explicit sub-steps " + at + ", " + limit + lower);
   throw InputError(source, 0, "viscoelasticity.qlv_stiffening",
                    short_number(mech.stiffening.b) + " in the edge-map form: a compressed edge carries " +
-                       figure(edge_map_compression_share(mech.stiffening.b, strain)) + " of the linear tension " + at +
+                       three_digits(edge_map_compression_share(mech.stiffening.b, strain)) + " of the linear tension " + at +
                        ", below the 0.5 without which a deep press collapses the organ (\"qlv_form\": \"energy\" has no such bound)" + lower);
 }
 
