@@ -69,7 +69,8 @@ void check_stiffening(const GpsMechanisms& mech, double largest_edge_strain, dou
   if (stiffening_runs(mech, largest_edge_strain, allowed)) return;
   const double strain = ExplicitIntegrator::headroom_strain(largest_edge_strain);
   const double growth = std::sqrt(mech.stiffness_growth(strain));
-  const std::string at = "at edge strain " + three_digits(strain) + " (organ.largest_edge_strain " + short_number(largest_edge_strain) + " + headroom)";
+  const std::string at =
+      "at edge strain " + three_digits(strain) + " (organ.largest_edge_strain " + short_number(largest_edge_strain) + " + headroom)";
   const std::string limit =
       "at most " + three_digits(allowed) +
       (allowed < ExplicitIntegrator::kMaxStiffenedSubSteps ? " fit this tick's budget (viscera-server --max-tick-ms)"
@@ -81,8 +82,9 @@ void check_stiffening(const GpsMechanisms& mech, double largest_edge_strain, dou
         short_number(mech.asymmetry.compression_ratio) + " needs " + three_digits(growth) + " times the explicit sub-steps " + at + "; " + limit);
   const std::string lower = "; this organ takes B up to " + short_number(std::floor(largest * 10) / 10) + " in this form and shape";
   if (growth > allowed)
-    throw InputError(source, 0, "viscoelasticity.qlv_stiffening",
-                     short_number(mech.stiffening.b) + " needs " + three_digits(growth) + " times the explicit sub-steps " + at + ", " + limit + lower);
+    throw InputError(
+        source, 0, "viscoelasticity.qlv_stiffening",
+        short_number(mech.stiffening.b) + " needs " + three_digits(growth) + " times the explicit sub-steps " + at + ", " + limit + lower);
   throw InputError(source, 0, "viscoelasticity.qlv_stiffening",
                    short_number(mech.stiffening.b) + " in the edge-map form: a compressed edge carries " +
                        three_digits(edge_map_compression_share(mech.stiffening.b, strain)) + " of the linear tension " + at +
