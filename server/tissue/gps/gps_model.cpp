@@ -220,7 +220,9 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     }
     double raw[6][L];  // the large-strain GPS: the elongations before any map or memory
     const bool large = !neo_.empty();
-    if (large)
+    // The large-strain GPS of an elastic material without stiffening: its edges carry nothing.
+    const bool edges_idle = large && !kMemory && !(qlv > 0);
+    if (large && !edges_idle)
       for (int k = 0; k < 6; ++k)
 #pragma omp simd
         for (int j = 0; j < L; ++j) raw[k][j] = dL[k][j];
@@ -334,9 +336,7 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         }
       }
     }
-    // The large-strain GPS of an elastic material without stiffening: its edges carry nothing.
-    const bool edges_idle = large && !kMemory && !(qlv > 0);
-    if (large)  // the linear edge response is the backbone's: the edges keep what departs from it
+    if (large && !edges_idle)  // the linear edge response is the backbone's: the edges keep what departs from it
       for (int k = 0; k < 6; ++k)
 #pragma omp simd
         for (int j = 0; j < L; ++j) dL[k][j] -= raw[k][j];
