@@ -22,11 +22,14 @@ bin_server="$build/server/runtime/viscera-server"
 hc="$build/tools/haptic-client/haptic-client"
 ctl="$build/tools/viscera-control/viscera-control"
 now() { date +%s.%N; }
-# The 1.5k liver, with the 12k liver beside it to load.
+# The 1.5k liver, with the 12k liver and a deeper-pressed 1.5k liver beside it to load.
 mkdir -p "$tmp/scenes"
 cp "$scene" "$tmp/scenes/liver.json"
 sed "s/\"domain_id\": 0/\"domain_id\": $domain/; s#\"../meshes/#\"$src/data/meshes/#; s#\"../materials/#\"$src/data/materials/#" \
   "$src/data/scenes/liver-12k.json" > "$tmp/scenes/liver-12k.json"
+# The 1.5k liver stating a deeper strain for the stiff material's press (below).
+sed 's/"volume_term": 0.5,/"volume_term": 0.5, "largest_edge_strain": 0.5,/; s/"name": "liver"/"name": "liver-deep"/' \
+  "$tmp/scenes/liver.json" > "$tmp/scenes/liver-deep.json"
 start_server() {  # log; waits for its first status line
   "$bin_server" --scene "$tmp/scenes/liver.json" > "$1" 2>&1 &
   server=$!
@@ -131,30 +134,36 @@ CSV
 "$hc" --domain "$domain" --client-id 1 --instrument 4 --trajectory "$tmp/release.csv" --frame organ-top --duration 4.8 --quiet \
   --report "$tmp/release.json" > "$tmp/hc-release.log" 2>&1
 rc_client=$?
+rc_release=$rc_client
 cat "$tmp/hc-release.log"
+resets_before_stiff=$(grep -c 'physics: ' "$tmp/server.log")
 
 # --- The stiffest stiffening the server takes, pressed 3 cm into the 1.5k liver; a stiffer one is
-# refused with its reason (server/runtime/stiffening_limit.hpp: B up to 18.8 in this form). ---
-"$ctl" load liver --domain "$domain" > "$tmp/ctl-stiff.log" 2>&1
+# refused with its reason (server/runtime/stiffening_limit.hpp). The scene states the deepest edge
+# strain it must run at, 0.5: a 3 cm press reaches 0.35-0.43, more when the machine is loaded and
+# the commands come in bursts (0.403 measured with two busy cores, past the default 0.4 the rule
+# assumes). At 0.5 the rule takes B up to 15.07 in this form. ---
+"$ctl" load liver-deep --domain "$domain" > "$tmp/ctl-stiff.log" 2>&1
 stiff() {  # B: a material file of the liver's elasticity with Fung's exponential in the energy form
   printf '{"name": "stiff liver %s", "density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000, "poisson_ratio": 0.45},
  "viscoelasticity": {"model": "constant_q", "shear_q": 4.8, "bulk_q": 4.8, "band_hz": [0.01, 10], "mechanisms": 3,
  "reference_frequency_hz": 2, "qlv_stiffening": %s, "qlv_form": "energy"}}' "$1" "$1" > "$tmp/stiff-$1.json"
 }
-stiff 20; stiff 18.7
-"$ctl" material --file "$tmp/stiff-20.json" --domain "$domain" >> "$tmp/ctl-stiff.log" 2>&1; rc_refused=$?
-"$ctl" material --file "$tmp/stiff-18.7.json" --domain "$domain" >> "$tmp/ctl-stiff.log" 2>&1; rc_taken=$?
+stiff 18.7; stiff 15
+"$ctl" material --file "$tmp/stiff-18.7.json" --domain "$domain" >> "$tmp/ctl-stiff.log" 2>&1; rc_refused=$?
+"$ctl" material --file "$tmp/stiff-15.json" --domain "$domain" >> "$tmp/ctl-stiff.log" 2>&1; rc_taken=$?
 cat "$tmp/ctl-stiff.log"
-check "stiff: B = 20 refused naming the field and the largest B (rc $rc_refused)" \
-  "[ $rc_refused -eq 1 ] && grep -q 'viscoelasticity.qlv_stiffening' '$tmp/ctl-stiff.log' && grep -q 'B up to 18.8' '$tmp/ctl-stiff.log'"
-check "stiff: B = 18.7 taken (rc $rc_taken)" "[ $rc_taken -eq 0 ] && grep -q 'material stiff liver 18.7' '$tmp/ctl-stiff.log'"
+check "stiff: B = 18.7 refused naming the field and the largest B (rc $rc_refused)" \
+  "[ $rc_refused -eq 1 ] && grep -q 'viscoelasticity.qlv_stiffening' '$tmp/ctl-stiff.log' && grep -q 'B up to 15 in' '$tmp/ctl-stiff.log'"
+check "stiff: B = 15 taken (rc $rc_taken)" "[ $rc_taken -eq 0 ] && grep -q 'material stiff liver 15' '$tmp/ctl-stiff.log'"
 "$hc" --domain "$domain" --client-id 1 --instrument 1 --script press --depth 0.03 --duration 6 --quiet --report "$tmp/stiff.json" \
   > "$tmp/hc-stiff.log" 2>&1
 rc_client=$?
 stop_server
 cat "$tmp/hc-stiff.log"
 check "stiff: the 3 cm press ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
-check "stiff: no physics reset on the server" "! grep -q 'physics: ' '$tmp/server.log'"
+grep 'physics: ' "$tmp/server.log"
+check "stiff: no physics reset on the server" "[ \$(grep -c 'physics: ' '$tmp/server.log') -eq $resets_before_stiff ]"
 pycheck "$tmp/stiff.json" <<'PY'
 import json, math, sys
 r = json.load(open(sys.argv[1]))
@@ -165,8 +174,8 @@ print(f"[ figure ] stiffest accepted material pressed 3 cm: peak {max(mag(x) for
 assert max(mag(x) for x in s) > 0.5, "the probe never pressed"
 assert worst <= r["slew_limit"]["n_per_ms"] + 1e-9, f"the force changed by {worst:.3f} N in one sample"
 PY
-check "scalpel: the client ran to its end (rc $rc_client)" "[ $rc_client -eq 0 ]"
-check "scalpel: no physics reset on the server" "! grep -q 'physics: ' '$tmp/server.log'"
+check "scalpel: the client ran to its end (rc $rc_release)" "[ $rc_release -eq 0 ]"
+check "scalpel: no physics reset on the server" "[ $resets_before_stiff -eq 0 ]"
 pycheck "$tmp/release.json" <<'PY'
 import json, math, sys
 r = json.load(open(sys.argv[1]))
