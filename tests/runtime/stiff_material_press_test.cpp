@@ -14,56 +14,22 @@
 
 #include "viscera/common/input_error.hpp"
 #include "viscera/runtime/organ.hpp"
-#include "viscera/runtime/probe_contact.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/runtime/stiffening_limit.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
+#include "organ_press.hpp"
+
 using namespace viscera::runtime;
 using namespace viscera::tissue;
+using viscera::runtime::test::Press;
+using viscera::runtime::test::press;
 
 namespace {
 
 const std::string kScene = std::string(VISCERA_DATA_DIR) + "/scenes/liver.json";
-
-struct Press {
-  double depth_m = 0;  ///< how far the tool went below its first contact
-  double peak_force_n = 0, peak_edge_strain = 0;
-  long most_substeps = 0;  ///< in one 1 ms tick
-};
-
-/// The organ of `spec` pressed `depth_m` beyond first contact at 2 cm/s, then held 0.3 s.
-/// Throws SimulationError where the server would reset the organ.
-Press press(const SceneSpec& spec, double depth_m) {
-  const auto organ = build_organ(spec, TickBudget{1e9});  // about the press, not this machine's speed
-  const ProbeContact probe(organ->boundary.triangles, organ->mesh->nodes, 0.006, spec.contact_stiffness_n_per_m, 0.02, spec.contact_damping_s_per_m);
-  const Box& b = organ->bounds;
-  Vec3 tool(0.5 * (b.lo.x() + b.hi.x()), 0.5 * (b.lo.y() + b.hi.y()), b.hi.z() + 0.002), tool_velocity = Vec3::Zero();
-  ContactResult last;
-  organ->integrator->boundary_conditions().force_field = [&](const BoundaryConditions::FieldEvaluation& e) {
-    last = probe.apply(tool, tool_velocity, e);
-  };
-  State state = State::at_rest(*organ->mesh);
-  Press r;
-  double contact_z = NAN;
-  int held = 0;
-  const double step = 0.02 * 1e-3;  // 2 cm/s
-  while (held < 300) {
-    const double target = std::isnan(contact_z) ? b.lo.z() : contact_z - depth_m;
-    const double move = std::max(-step, target - tool.z());
-    tool.z() += move;
-    tool_velocity = Vec3(0, 0, move / 1e-3);
-    r.most_substeps = std::max(r.most_substeps, organ->integrator->advance(state, 1e-3));
-    if (std::isnan(contact_z) && last.in_contact) contact_z = tool.z();
-    if (!std::isnan(contact_z)) r.depth_m = contact_z - tool.z();
-    if (move == 0.0) ++held;
-    r.peak_force_n = std::max(r.peak_force_n, last.force_on_tool.norm());
-    r.peak_edge_strain = std::max(r.peak_edge_strain, organ->integrator->max_edge_strain());
-  }
-  return r;
-}
 
 /// The liver scene with a material of the liver's elasticity and constant Q and this stiffening.
 SceneSpec scene_with(const std::string& stiffening_json, const std::string& name) {

@@ -164,9 +164,27 @@ TEST(LargeStrainGps, RefusesWhatItCannotRepresent) {
   EXPECT_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, volume), std::invalid_argument);
   std::mt19937_64 rng(1);
   EXPECT_THROW(GpsModel(mesh, {test::random_spd(rng, 1e4)}, {}, large_strain()), std::invalid_argument);
+  // Memory relaxes the backbone's stress, with the bulk relaxing as the shear or not at all; not
+  // together with stiffening or first-load softening.
   GpsMechanisms viscous;
+  viscous.viscous.omega_rad_s = {10.0, 100.0};
+  viscous.viscous.shear_weight = {0.2, 0.1};
   viscous.viscous.kelvin_voigt_time_s = 0.01;
-  EXPECT_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(viscous)), std::invalid_argument);
+  EXPECT_NO_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(viscous)));
+  GpsMechanisms no_bulk = viscous;
+  no_bulk.viscous.bulk_weight = {0.0, 0.0};
+  EXPECT_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(no_bulk)), std::invalid_argument);  // with Kelvin-Voigt
+  no_bulk.viscous.kelvin_voigt_time_s = 0.0;
+  EXPECT_NO_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(no_bulk)));
+  GpsMechanisms other_bulk = no_bulk;
+  other_bulk.viscous.bulk_weight = {0.1, 0.0};
+  EXPECT_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(other_bulk)), std::invalid_argument);
+  GpsMechanisms stiffened = viscous;
+  stiffened.stiffening.b = 2.0;
+  EXPECT_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(stiffened)), std::invalid_argument);
+  GpsMechanisms softened = viscous;
+  softened.softening.d = 0.3;
+  EXPECT_THROW(GpsModel(mesh, {test::soft_tissue()}, {}, large_strain(softened)), std::invalid_argument);
 }
 
 TEST(LargeStrainGps, TheStiffnessGrowthBoundsTheTangentAtTheElementsLargestEdgeStrain) {

@@ -33,7 +33,9 @@ void GpsModel::carry_memory(const double* in, const std::array<Vec3, 4>& parent_
   const auto child_rest = gather(mesh_->nodes, e);
   const bool same = child_rest == parent_rest;
   Mat6 map = Mat6::Identity();
-  if (!same) {
+  // The large-strain GPS's memory is its backbone's stress in the rest frame: a piece of a cut
+  // element holds its parent's.
+  if (!same && neo_.empty()) {
     map = elongation_of_strain(child_rest) * elongation_of_strain(parent_rest).fullPivLu().inverse();
     // The energy form of Fung's map keeps tensions, t = H dL at small strain.
     if (options_.mechanisms.energy_map()) map = packed_hessian(e) * map * parent_h.fullPivLu().inverse();

@@ -33,12 +33,22 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
   if (options_.large_strain) {
     if (options_.variant != GpsVariant::energy_consistent) throw std::invalid_argument("the large-strain GPS is energy-consistent");
     if (with_volume_) throw std::invalid_argument("the large-strain GPS has no volume term: its backbone holds the volume");
-    if (options_.mechanisms.has_memory())
-      throw std::invalid_argument(
-          "the large-strain GPS is elastic for now: with memory variables the 1.5k liver pressed 35 mm went unstable (docs/TISSUE.md, \"Large "
-          "strain\")");
     if (options_.mechanisms.energy_map())
       throw std::invalid_argument("the large-strain GPS takes the stiffening in its edge-map form only (not \"qlv_form\": \"energy\")");
+    // Its memory relaxes the backbone's stress (docs/TISSUE.md, "Large strain"); stiffening and
+    // first-load softening would need memory of their own.
+    const GpsMechanisms& m = options_.mechanisms;
+    if (m.viscous.active() && (m.stiffening.active() || m.asymmetry.active()))
+      throw std::invalid_argument("the large-strain GPS takes viscoelasticity or strain stiffening, not both");
+    if (m.softening.active()) throw std::invalid_argument("the large-strain GPS has no first-load softening");
+    if (m.viscous.bulk_differs()) {
+      for (std::size_t l = 0; l < m.viscous.mechanisms(); ++l)
+        if (m.viscous.bulk(l) != 0.0)
+          throw std::invalid_argument("the large-strain GPS relaxes the bulk as the shear (bulk_q equal to shear_q) or not at all (bulk_q absent)");
+      if (m.viscous.kelvin_voigt_time_s > 0)
+        throw std::invalid_argument("the large-strain GPS takes a Kelvin-Voigt time only where the bulk relaxes as the shear");
+      deviatoric_memory_ = true;
+    }
   }
   const GpsViscous& viscous = options_.mechanisms.viscous;
   mechanisms_ = viscous.mechanisms();
@@ -50,7 +60,7 @@ GpsModel::GpsModel(std::shared_ptr<const TetMesh> mesh, std::vector<Mat6> materi
     for (const Mat6& D : materials_) backbone_.push_back(neo_hookean_of(D));
   const std::size_t n = element_count();
   blocks_.resize((n + L - 1) / L);
-  if (viscous.bulk_differs()) bulk_.resize(blocks_.size());
+  if (viscous.bulk_differs() && !options_.large_strain) bulk_.resize(blocks_.size());  // the backbone splits its own
   if (options_.large_strain) neo_.resize(blocks_.size());
   for (std::size_t slot = 0; slot < blocks_.size() * L; ++slot) write_lane(slot);
 }
@@ -220,8 +230,8 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     }
     double raw[6][L];  // the large-strain GPS: the elongations before any map or memory
     const bool large = !neo_.empty();
-    // The large-strain GPS of an elastic material without stiffening: its edges carry nothing.
-    const bool edges_idle = large && !kMemory && !(qlv > 0);
+    // The large-strain GPS without stiffening: its edges carry nothing (its memory is the backbone's).
+    const bool edges_idle = large && !(qlv > 0);
     if (large && !edges_idle)
       for (int k = 0; k < 6; ++k)
 #pragma omp simd
@@ -286,53 +296,56 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
         for (int j = 0; j < L; ++j) lane_probe[j] += 0.0 * filtered[k][j];
       for (int j = 0; j < L; ++j) block_probe += lane_probe[j];
     }
+    // zeta_l <- e zeta_l + a q_prev + c (q - q_prev): exact for q linear over the step (dt = 0
+    // gives e = 1, a = c = 0: the memory stays); q the elongations (or tensions), or for the
+    // large-strain GPS its backbone's second Piola-Kirchhoff stress.
+    const double* in = kMemory ? memory->before.data() + bi * stride : nullptr;
+    // A block with a non-finite elongation leaves its memory untouched (it is reported as an
+    // instability by the caller); its new values go to a local scratch instead.
+    double scratch[(1 + 8 + 2) * 6 * L];
+    double* out = kMemory ? (block_probe == 0.0 ? memory->after.data() + bi * stride : scratch) : nullptr;
     if constexpr (kMemory) {
-      // zeta_l <- e zeta_l + a dL_prev + c (dL - dL_prev): exact for dL linear over the step
-      // (dt = 0 gives e = 1, a = c = 0: the memory stays).
-      const double* in = memory->before.data() + bi * stride;
-      // A block with a non-finite elongation leaves its memory untouched (it is reported as an
-      // instability by the caller); its new values go to a local scratch instead.
-      double scratch[(1 + 8 + 2) * 6 * L];
-      double* out = block_probe == 0.0 ? memory->after.data() + bi * stride : scratch;
-      if (softening > 0) {
-        // Below the largest strain seen in the same sense, the elastic response is softened; the
-        // extremes then take this evaluation's strain (read before written: in place is fine).
-        const double* peak_in = in + soft_at;
-        double* peak_out = out + soft_at;
-        for (int k = 0; k < 6; ++k)
+      if (!large) {  // the large-strain GPS's memory is its backbone's (below)
+        if (softening > 0) {
+          // Below the largest strain seen in the same sense, the elastic response is softened; the
+          // extremes then take this evaluation's strain (read before written: in place is fine).
+          const double* peak_in = in + soft_at;
+          double* peak_out = out + soft_at;
+          for (int k = 0; k < 6; ++k)
 #pragma omp simd
-          for (int j = 0; j < L; ++j) {
-            const double e = strain[k][j], a = std::fabs(e);
-            const double tension = peak_in[k * L + j], compression = peak_in[(6 + k) * L + j];
-            const double peak = e >= 0 ? tension : compression;
-            filtered[k][j] *= a < peak ? 1.0 - softening * (1.0 - a / peak) : 1.0;
-            peak_out[k * L + j] = e >= 0 ? std::max(tension, a) : tension;
-            peak_out[(6 + k) * L + j] = e < 0 ? std::max(compression, a) : compression;
-          }
-      }
-      for (int k = 0; k < 6; ++k) {
-        double zs[L] = {}, zb[L] = {};
-        const double* prev = in + k * L;
-        for (std::size_t l = 0; l < nm; ++l) {
-          const double* zin = in + ((1 + l) * 6 + static_cast<std::size_t>(k)) * L;
-          double* zout = out + ((1 + l) * 6 + static_cast<std::size_t>(k)) * L;
-          const double e = me[l], a = ma[l], c = mc[l], y_s = ys[l], y_b = yb[l];
-#pragma omp simd
-          for (int j = 0; j < L; ++j) {
-            const double z = e * zin[j] + a * prev[j] + c * (filtered[k][j] - prev[j]);
-            zout[j] = z;
-            zs[j] += y_s * z;
-            zb[j] += y_b * z;
-          }
+            for (int j = 0; j < L; ++j) {
+              const double e = strain[k][j], a = std::fabs(e);
+              const double tension = peak_in[k * L + j], compression = peak_in[(6 + k) * L + j];
+              const double peak = e >= 0 ? tension : compression;
+              filtered[k][j] *= a < peak ? 1.0 - softening * (1.0 - a / peak) : 1.0;
+              peak_out[k * L + j] = e >= 0 ? std::max(tension, a) : tension;
+              peak_out[(6 + k) * L + j] = e < 0 ? std::max(compression, a) : compression;
+            }
         }
-        double* prev_out = out + k * L;
+        for (int k = 0; k < 6; ++k) {
+          double zs[L] = {}, zb[L] = {};
+          const double* prev = in + k * L;
+          for (std::size_t l = 0; l < nm; ++l) {
+            const double* zin = in + ((1 + l) * 6 + static_cast<std::size_t>(k)) * L;
+            double* zout = out + ((1 + l) * 6 + static_cast<std::size_t>(k)) * L;
+            const double e = me[l], a = ma[l], c = mc[l], y_s = ys[l], y_b = yb[l];
 #pragma omp simd
-        for (int j = 0; j < L; ++j) {
-          const double dl = filtered[k][j];
-          const double rate = (dl - prev[j]) * rate_scale;  // Kelvin-Voigt: tau d(dL)/dt
-          prev_out[j] = dl;
-          filtered[k][j] = dl - zs[j] + rate;  // a_s: the relaxed (shear) elongation (or tension)
-          bulk_part[k][j] = zs[j] - zb[j];  // a_b - a_s
+            for (int j = 0; j < L; ++j) {
+              const double z = e * zin[j] + a * prev[j] + c * (filtered[k][j] - prev[j]);
+              zout[j] = z;
+              zs[j] += y_s * z;
+              zb[j] += y_b * z;
+            }
+          }
+          double* prev_out = out + k * L;
+#pragma omp simd
+          for (int j = 0; j < L; ++j) {
+            const double dl = filtered[k][j];
+            const double rate = (dl - prev[j]) * rate_scale;  // Kelvin-Voigt: tau d(dL)/dt
+            prev_out[j] = dl;
+            filtered[k][j] = dl - zs[j] + rate;  // a_s: the relaxed (shear) elongation (or tension)
+            bulk_part[k][j] = zs[j] - zb[j];  // a_b - a_s
+          }
         }
       }
     }
@@ -392,32 +405,83 @@ ForceStats GpsModel::add_forces_impl(std::span<const Vec3> x, std::span<Vec3> f,
     }
     if (large) {
       // The backbone: P = mu F + lam (J - alpha) cof(F), F = Ds Dm^-1; vertex forces -V0 P Dm^-T.
+      // With memory, P = P_e + F (tau dq/dt - sum_l y_l zeta_l): the memory relaxes the second
+      // Piola-Kirchhoff stress q = S = mu I + lam (J - alpha) cof^T cof / J, or where the bulk does
+      // not relax q = DEV[S] = mu (I - tr(C) cof^T cof / (3 J^2)) (neo_hookean_backbone.hpp).
+      // In stages over the lanes, as the edges' memory: the mechanisms' loop inside a lane's
+      // would not vectorise.
       const NeoBlock& nb = neo_[bi];
+      double F[3][3][L], P[3][3][L], q_now[6][L];
 #pragma omp simd
       for (int j = 0; j < L; ++j) {
-        double ds[3][3], F[3][3], dm[3][3];
+        double ds[3][3], Fl[3][3];
         for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) {
-            ds[r][c] = p[c + 1][r][j] - p[0][r][j];
-            dm[r][c] = nb.dm_inv[3 * r + c][j];
-          }
+          for (int c = 0; c < 3; ++c) ds[r][c] = p[c + 1][r][j] - p[0][r][j];
         for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) F[r][c] = ds[r][0] * dm[0][c] + ds[r][1] * dm[1][c] + ds[r][2] * dm[2][c];
+          for (int c = 0; c < 3; ++c) Fl[r][c] = ds[r][0] * nb.dm_inv[c][j] + ds[r][1] * nb.dm_inv[3 + c][j] + ds[r][2] * nb.dm_inv[6 + c][j];
         // cof(F), column by column: F1 x F2, F2 x F0, F0 x F1 (Fc: column c).
         double C[3][3];
         for (int c = 0; c < 3; ++c) {
           const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-          C[0][c] = F[1][c1] * F[2][c2] - F[2][c1] * F[1][c2];
-          C[1][c] = F[2][c1] * F[0][c2] - F[0][c1] * F[2][c2];
-          C[2][c] = F[0][c1] * F[1][c2] - F[1][c1] * F[0][c2];
+          C[0][c] = Fl[1][c1] * Fl[2][c2] - Fl[2][c1] * Fl[1][c2];
+          C[1][c] = Fl[2][c1] * Fl[0][c2] - Fl[0][c1] * Fl[2][c2];
+          C[2][c] = Fl[0][c1] * Fl[1][c2] - Fl[1][c1] * Fl[0][c2];
         }
-        const double J = F[0][0] * C[0][0] + F[1][0] * C[1][0] + F[2][0] * C[2][0];
-        const double s = nb.lam[j] * (J - nb.alpha[j]), V0 = b.rest_volume[j];
+        const double J = Fl[0][0] * C[0][0] + Fl[1][0] * C[1][0] + Fl[2][0] * C[2][0];
+        const double s = nb.lam[j] * (J - nb.alpha[j]);
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            F[r][c][j] = Fl[r][c];
+            P[r][c][j] = nb.mu[j] * Fl[r][c] + s * C[r][c];
+          }
+        if constexpr (kMemory) {
+          const double jf = std::max(J, kBackboneMemoryFloorJ);
+          double trC = 0.0;
+          for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) trC += Fl[r][c] * Fl[r][c];
+          const double diagonal = nb.mu[j], coupling = deviatoric_memory_ ? -nb.mu[j] * trC / (3 * jf * jf) : s / jf;
+          for (int q = 0; q < 6; ++q) {
+            const int a = kVoigtPairs[q][0], c = kVoigtPairs[q][1];
+            q_now[q][j] = (a == c ? diagonal : 0.0) + coupling * (C[0][a] * C[0][c] + C[1][a] * C[1][c] + C[2][a] * C[2][c]);
+          }
+        }
+      }
+      if constexpr (kMemory) {
+        double W[6][L];
+        for (int q = 0; q < 6; ++q) {
+          double zs[L] = {};
+          const double* prev = in + q * L;
+          for (std::size_t l = 0; l < nm; ++l) {
+            const double* zin = in + ((1 + l) * 6 + static_cast<std::size_t>(q)) * L;
+            double* zout = out + ((1 + l) * 6 + static_cast<std::size_t>(q)) * L;
+            const double e = me[l], a = ma[l], c = mc[l], y = ys[l];
+#pragma omp simd
+            for (int j = 0; j < L; ++j) {
+              const double z = e * zin[j] + a * prev[j] + c * (q_now[q][j] - prev[j]);
+              zout[j] = z;
+              zs[j] += y * z;
+            }
+          }
+          double* prev_out = out + q * L;
+#pragma omp simd
+          for (int j = 0; j < L; ++j) {
+            W[q][j] = (q_now[q][j] - prev[j]) * rate_scale - zs[j];
+            prev_out[j] = q_now[q][j];
+          }
+        }
+        constexpr int kAt[3][3] = {{0, 5, 4}, {5, 1, 3}, {4, 3, 2}};  // Voigt slot of (row, column)
+#pragma omp simd
+        for (int j = 0; j < L; ++j)
+          for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) P[r][c][j] += F[r][0][j] * W[kAt[0][c]][j] + F[r][1][j] * W[kAt[1][c]][j] + F[r][2][j] * W[kAt[2][c]][j];
+      }
+#pragma omp simd
+      for (int j = 0; j < L; ++j) {
+        const double V0 = b.rest_volume[j];
         for (int r = 0; r < 3; ++r) {
-          const double P0 = nb.mu[j] * F[r][0] + s * C[r][0], P1 = nb.mu[j] * F[r][1] + s * C[r][1], P2 = nb.mu[j] * F[r][2] + s * C[r][2];
           double sum = 0.0;
           for (int v = 0; v < 3; ++v) {  // -V0 (P Dm^-T)_{r v}: the force on vertex v + 1
-            const double h = -V0 * (P0 * dm[v][0] + P1 * dm[v][1] + P2 * dm[v][2]);
+            const double h = -V0 * (P[r][0][j] * nb.dm_inv[3 * v][j] + P[r][1][j] * nb.dm_inv[3 * v + 1][j] + P[r][2][j] * nb.dm_inv[3 * v + 2][j]);
             fv[v + 1][r][j] += h;
             sum += h;
           }

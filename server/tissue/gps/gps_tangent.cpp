@@ -27,6 +27,7 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double d
     bulk -= viscous.bulk(l) * c;
   }
   const double kv = dt_s > 0 ? viscous.kelvin_voigt_time_s / dt_s : 0.0;
+  if (options_.large_strain) return backbone_tangent(x, e, dt_s, shear + kv, memory);
   const double d = mech.softening.d;
   if (memory.size() != memory_size()) return tangent(x, e, shear + kv, bulk - shear);
   // What the step's start holds (add_forces_impl's memory update, its part that does not depend
@@ -70,6 +71,34 @@ Mat12 GpsModel::element_tangent(std::span<const Vec3> x, std::size_t e, double d
     }
   }
   return tangent(x, e, shear + kv, bulk - shear, &phi, &dphi, &held);
+}
+
+Mat12 GpsModel::backbone_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, double scale, std::span<const double> memory) const {
+  // The large-strain GPS with memory (its edges idle: no stiffening): P = P_e(F) + kappa F q(F)
+  // - F H, kappa = scale - 1 = tau / dt - sum_l y_l c_l, q the filtered stress (S, for which
+  // F S = P_e, or DEV[S]), H = sum_l y_l (e_l zeta_l + (a_l - c_l) q_prev) + (tau / dt) q_prev:
+  // what the step's start holds.
+  const auto p = gather(x, e), rest = gather(mesh_->nodes, e);
+  const Mat3 dm_inv = rest_shape_inverse(rest);
+  const double V0 = signed_volume(rest[0], rest[1], rest[2], rest[3]);
+  Mat12 K = deviatoric_memory_
+                ? Mat12(neo_hookean_tangent(backbone(e), p, dm_inv, V0) + (scale - 1.0) * deviatoric_stress_tangent(backbone(e), p, dm_inv, V0))
+                : Mat12(scale * neo_hookean_tangent(backbone(e), p, dm_inv, V0));
+  if (memory.size() != memory_size()) return K;
+  const GpsViscous& viscous = options_.mechanisms.viscous;
+  const double* in = memory.data() + (e / kLanes) * memory_stride();
+  const std::size_t j = e % kLanes;
+  Mat3 held = Mat3::Zero();
+  for (int q = 0; q < 6; ++q) {
+    const double prev = in[static_cast<std::size_t>(q) * kLanes + j];
+    double h = dt_s > 0 ? viscous.kelvin_voigt_time_s / dt_s * prev : 0.0;
+    for (std::size_t l = 0; l < mechanisms_; ++l) {
+      const MemoryStep st = MemoryStep::make(viscous.omega_rad_s[l], dt_s);
+      h += viscous.shear_weight[l] * (st.e * in[((1 + l) * 6 + static_cast<std::size_t>(q)) * kLanes + j] + (st.a - st.c) * prev);
+    }
+    held(kVoigtPairs[q][0], kVoigtPairs[q][1]) = held(kVoigtPairs[q][1], kVoigtPairs[q][0]) = h;
+  }
+  return K + held_stress_tangent(held, dm_inv, V0);
 }
 
 Mat12 GpsModel::tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi, const Vec6* dphi_de,

@@ -1,5 +1,6 @@
 #include "viscera/tissue/gps/neo_hookean_backbone.hpp"  // SPDX-License-Identifier: Apache-2.0
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -89,6 +90,41 @@ Mat12 neo_hookean_tangent(const NeoHookean& m, const std::array<Vec3, 4>& x, con
       K.col(3 * v + d) = -forces_of(dP, dm_inv, V0);
     }
   return 0.5 * (K + K.transpose());
+}
+
+Mat12 deviatoric_stress_tangent(const NeoHookean& m, const std::array<Vec3, 4>& x, const Mat3& dm_inv, double V0) {
+  // T = mu (F - tr(C) cof / (3 Jf)); f_w = -V0 T g_w, so column (v, d) is V0 dT g_w.
+  const Mat3 F = deformation_gradient(x, dm_inv), C = cofactor(F);
+  const double J = F.determinant(), Jf = std::max(J, kBackboneMemoryFloorJ), trC = F.squaredNorm();
+  Eigen::Matrix<double, 4, 3> grad;
+  grad.block<3, 3>(1, 0) = dm_inv;
+  grad.row(0) = -(dm_inv.row(0) + dm_inv.row(1) + dm_inv.row(2));
+  Mat12 K;
+  for (int v = 0; v < 4; ++v)
+    for (int d = 0; d < 3; ++d) {
+      const Mat3 dF = Vec3::Unit(d) * grad.row(v);
+      Mat3 dC;
+      dC.col(0) = dF.col(1).cross(F.col(2)) + F.col(1).cross(dF.col(2));
+      dC.col(1) = dF.col(2).cross(F.col(0)) + F.col(2).cross(dF.col(0));
+      dC.col(2) = dF.col(0).cross(F.col(1)) + F.col(0).cross(dF.col(1));
+      const double dtrC = 2.0 * (F.array() * dF.array()).sum();
+      // d(cof / Jf): dcof / Jf - cof dJ / J^2 above the floor, dcof / Jf below it.
+      Mat3 dcof_j = dC / Jf;
+      if (J >= kBackboneMemoryFloorJ) dcof_j -= C * ((C.array() * dF.array()).sum() / (J * J));
+      const Mat3 dT = m.mu * (dF - (dtrC / (3 * Jf)) * C - (trC / 3) * dcof_j);
+      for (int w = 0; w < 4; ++w) K.block<3, 1>(3 * w, 3 * v + d) = V0 * dT * grad.row(w).transpose();
+    }
+  return K;
+}
+
+Mat12 held_stress_tangent(const Mat3& held, const Mat3& dm_inv, double V0) {
+  Eigen::Matrix<double, 4, 3> grad;  // F = sum_v x_v grad.row(v)
+  grad.block<3, 3>(1, 0) = dm_inv;
+  grad.row(0) = -(dm_inv.row(0) + dm_inv.row(1) + dm_inv.row(2));
+  Mat12 K = Mat12::Zero();
+  for (int v = 0; v < 4; ++v)
+    for (int w = 0; w < 4; ++w) K.block<3, 3>(3 * w, 3 * v) = (-V0 * grad.row(v).dot(held * grad.row(w).transpose())) * Mat3::Identity();
+  return K;
 }
 
 }  // namespace viscera::tissue

@@ -29,13 +29,13 @@ struct GpsOptions {
   GpsMechanisms mechanisms;
   /// The large-strain GPS (docs/TISSUE.md, "Large strain"): the elastic response is the stable
   /// neo-Hookean solid of the material's moduli (gps/neo_hookean_backbone.hpp), and the edges carry
-  /// what the mechanisms add to or take from the linear edge response 0.5 dL^T H dL (the
-  /// relaxation, the edge map's stiffening): E = E_GPS - 0.5 dL^T H dL + V0 Psi(F). At small
-  /// strain the two edge terms cancel and the backbone is linear FE, so the sum is the GPS's as
-  /// before. Needs the energy-consistent variant, no volume term (the backbone holds the volume),
-  /// isotropic materials and the edge-map form of the stiffening; no memory variables yet (the
-  /// relaxation subtracts from a linear edge response the backbone no longer has: on the 1.5k
-  /// liver it went unstable under a 35 mm press).
+  /// what the edge map's stiffening adds to the linear edge response 0.5 dL^T H dL:
+  /// E = E_GPS - 0.5 dL^T H dL + V0 Psi(F). At small strain the two edge terms cancel and the
+  /// backbone is linear FE, so the sum is the GPS's as before. Its memory variables relax the
+  /// backbone's stress (neo_hookean_backbone.hpp), not the edges'. Needs the energy-consistent
+  /// variant, no volume term (the backbone holds the volume), isotropic materials and the edge-map
+  /// form of the stiffening; takes viscoelasticity (the bulk relaxing as the shear or not at all)
+  /// or stiffening, not both, and no first-load softening.
   bool large_strain = false;
 };
 
@@ -132,6 +132,9 @@ class GpsModel final : public ForceModel {
   /// previous elongations): it adds to the geometric stiffness only.
   Mat12 tangent(std::span<const Vec3> x, std::size_t e, double stiffness_scale, double bulk_extra, const Vec6* phi = nullptr,
                 const Vec6* dphi_de = nullptr, const Vec6* held = nullptr) const;
+  /// The large-strain GPS's tangent over a viscoelastic step of dt: scale (1 - sum y_l c_l + tau /
+  /// dt) times the backbone's, plus the held stress's (the memory at the step's start, if given).
+  Mat12 backbone_tangent(std::span<const Vec3> x, std::size_t e, double dt_s, double scale, std::span<const double> memory) const;
   /// Offset of the softening extremes in a block's memory (tension extremes, then compression).
   std::size_t softening_offset() const { return (1 + mechanisms_) * 6 * kLanes; }
   std::size_t memory_stride() const { return (1 + mechanisms_ + (options_.mechanisms.softening.active() ? 2 : 0)) * 6 * kLanes; }
@@ -151,6 +154,7 @@ class GpsModel final : public ForceModel {
   std::vector<Block> blocks_;  ///< padding lanes have H = 0 and copy a real element
   std::vector<BulkBlock> bulk_;  ///< only when bulk and shear relax differently
   std::vector<NeoBlock> neo_;  ///< only for the large-strain GPS
+  bool deviatoric_memory_ = false;  ///< the large-strain GPS's memory: DEV[S] (the bulk does not relax), else S
   std::vector<NeoHookean> backbone_;  ///< per material, for the large-strain GPS
   std::size_t mechanisms_ = 0;
   std::vector<Mat6> materials_;

@@ -34,4 +34,20 @@ Vec12 neo_hookean_forces(const NeoHookean& m, const std::array<Vec3, 4>& x, cons
 /// The tangent -df/dx (symmetric).
 Mat12 neo_hookean_tangent(const NeoHookean& m, const std::array<Vec3, 4>& x, const Mat3& dm_inv, double V0);
 
+/// Viscoelasticity on the backbone: the memory variables filter its second Piola-Kirchhoff stress
+/// S = F^-1 P = mu I + lam (J - alpha) cof(F)^T cof(F) / J (symmetric, invariant under rotation),
+/// or where the bulk does not relax its deviatoric part DEV[S] = S - (S : C) C^-1 / 3
+/// = mu (I - tr(C) C^-1 / 3) (the volume's stress removed exactly, whatever lam), kept in Voigt
+/// order (xx, yy, zz, yz, xz, xy). The element's stress is P = P_e(F) + F W,
+/// W = tau dq/dt - sum_l y_l zeta_l (3D quasi-linear viscoelasticity: at a held strain the stress
+/// relaxes as the linear modulus does). Both are singular at J = 0: the memory takes J at least
+/// kBackboneMemoryFloorJ (an element that inverted under a hand keeps finite memory).
+inline constexpr double kBackboneMemoryFloorJ = 0.05;
+inline constexpr std::array<std::array<int, 2>, 6> kVoigtPairs{{{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}}};
+/// The tangent -df/dx of the stress F DEV[S] = mu (F - tr(C) cof(F) / (3 J)) (J floored as above).
+Mat12 deviatoric_stress_tangent(const NeoHookean& m, const std::array<Vec3, 4>& x, const Mat3& dm_inv, double V0);
+/// The tangent -df/dx of the stress -F H of a stress H held in the rest frame (f = V0 F H Dm^-T
+/// on vertices 1-3): -V0 (g_v . H g_w) I for vertices v, w with F = sum_v x_v g_v^T.
+Mat12 held_stress_tangent(const Mat3& held, const Mat3& dm_inv, double V0);
+
 }  // namespace viscera::tissue
