@@ -23,6 +23,23 @@ Mat3 cofactor(const Mat3& F) {
   return c;
 }
 
+/// d cof(F) along dF.
+Mat3 cofactor_derivative(const Mat3& F, const Mat3& dF) {
+  Mat3 d;
+  d.col(0) = dF.col(1).cross(F.col(2)) + F.col(1).cross(dF.col(2));
+  d.col(1) = dF.col(2).cross(F.col(0)) + F.col(2).cross(dF.col(0));
+  d.col(2) = dF.col(0).cross(F.col(1)) + F.col(0).cross(dF.col(1));
+  return d;
+}
+
+/// The rows g_v with F = sum_v x_v g_v^T: Dm^-1's rows for vertices 1-3, minus their sum for 0.
+Eigen::Matrix<double, 4, 3> vertex_gradients(const Mat3& dm_inv) {
+  Eigen::Matrix<double, 4, 3> g;
+  g.block<3, 3>(1, 0) = dm_inv;
+  g.row(0) = -(dm_inv.row(0) + dm_inv.row(1) + dm_inv.row(2));
+  return g;
+}
+
 /// Vertex forces of a first Piola-Kirchhoff stress: -V0 P Dm^-T on vertices 1-3, their negative sum on 0.
 Vec12 forces_of(const Mat3& P, const Mat3& dm_inv, double V0) {
   const Mat3 h = -V0 * P * dm_inv.transpose();
@@ -74,17 +91,12 @@ Mat12 neo_hookean_tangent(const NeoHookean& m, const std::array<Vec3, 4>& x, con
   const Mat3 F = deformation_gradient(x, dm_inv), C = cofactor(F);
   const double s = F.determinant() - m.alpha();
   // dF for a unit move of vertex v along axis d: e_d (row of Dm^-1 of v - 1), or minus their sum for v = 0.
-  Eigen::Matrix<double, 4, 3> grad;  // dF = e_d grad.row(v)
-  grad.block<3, 3>(1, 0) = dm_inv;
-  grad.row(0) = -(dm_inv.row(0) + dm_inv.row(1) + dm_inv.row(2));
+  const Eigen::Matrix<double, 4, 3> grad = vertex_gradients(dm_inv);  // dF = e_d grad.row(v)
   Mat12 K;
   for (int v = 0; v < 4; ++v)
     for (int d = 0; d < 3; ++d) {
       const Mat3 dF = Vec3::Unit(d) * grad.row(v);
-      Mat3 dC;
-      dC.col(0) = dF.col(1).cross(F.col(2)) + F.col(1).cross(dF.col(2));
-      dC.col(1) = dF.col(2).cross(F.col(0)) + F.col(2).cross(dF.col(0));
-      dC.col(2) = dF.col(0).cross(F.col(1)) + F.col(0).cross(dF.col(1));
+      const Mat3 dC = cofactor_derivative(F, dF);
       const double dJ = (C.array() * dF.array()).sum();
       const Mat3 dP = m.mu * dF + m.lam * (dJ * C + s * dC);
       K.col(3 * v + d) = -forces_of(dP, dm_inv, V0);
@@ -96,17 +108,12 @@ Mat12 deviatoric_stress_tangent(const NeoHookean& m, const std::array<Vec3, 4>& 
   // T = mu (F - tr(C) cof / (3 Jf)); f_w = -V0 T g_w, so column (v, d) is V0 dT g_w.
   const Mat3 F = deformation_gradient(x, dm_inv), C = cofactor(F);
   const double J = F.determinant(), Jf = std::max(J, kBackboneMemoryFloorJ), trC = F.squaredNorm();
-  Eigen::Matrix<double, 4, 3> grad;
-  grad.block<3, 3>(1, 0) = dm_inv;
-  grad.row(0) = -(dm_inv.row(0) + dm_inv.row(1) + dm_inv.row(2));
+  const Eigen::Matrix<double, 4, 3> grad = vertex_gradients(dm_inv);
   Mat12 K;
   for (int v = 0; v < 4; ++v)
     for (int d = 0; d < 3; ++d) {
       const Mat3 dF = Vec3::Unit(d) * grad.row(v);
-      Mat3 dC;
-      dC.col(0) = dF.col(1).cross(F.col(2)) + F.col(1).cross(dF.col(2));
-      dC.col(1) = dF.col(2).cross(F.col(0)) + F.col(2).cross(dF.col(0));
-      dC.col(2) = dF.col(0).cross(F.col(1)) + F.col(0).cross(dF.col(1));
+      const Mat3 dC = cofactor_derivative(F, dF);
       const double dtrC = 2.0 * (F.array() * dF.array()).sum();
       // d(cof / Jf): dcof / Jf - cof dJ / J^2 above the floor, dcof / Jf below it.
       Mat3 dcof_j = dC / Jf;
@@ -118,9 +125,7 @@ Mat12 deviatoric_stress_tangent(const NeoHookean& m, const std::array<Vec3, 4>& 
 }
 
 Mat12 held_stress_tangent(const Mat3& held, const Mat3& dm_inv, double V0) {
-  Eigen::Matrix<double, 4, 3> grad;  // F = sum_v x_v grad.row(v)
-  grad.block<3, 3>(1, 0) = dm_inv;
-  grad.row(0) = -(dm_inv.row(0) + dm_inv.row(1) + dm_inv.row(2));
+  const Eigen::Matrix<double, 4, 3> grad = vertex_gradients(dm_inv);  // F = sum_v x_v grad.row(v)
   Mat12 K = Mat12::Zero();
   for (int v = 0; v < 4; ++v)
     for (int w = 0; w < 4; ++w) K.block<3, 3>(3 * w, 3 * v) = (-V0 * grad.row(v).dot(held * grad.row(w).transpose())) * Mat3::Identity();
