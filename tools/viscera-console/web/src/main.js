@@ -10,7 +10,7 @@ import './style.css';
 
 const state = (window.viscera = {
   connected: false, stations: [], station: '', scene: null, telemetry: null, settings: { force_limit_n: 3 },
-  topologyVertices: 0, topologyGeneration: 0, topologyTriangles: 0, meshId: -1, framesReceived: 0, frame: -1, maxDisplacementM: 0, latenciesMs: [],
+  topologyVertices: 0, topologyGeneration: 0, topologyTriangles: 0, topologyChecksum: 0, meshId: -1, framesReceived: 0, frame: -1, maxDisplacementM: 0, latenciesMs: [],
   forcePeakN: 0, forceSummaries: 0, events: [], replies: [], errors: [], held: [], tips: {},
 });
 
@@ -74,6 +74,11 @@ function onTopology(buf) {
   state.topologyVertices = nv;
   state.topologyGeneration = generation;
   state.topologyTriangles = nt;
+  // Which surface the page holds, beyond its counts: a cut whose crossings all snapped to existing
+  // nodes re-triangulates the surface and may keep both counts.
+  let checksum = 0;
+  for (let i = 0; i < index.length; i++) checksum = (Math.imul(checksum, 31) + index[i]) >>> 0;
+  state.topologyChecksum = checksum;
   state.maxDisplacementM = 0;
   // A cut (the same mesh, a later generation) keeps the view; another organ is framed anew.
   if (meshId !== state.meshId) {
