@@ -81,7 +81,15 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   for (std::size_t e = 0; e < organ.regions.material_of_tet.size(); ++e)
     if (const std::uint16_t m = organ.regions.material_of_tet[e]) density[e] = organ.region_materials[m - 1].density_kg_m3;
   organ.model_recipe = {s.model, materials, s.volume_term, ve};
-  organ.model = make_force_model(s.model, organ.mesh, materials, s.volume_term, ve, organ.regions.material_of_tet);
+  try {
+    organ.model = make_force_model(s.model, organ.mesh, materials, s.volume_term, ve, organ.regions.material_of_tet);
+  } catch (const InputError& e) {
+    // The factory knows no file: the refusal names the scene's field and the material it refused.
+    if (e.source() != "model") throw;
+    std::string why = e.what();
+    if (const std::string prefix = "model: name: "; why.starts_with(prefix)) why = why.substr(prefix.size());
+    throw InputError(s.source, 0, "organ.model", why + " (material " + s.material + ")");
+  }
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
   bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, fixed_slab(s, organ.bounds));

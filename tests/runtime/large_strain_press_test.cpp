@@ -5,10 +5,13 @@
 // unstable. The linear GPS the scenes run is pressed alike for the figure beside it. Release only
 // (label "physics").
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "viscera/common/input_error.hpp"
 #include "viscera/runtime/scene_file.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 
@@ -81,5 +84,26 @@ TEST(HardPress, TheForceRisesWithTheDepthAndTheOrganHoldsOnTheLiver1k5) { hard_p
 
 // 90 s on the 2-core machine (17 sub-steps a tick at depth): run with --gtest_also_run_disabled_tests.
 TEST(HardPress, DISABLED_TheForceRisesWithTheDepthAndTheOrganHoldsOnTheLiver12k) { hard_press("liver-12k"); }
+
+TEST(HardPress, AMaterialTheModelCannotRelaxIsRefusedNamingTheSceneFieldAndMaterial) {
+  // Bulk relaxing unlike the shear: the large-strain GPS refuses it at the organ's build.
+  std::filesystem::create_directories(VISCERA_TEST_TMP);
+  const std::string material = std::string(VISCERA_TEST_TMP) + "/bulk-q-20.json";
+  std::ofstream(material) << R"({"name": "bulk q 20", "density_kg_m3": 1060, "elasticity": {"type": "isotropic", "youngs_modulus_pa": 5000,
+  "poisson_ratio": 0.45}, "viscoelasticity": {"model": "constant_q", "shear_q": 4.8, "bulk_q": 20, "band_hz": [0.01, 10], "mechanisms": 3}})";
+  SceneSpec spec = read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/liver.json");
+  spec.model = "gps_large_strain";
+  spec.material = material;
+  try {
+    build_organ(spec, TickBudget{1e9});
+    ADD_FAILURE() << "accepted";
+  } catch (const viscera::common::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.source(), spec.source) << what;
+    EXPECT_EQ(e.field(), "organ.model") << what;
+    EXPECT_NE(what.find(material), std::string::npos) << what;
+    EXPECT_NE(what.find("bulk"), std::string::npos) << what;
+  }
+}
 
 }  // namespace
