@@ -41,6 +41,17 @@ std::shared_ptr<const ContactSurface> make_contact_surface(std::vector<tissue::T
     const Vec3 &a = rest[t[0]], &b = rest[t[1]], &c = rest[t[2]];
     s->longest_rest_edge_m.push_back(std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}));
   }
+  std::size_t nodes = 0;
+  for (const auto& t : triangles)
+    for (const auto v : t) nodes = std::max(nodes, static_cast<std::size_t>(v) + 1);
+  s->incident_begin.assign(nodes + 1, 0);
+  for (const auto& t : triangles)
+    for (const auto v : t) ++s->incident_begin[static_cast<std::size_t>(v) + 1];
+  for (std::size_t i = 0; i < nodes; ++i) s->incident_begin[i + 1] += s->incident_begin[i];
+  s->incident.resize(3 * triangles.size());
+  std::vector<std::uint32_t> fill(s->incident_begin.begin(), s->incident_begin.end() - 1);
+  for (std::size_t k = 0; k < triangles.size(); ++k)
+    for (const auto v : triangles[k]) s->incident[fill[static_cast<std::size_t>(v)]++] = static_cast<std::uint32_t>(k);
   s->triangles = std::move(triangles);
   return s;
 }

@@ -54,6 +54,9 @@ struct ContactResult {
 struct ContactSurface {
   std::vector<tissue::Triangle> triangles;
   std::vector<double> longest_rest_edge_m;
+  /// The triangles around each node (for vertex normals): those of node i are
+  /// incident[incident_begin[i] .. incident_begin[i + 1]); nodes off the surface have none.
+  std::vector<std::uint32_t> incident_begin, incident;
 };
 std::shared_ptr<const ContactSurface> make_contact_surface(std::vector<tissue::Triangle> triangles, std::span<const Vec3> rest);
 
