@@ -15,20 +15,33 @@ void add_grasp(ContactResult& result, const GraspHold::Reaction& r) {
   result.in_contact = true;
 }
 
+ContactProxyParameters proxy_parameters(const SceneSpec& scene, const InstrumentSpec& spec) {
+  ContactProxyParameters p;
+  p.tip_radius_m = spec.tip_radius_m;
+  p.stiffness_n_per_m = scene.contact_stiffness_n_per_m;
+  p.damping_s_per_m = scene.contact_damping_s_per_m;
+  p.friction = {scene.contact_friction_static, scene.contact_friction_kinetic};
+  p.force_limit_n = scene.contact_force_limit_n;
+  return p;
+}
+
 std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance, bool wait) {
   if (!r.in_contact || r.deepest_triangle[0] < 0) return r.stiffness;
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> penalty(r.stiffness.data());
-  const double k_penalty = r.normal.dot(penalty * r.normal);
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> coupling(r.stiffness.data());
+  const double k_normal = r.normal.dot(coupling * r.normal);
+  if (!(k_normal > 0)) return r.stiffness;
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
   for (int k = 0; k < 3; ++k) {
     const auto block = wait ? compliance.wait_node(r.deepest_triangle[k]) : compliance.node(r.deepest_triangle[k]);
     if (!block) return r.stiffness;
     C += r.deepest_weights[k] * *block;
   }
-  const double k = 1.0 / (1.0 / k_penalty + r.normal.dot(C * r.normal));
   std::array<double, 9> out{};
+  const bool stuck = coupling.trace() > 1.5 * k_normal;  // isotropic: friction holds
+  const Eigen::Matrix3d K = stuck ? Eigen::Matrix3d((Eigen::Matrix3d::Identity() / k_normal + 0.5 * (C + C.transpose())).inverse())
+                                  : Eigen::Matrix3d(r.normal * r.normal.transpose() / (1.0 / k_normal + r.normal.dot(C * r.normal)));
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) out[3 * i + j] = k * r.normal[i] * r.normal[j];
+    for (int j = 0; j < 3; ++j) out[static_cast<std::size_t>(3 * i + j)] = K(i, j);
   return out;
 }
 
@@ -99,7 +112,8 @@ ContactResult CommandResponder::answer(std::uint32_t instrument_id, const protoc
     return ContactResult{.cutting = true};  // cutting: the blade passes through
   if (snap->in_cut.contains(instrument_id)) return ContactResult{};  // leaving the cut: it touches nothing
   const ProbeContact& query = *queries_.at(instrument_id);
-  ContactResult result = query.query(tip, snap->x);
+  const auto proxy = snap->proxies.find(instrument_id);
+  ContactResult result = proxy != snap->proxies.end() ? proxy->second.query(tip, snap->x) : query.query(tip, snap->x);
   if (snap->paused && !result.in_contact) {
     const Vec3 back = held->second - tip;
     result = contact_from_inside(query, snap->x, tip, back.norm() > 1e-9 ? Vec3(back.normalized()) : Vec3::UnitZ());

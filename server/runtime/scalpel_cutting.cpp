@@ -74,7 +74,10 @@ void SimulationServer::Impl::cut_with_scalpels(const Status& status) {
     std::lock_guard world(organ_mutex);  // the command thread's queries see the new surface whole
     responder.set_surface(organ->contact_surface);
   }
-  for (auto& [id, t] : tools) t.contact->set_surface(organ->contact_surface);
+  for (auto& [id, t] : tools) {
+    t.contact->set_surface(organ->contact_surface);
+    t.proxy.set_surface(organ->contact_surface);  // it anchors again on the cut surface, its force fading in
+  }
   topology_to_publish = true;
 }
 

@@ -98,9 +98,28 @@ SceneSpec read_scene_file(const std::string& path) {
   s.mesh_rate_hz = top.number("mesh_rate_hz", 0, 240, 60);
   s.max_tool_speed_m_s = top.number("max_tool_speed_m_s", 1e-3, 100, 0.5);
   const JsonObject o = top.object("organ");
-  o.require_known({"mesh", "material", "model", "scale_m_per_unit", "refine", "stable_step", "added_mass_fraction", "physics_threads", "volume_term",
-                   "damping_per_s", "gravity_m_s2", "contact_stiffness_n_per_m", "contact_damping_s_per_m", "grasp_stiffness_n_per_m", "fix_slab",
-                   "regions", "strain_radius_m", "largest_edge_strain"});
+  o.require_known({"mesh",
+                   "material",
+                   "model",
+                   "scale_m_per_unit",
+                   "refine",
+                   "stable_step",
+                   "added_mass_fraction",
+                   "physics_threads",
+                   "volume_term",
+                   "damping_per_s",
+                   "gravity_m_s2",
+                   "contact_stiffness_n_per_m",
+                   "contact_damping_s_per_m",
+                   "contact",
+                   "contact_friction_static",
+                   "contact_friction_kinetic",
+                   "contact_force_limit_n",
+                   "grasp_stiffness_n_per_m",
+                   "fix_slab",
+                   "regions",
+                   "strain_radius_m",
+                   "largest_edge_strain"});
   s.mesh = (dir / o.text("mesh")).string();
   s.material = (dir / o.text("material")).string();
   s.model = o.choice("model", {"gps", "gps_energy", "gps_large_strain", "corotational", "linear"}, "gps_energy");
@@ -115,6 +134,13 @@ SceneSpec read_scene_file(const std::string& path) {
   s.contact_stiffness_n_per_m = o.number("contact_stiffness_n_per_m", 1e-3, 1e7, 200.0);
   s.grasp_stiffness_n_per_m = o.number("grasp_stiffness_n_per_m", 1e-3, 1e7, 100.0);
   s.contact_damping_s_per_m = o.number("contact_damping_s_per_m", 0, 1e4, 0.0);
+  s.contact_proxy = o.choice("contact", {"penalty", "proxy"}, "penalty") == "proxy";
+  s.contact_friction_static = o.number("contact_friction_static", 0, 2, 0.15);
+  s.contact_friction_kinetic = o.number("contact_friction_kinetic", 0, 2, std::min(0.1, s.contact_friction_static));
+  if (s.contact_friction_kinetic > s.contact_friction_static)
+    o.fail("contact_friction_kinetic", std::to_string(s.contact_friction_kinetic) + " is above contact_friction_static " +
+                                           std::to_string(s.contact_friction_static) + ": sliding never holds more than sticking");
+  s.contact_force_limit_n = o.number("contact_force_limit_n", 0.1, 1000, 15.0);
   s.strain_radius_m = o.number("strain_radius_m", 0.001, 0.05, 0.02);
   s.largest_edge_strain = o.number("largest_edge_strain", 0.01, 1.5, 0.4);
   if (o.has("fix_slab")) {

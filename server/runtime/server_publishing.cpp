@@ -75,6 +75,7 @@ void SimulationServer::Impl::publish_snapshot(std::uint64_t tick) {
     if (t.tool.pressed_through()) snap->pressed_through.insert(id);
     if (t.tool.cutting() || t.tool.leaving_cut()) snap->in_cut.insert(id);
     if (t.tool.active()) snap->tool_position[id] = t.tool.position();
+    if (t.tool.active() && scene.contact_proxy) snap->proxies.emplace(id, t.proxy);
     if (t.result.in_contact) snap->tip_strain[id] = t.result.tip_strain;
   }
   responder.publish(std::move(snap));

@@ -61,7 +61,10 @@ void SimulationServer::Impl::adopt(std::shared_ptr<Organ> next, bool new_scene) 
         tools.emplace(spec.id, Tool{SimulatedTool(spec),
                                     std::make_unique<ProbeContact>(organ->contact_surface, spec.tip_radius_m, scene.contact_stiffness_n_per_m, 0.02,
                                                                    scene.contact_damping_s_per_m),
+                                    ContactProxy(organ->contact_surface, proxy_parameters(scene, spec)),
                                     {},
+                                    {},
+                                    0,
                                     {}});
       responder.set_instruments(scene.instruments, organ->contact_surface, scene.contact_stiffness_n_per_m);
       strokes = 0;
@@ -109,6 +112,7 @@ void SimulationServer::Impl::reset_organ() {
 }
 
 void SimulationServer::Impl::start_outside(Tool& t) const {
+  t.proxy.release();  // it anchors again where the tool enters
   // Out the way it came: along the normal of the contact it had (a reset or a new material under a
   // press), else up against gravity (scenes' gravity is along -z), the way a hand brings a tool.
   const Vec3 back = t.result.in_contact ? t.result.normal : Vec3::UnitZ();
@@ -136,7 +140,8 @@ void SimulationServer::Impl::apply_instruments(const BoundaryConditions::FieldEv
       t.result = ContactResult{.cutting = t.tool.cutting()};
       continue;
     }
-    t.result = t.contact->apply(t.tool.position(), t.tool.velocity(), e);
+    t.result =
+        scene.contact_proxy ? t.proxy.apply(t.tool.position(), t.tool.velocity(), e) : t.contact->apply(t.tool.position(), t.tool.velocity(), e);
     if (!t.tool.held().empty()) add_grasp(t.result, t.tool.held().apply(t.tool.position(), t.tool.orientation(), t.tool.velocity(), e));
   }
 }
@@ -183,6 +188,10 @@ std::int64_t SimulationServer::Impl::tick(const Status& status, const proto::Loc
   if (!paused) {
     for (auto& [id, t] : tools) {
       t.tool.move(dt, scene.max_tool_speed_m_s);
+      if (scene.contact_proxy && t.tool.active() && !t.tool.cutting() && !t.tool.leaving_cut())
+        t.proxy.track(t.tool.position(), state.x, dt);
+      else
+        t.proxy.release();
       if (const ToolEvent e = t.tool.update_grasp(organ->boundary.nodes, state.x, scene.grasp_stiffness_n_per_m); e == ToolEvent::grasped)
         event(proto::EventKind::grasped, id, t.tool.owner(), std::to_string(t.tool.held().size()) + " surface nodes");
       else if (e == ToolEvent::let_go)

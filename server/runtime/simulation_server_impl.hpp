@@ -77,7 +77,8 @@ struct SimulationServer::Impl {
   };
   struct Tool {  // physics thread only
     SimulatedTool tool;
-    std::unique_ptr<ProbeContact> contact;
+    std::unique_ptr<ProbeContact> contact;  // the tip's sphere against the surface: where it enters
+    ContactProxy proxy;  // the tool the tissue touches (its force)
     ContactResult result;
     Stroke stroke;
     double cut_edge_strain = 0;  // the largest edge strain of what its blade cut this tick

@@ -7,8 +7,6 @@
 // proxy into the tissue (measured by the penalty contact's own geometry, another code path).
 #include "viscera/runtime/contact_proxy.hpp"
 
-#include "viscera/runtime/surface_exit.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -16,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "viscera/runtime/surface_exit.hpp"
 #include "viscera/tissue/gps/gps_model.hpp"
 #include "viscera/tissue/integrator/explicit_integrator.hpp"
 #include "viscera/tissue/material/elasticity.hpp"
@@ -84,7 +83,9 @@ double sphere_overlap(const ContactSurface& s, std::span<const Vec3> x, const Ve
   return inside_surface(s, x, c) ? radius + nearest : radius - nearest;
 }
 
-ContactResult at(const ContactProxy& proxy, const Vec3& goal, std::span<const Vec3> x) { return proxy.apply(goal, Vec3::Zero(), {x, {}, {}, {}, {}, 0.0}); }
+ContactResult at(const ContactProxy& proxy, const Vec3& goal, std::span<const Vec3> x) {
+  return proxy.apply(goal, Vec3::Zero(), {x, {}, {}, {}, {}, 0.0});
+}
 }  // namespace
 
 TEST(ContactProxy, StaysOnARigidSurfaceAtAnyDepthOfTheGoal) {
@@ -107,7 +108,9 @@ TEST(ContactProxy, StaysOnARigidSurfaceAtAnyDepthOfTheGoal) {
     const Vec3 centre = proxy.centre(goal, plate.x);
     EXPECT_NEAR(centre.z(), r, 2e-6) << "on the surface";
     EXPECT_NEAR((centre - goal).head<2>().norm(), 0.0, 1e-12) << "right above the goal";
-    if (depth > 0.0205 + r) EXPECT_FALSE(penalty.query(goal, plate.x).in_contact) << "the penalty contact has let go at " << depth;
+    if (depth > 0.0205 + r) {
+      EXPECT_FALSE(penalty.query(goal, plate.x).in_contact) << "the penalty contact has let go at " << depth;
+    }
   }
   goal.z() = r + 1e-4;  // lifted out: it lets go
   proxy.track(goal, plate.x, 1e-3);
@@ -305,9 +308,10 @@ TEST(ContactProxy, APressTo70PercentOfTheBlockHoldsTheProxyOnTheSurface) {
     worst_overlap = std::max(worst_overlap, sphere_overlap(*b.surface, b.state.x, centre, r));
     worst_off_surface = std::max(worst_off_surface, std::abs(r - sphere_overlap(*b.surface, b.state.x, b.last.point, r)));
   }
-  std::printf("pressed 14 mm: peak %.3f N, largest fall below the running peak %.2f%%, proxy's point off the surface by %.3f mm at most, "
-              "its sphere overlapping the dent's walls by %.3f mm at most\n",
-              peak, 100 * worst_fall, 1e3 * worst_off_surface, 1e3 * worst_overlap);
+  std::printf(
+      "pressed 14 mm: peak %.3f N, largest fall below the running peak %.2f%%, proxy's point off the surface by %.3f mm at most, "
+      "its sphere overlapping the dent's walls by %.3f mm at most\n",
+      peak, 100 * worst_fall, 1e3 * worst_off_surface, 1e3 * worst_overlap);
   EXPECT_GT(peak, 1.0);
   EXPECT_LT(worst_fall, 0.10);
   EXPECT_LT(worst_off_surface, 0.5e-3);  // the figure for the proxy's penetration

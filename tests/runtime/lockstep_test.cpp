@@ -88,6 +88,23 @@ TEST(Lockstep, TheSameStepsGiveTheSameBitsOnOneThreadAndOnTwoAndANudgedCommandSh
   EXPECT_EQ(d.rfind("tick " + std::to_string(kFirstTick + 200) + ":", 0), 0u) << d;
 }
 
+// The contact proxy (organ.contact "proxy") keeps state across ticks (where it holds, whether it
+// slides): the same steps still give the same bits, and its forces are not the penalty's.
+TEST(Lockstep, TheContactProxyGivesTheSameBitsOnEveryRunAndOnTwoThreads) {
+  const auto with_proxy = [](SceneSpec& s) { s.contact_proxy = true; };
+  const LockstepRun a = run(1, 0, {}, with_proxy), again = run(1, 0, {}, with_proxy), two = run(2, 0, {}, with_proxy);
+  ASSERT_EQ(a.results.size(), static_cast<std::size_t>(kTicks + 1));
+  EXPECT_EQ(first_difference(a, again), "");
+  EXPECT_EQ(first_difference(a, two), "");
+  EXPECT_NE(first_difference(a, run(1)), "");
+  std::string why;
+  int touching = 0;
+  for (const auto& r : a.results)
+    for (const auto& p : r.forces)
+      if (const auto f = proto::decode_force(p, &why); f && f->in_contact && std::abs(f->force[2]) > 0.01) ++touching;
+  EXPECT_GT(touching, 0) << "the script's probe presses the organ";
+}
+
 TEST(Lockstep, StepsTakeEffectAtTheTicksTheyNameOnTheRecordingsClock) {
   const LockstepRun a = run(1);
   ASSERT_EQ(a.results.size(), static_cast<std::size_t>(kTicks + 1));

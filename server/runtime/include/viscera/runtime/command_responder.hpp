@@ -14,6 +14,7 @@
 
 #include "viscera/protocol/messages.hpp"
 #include "viscera/runtime/contact_compliance.hpp"
+#include "viscera/runtime/contact_proxy.hpp"
 #include "viscera/runtime/grasp_hold.hpp"
 #include "viscera/runtime/probe_contact.hpp"
 #include "viscera/runtime/scene_file.hpp"
@@ -41,16 +42,23 @@ struct Snapshot {
   /// do not move while paused), so a hand pressing on a frozen organ never falls through.
   bool paused = false;
   std::map<std::uint32_t, Vec3> tool_position;  ///< each active tool's, after the tick
+  /// Each active tool's proxy after the tick: an answer tracks it to the commanded tip.
+  std::map<std::uint32_t, ContactProxy> proxies;
   double tool_reach_m = 0;  ///< how far a tool may move in one tick (the scene's speed limit / rate)
 };
+
+/// The contact proxy of `spec` in `scene`: its tip, the scene's contact stiffness, dashpot,
+/// friction and force limit.
+ContactProxyParameters proxy_parameters(const SceneSpec& scene, const InstrumentSpec& spec);
 
 /// Grasped tissue follows the jaws through stiff springs; the tool feels their reaction.
 void add_grasp(ContactResult& result, const GraspHold::Reaction& reaction);
 
-/// The local force model's stiffness: the contact penalty in series with the tissue condensed onto
-/// the contact, along the contact normal (the contact is frictionless); the penalty alone (an upper
-/// bound) until the tissue's compliance at the contact is known; with `wait`, it waits for it
-/// (lockstep: the same bits whenever the compliance worker is done).
+/// The local force model's stiffness: the contact's coupling in series with the tissue condensed
+/// onto the contact: along the contact normal, and across it too where friction holds the tool
+/// (a stuck proxy's coupling is isotropic); the coupling alone (an upper bound) until the
+/// tissue's compliance at the contact is known; with `wait`, it waits for it (lockstep: the same
+/// bits whenever the compliance worker is done).
 std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance& compliance, bool wait = false);
 
 /// The force message answering `command` of `owner`'s instrument.

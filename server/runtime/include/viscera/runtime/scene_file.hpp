@@ -64,6 +64,14 @@ struct SceneSpec {
   int physics_threads = 1;
   double contact_stiffness_n_per_m = 200.0;
   double contact_damping_s_per_m = 0.0;  ///< probe contact's Hunt-Crossley dashpot alpha (0: none)
+  /// How instruments touch the organ: the tip's sphere as a penalty (ProbeContact), or a proxy kept
+  /// on the surface with friction (ContactProxy; docs/HAPTICS.md, "The contact proxy").
+  bool contact_proxy = false;
+  /// Coulomb friction between the instruments and the organ's surface (the proxy's) [-]
+  double contact_friction_static = 0.15, contact_friction_kinetic = 0.1;
+  /// The most force the contact puts on a tool and on the tissue, whatever the depth the hand
+  /// commands (the device's limit) [N]
+  double contact_force_limit_n = 15.0;
   double grasp_stiffness_n_per_m = 100.0;  ///< per grasped node
   /// The radius over which the strain at an instrument is averaged (Force.tip_strain) [m]; a
   /// measure that does not depend on the mesh needs it at least 1.5 element edges (docs/TRAINING.md)
