@@ -5,6 +5,8 @@
 // Elements/..., NodesOnly/... and Serial/...: the element loop alone, the tick without it, and the
 // tick without it but with the force threads' hand-over and buffers (the serial share).
 // Material/...: the same tick with the organ switched to each mechanism the lab can hand over.
+// Contact/...: the tick with two probes pressed into the organ, by the penalty contact or the
+// proxy, against none.
 // Run: build/bench/tick_bench [--benchmark_filter=liver-12k]
 #include <algorithm>
 #include <cmath>
@@ -17,6 +19,8 @@
 #include <benchmark/benchmark.h>
 
 #include "viscera/common/json_input.hpp"
+#include "viscera/runtime/command_responder.hpp"
+#include "viscera/runtime/contact_proxy.hpp"
 #include "viscera/runtime/organ.hpp"
 #include "viscera/runtime/parallel_forces.hpp"
 #include "viscera/runtime/scene_file.hpp"
@@ -160,6 +164,66 @@ void tick_with_material(benchmark::State& st, const std::string& scene_name, con
   run_ticks(st, *runtime::rebuild_with_material(*built, change, scene.physics_rate_hz), scene.physics_rate_hz, 1.002);
 }
 
+/// How two probes (6 mm tips, 3 cm apart) touch `scene`'s organ in Contact/...: none, the penalty
+/// contact, or the contact proxy (docs/HAPTICS.md).
+enum class Touch { none, penalty, proxy };
+
+/// The tick of `scene` on one thread with two probes pressed 8 mm into its top and held there:
+/// the contact's cost side by side with none (the scene's contact stiffness, dashpot, friction).
+void contact_tick(benchmark::State& st, const std::string& scene_name, Touch touch) {
+  const runtime::SceneSpec scene = runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
+  const auto organ = runtime::build_organ(scene);
+  if (organ->mesh->node_count() > 0) organ->compliance->wait_node(0);
+  runtime::InstrumentSpec tip;
+  tip.tip_radius_m = 0.006;
+  const double dt = 1.0 / scene.physics_rate_hz;
+  const tissue::Box& b = organ->bounds;
+  const tissue::Vec3 centre(0.5 * (b.lo.x() + b.hi.x()), 0.5 * (b.lo.y() + b.hi.y()), b.hi.z() + 0.002);
+  std::vector<tissue::Vec3> goals = {centre - tissue::Vec3(0.015, 0, 0), centre + tissue::Vec3(0.015, 0, 0)}, velocity(2, tissue::Vec3::Zero());
+  std::vector<runtime::ContactProxy> proxies(2, runtime::ContactProxy(organ->contact_surface, runtime::proxy_parameters(scene, tip)));
+  std::vector<runtime::ProbeContact> penalties(
+      2, runtime::ProbeContact(organ->contact_surface, tip.tip_radius_m, scene.contact_stiffness_n_per_m, 0.02, scene.contact_damping_s_per_m));
+  std::vector<bool> touching(2, false);
+  std::vector<double> touched_z(2, NAN);
+  bool timing = false;
+  organ->integrator->boundary_conditions().force_field = [&](const tissue::BoundaryConditions::FieldEvaluation& e) {
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (touch == Touch::none) {  // the penalty's geometry only, for the press to find the surface
+        if (!timing) touching[k] = penalties[k].query(goals[k], e.x).in_contact;
+        continue;
+      }
+      const auto r = touch == Touch::proxy ? proxies[k].apply(goals[k], velocity[k], e) : penalties[k].apply(goals[k], velocity[k], e);
+      touching[k] = r.in_contact || (touch == Touch::proxy && proxies[k].anchored());
+    }
+  };
+  tissue::State state = tissue::State::at_rest(*organ->mesh);
+  long sub_steps = 0;
+  const auto step = [&] {
+    if (touch == Touch::proxy)
+      for (std::size_t k = 0; k < 2; ++k) proxies[k].track(goals[k], state.x, dt);
+    sub_steps = organ->integrator->advance(state, dt);
+  };
+  for (int t = 0; t < 20000; ++t) {  // down at 1 cm/s to 8 mm past each probe's first touch, then 0.2 s held
+    bool moving = false;
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (std::isnan(touched_z[k]) && touching[k]) touched_z[k] = goals[k].z();
+      const double target = std::isnan(touched_z[k]) ? b.lo.z() : touched_z[k] - 0.008;
+      const double move = std::max(-1e-5 * dt / 1e-3, target - goals[k].z());
+      goals[k].z() += move;
+      velocity[k] = tissue::Vec3(0, 0, move / dt);
+      moving = moving || move != 0.0;
+    }
+    step();
+    if (!moving && t > 200) break;
+  }
+  for (int t = 0; t < 200; ++t) step();
+  velocity.assign(2, tissue::Vec3::Zero());
+  timing = true;
+  for (auto _ : st) step();
+  st.counters["sub_steps"] = static_cast<double>(sub_steps);
+  st.counters["tets"] = static_cast<double>(organ->mesh->tet_count());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -192,6 +256,11 @@ int main(int argc, char** argv) {
   for (const std::string scene : {"liver", "liver-12k"})
     for (const MaterialVariant& v : material_variants())
       benchmark::RegisterBenchmark(("Material/" + std::string(v.name) + "/" + scene).c_str(), tick_with_material, scene, v)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
+  for (const std::string scene : {"liver", "liver-12k"})
+    for (const auto& [name, touch] : {std::pair{"none", Touch::none}, std::pair{"penalty", Touch::penalty}, std::pair{"proxy", Touch::proxy}})
+      benchmark::RegisterBenchmark(("Contact/" + scene + "/" + name).c_str(), contact_tick, scene, touch)
           ->Unit(benchmark::kMicrosecond)
           ->UseRealTime();
   benchmark::RunSpecifiedBenchmarks();

@@ -37,11 +37,11 @@ std::array<double, 9> local_stiffness(const ContactResult& r, ContactCompliance&
     C += r.deepest_weights[k] * *block;
   }
   std::array<double, 9> out{};
-  const bool stuck = coupling.trace() > 1.5 * k_normal;  // isotropic: friction holds
-  const Eigen::Matrix3d K = stuck ? Eigen::Matrix3d((Eigen::Matrix3d::Identity() / k_normal + 0.5 * (C + C.transpose())).inverse())
-                                  : Eigen::Matrix3d(r.normal * r.normal.transpose() / (1.0 / k_normal + r.normal.dot(C * r.normal)));
+  const Eigen::Matrix3d K = r.stuck ? Eigen::Matrix3d((Eigen::Matrix3d::Identity() / k_normal + 0.5 * (C + C.transpose())).inverse())
+                                    : Eigen::Matrix3d(r.normal * r.normal.transpose() / (1.0 / k_normal + r.normal.dot(C * r.normal)));
+  std::size_t next = 0;  // row-major
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) out[static_cast<std::size_t>(3 * i + j)] = K(i, j);
+    for (int j = 0; j < 3; ++j) out[next++] = K(i, j);
   return out;
 }
 

@@ -183,6 +183,7 @@ ContactResult ContactProxy::apply(const Vec3& goal, const Vec3& goal_velocity, c
     if (dashpot > 0 && !field.damping.empty()) field.damping[node] += std::sqrt(3.0) * dashpot * share_[i];
   }
   res.in_contact = true;
+  res.stuck = stuck;
   res.force_on_tool = on_tool;
   res.point = q;
   res.normal = n;
@@ -191,8 +192,9 @@ ContactResult ContactProxy::apply(const Vec3& goal, const Vec3& goal_velocity, c
   res.deepest_triangle = surface_->triangles[at_.triangle];
   res.deepest_weights = at_.weights;
   const Eigen::Matrix3d K = stuck ? Eigen::Matrix3d(k * Eigen::Matrix3d::Identity()) : Eigen::Matrix3d(k * n * n.transpose());
+  std::size_t next = 0;  // row-major
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) res.stiffness[static_cast<std::size_t>(3 * i + j)] = K(i, j);
+    for (int j = 0; j < 3; ++j) res.stiffness[next++] = K(i, j);
   return res;
 }
 

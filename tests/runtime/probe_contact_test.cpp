@@ -16,26 +16,10 @@
 #include "viscera/tissue/mesh/boundary_surface.hpp"
 #include "viscera/tissue/mesh/box_mesh.hpp"
 
-using namespace viscera::runtime;
-using viscera::tissue::Triangle;
+#include "flat_plate.hpp"
 
-namespace {
-struct Plate {
-  std::vector<Vec3> x;
-  std::vector<Triangle> triangles;
-  /// n x n squares of side h in the plane z = 0, two triangles each, normals +z.
-  Plate(int n, double h) {
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) x.emplace_back(i * h - 0.5 * n * h, j * h - 0.5 * n * h, 0.0);
-    const auto id = [n](int i, int j) { return static_cast<std::int32_t>(j * (n + 1) + i); };
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-  }
-};
-}  // namespace
+using namespace viscera::runtime;
+using viscera::runtime::test::Plate;
 
 TEST(ProbeContact, OneSpringAtTheDeepestPenetrationWhateverTheMeshing) {
   const double r = 0.006, k = 1000.0;

@@ -41,6 +41,8 @@ struct ContactResult {
   double depth_m = 0;  ///< deepest penetration of the tip sphere [m]
   std::array<std::int32_t, 3> deepest_triangle{-1, -1, -1};  ///< nodes of the deepest contact
   Vec3 deepest_weights = Vec3::Zero();  ///< its barycentric weights
+  /// Friction holds the tool where it touches (ContactProxy): its stiffness is isotropic.
+  bool stuck = false;
   /// A scalpel's blade cutting: it passes through the tissue, and touches nothing.
   bool cutting = false;
   /// The tissue's strain within the scene's strain radius of where the instrument touches, after
