@@ -12,7 +12,7 @@ namespace {
 constexpr double kLiftFadeS = 0.02;
 /// Triangles whose normal points more than about 107 degrees away from the proxy's are the far
 /// wall of a fold or of a cut's gap, not the surface the proxy slides on.
-constexpr double kFacingCos = -0.3;
+constexpr double kSlideFacingCos = -0.3;
 
 Vec3 vertex_normal(const ContactSurface& s, std::span<const Vec3> x, std::int32_t node) {
   Vec3 n = Vec3::Zero();
@@ -40,7 +40,7 @@ std::optional<SurfacePoint> nearest_surface_point(const ContactSurface& surface,
     if (facing) {
       const Vec3 n = (b - a).cross(c - a);
       const double area2 = n.norm();
-      if (!(area2 > 0) || n.dot(*facing) < kFacingCos * area2) continue;
+      if (!(area2 > 0) || n.dot(*facing) < kSlideFacingCos * area2) continue;
     }
     Vec3 w;
     const Vec3 q = closest_point_on_triangle(p, a, b, c, &w);
