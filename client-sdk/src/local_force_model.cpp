@@ -17,7 +17,20 @@ RenderedForce render_local_model(const protocol::Force& f, const protocol::Vecto
   }
   // Push only: a force that would pull the tool into the tissue is no contact.
   const auto& n = f.contact_normal;
-  if (r.force[0] * n[0] + r.force[1] * n[1] + r.force[2] * n[2] <= 0) return RenderedForce{};
+  const double normal = r.force[0] * n[0] + r.force[1] * n[1] + r.force[2] * n[2];
+  if (normal <= 0) return RenderedForce{};
+  // Coulomb: a model with friction holds sideways at most mu times its push (a stuck tool's model
+  // is stiff in every direction; moved far along the surface, it slides at the cone).
+  if (f.friction_mu > 0) {
+    double t[3], tangential = 0;
+    for (int i = 0; i < 3; ++i) {
+      t[i] = r.force[i] - normal * n[i];
+      tangential += t[i] * t[i];
+    }
+    tangential = std::sqrt(tangential);
+    if (const double cone = f.friction_mu * normal; tangential > cone)
+      for (int i = 0; i < 3; ++i) r.force[i] = normal * n[i] + t[i] * (cone / tangential);
+  }
   const double mag = std::sqrt(r.force[0] * r.force[0] + r.force[1] * r.force[1] + r.force[2] * r.force[2]);
   if (mag > max_force_n) {
     for (double& c : r.force) c *= max_force_n / mag;

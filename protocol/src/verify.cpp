@@ -19,6 +19,7 @@ namespace fb = viscera::wire;  // the flatc-generated types
 namespace {
 
 constexpr double kMaxForceN = 1e4;
+constexpr double kMaxFrictionMu = 2.0;  // a scene's friction coefficients are at most 2
 constexpr double kMaxEdgeStrain = 10.0;  // the server stops an organ whose edges stretch beyond 2 (unstable); 10: room, not physics
 
 fb::Vec3 to_fb(const Vector3& v) { return fb::Vec3(v[0], v[1], v[2]); }
@@ -53,7 +54,7 @@ std::vector<std::uint8_t> encode(const Force& f) {
   const auto model = fb::CreateLocalForceModel(b, &point, &normal, &K, f.in_contact);
   return finish(b, fb::CreateForceFeedback(b, f.instrument_id, f.client_id, f.command_seq, f.command_client_stamp_ns, f.server_stamp_ns, &force,
                                            &torque, model, f.step_time_ns, f.penetration_m, f.tick, f.max_edge_strain, f.cutting, f.cut_edge_strain,
-                                           f.tip_strain, f.organ_epoch));
+                                           f.tip_strain, f.organ_epoch, f.friction_mu));
 }
 
 std::vector<std::uint8_t> encode(const SessionRequest& r) {
@@ -188,6 +189,7 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   f.cut_edge_strain = m->cut_edge_strain();
   f.tip_strain = m->tip_strain();
   f.organ_epoch = m->organ_epoch();
+  f.friction_mu = m->friction_mu();
   if (const auto* lm = m->local_model()) {
     f.in_contact = lm->in_contact();
     f.contact_point = from_fb(lm->point());
@@ -196,8 +198,9 @@ std::optional<Force> decode_force(std::span<const std::uint8_t> bytes, std::stri
   }
   if (!finite(f.force) || !within(f.force, kMaxForceN) || !finite(f.torque) || !finite(f.contact_point) || !std::isfinite(f.penetration_m) ||
       std::abs(f.penetration_m) > kMaxPositionM || !(f.max_edge_strain >= 0 && f.max_edge_strain <= kMaxEdgeStrain) ||
-      !(f.cut_edge_strain >= 0 && f.cut_edge_strain <= kMaxEdgeStrain) || !(f.tip_strain >= 0 && f.tip_strain <= kMaxEdgeStrain)) {
-    *why = "force, torque, contact point, penetration or edge strain not finite or out of range";
+      !(f.cut_edge_strain >= 0 && f.cut_edge_strain <= kMaxEdgeStrain) || !(f.tip_strain >= 0 && f.tip_strain <= kMaxEdgeStrain) ||
+      !(f.friction_mu >= 0 && f.friction_mu <= kMaxFrictionMu)) {
+    *why = "force, torque, contact point, penetration, edge strain or friction not finite or out of range";
     return std::nullopt;
   }
   for (double k : f.stiffness)

@@ -64,6 +64,7 @@ protocol::Force force_message(std::uint32_t instrument_id, std::uint32_t owner, 
   f.cutting = r.cutting;
   // At most what a decoder accepts (an average of stretches beyond 10 is an organ past saving).
   f.tip_strain = std::isfinite(r.tip_strain) ? std::min(r.tip_strain, 10.0) : 10.0;
+  f.friction_mu = r.in_contact && !r.cutting ? r.friction_mu : 0.0;
   return f;
 }
 

@@ -184,6 +184,7 @@ ContactResult ContactProxy::apply(const Vec3& goal, const Vec3& goal_velocity, c
   }
   res.in_contact = true;
   res.stuck = stuck;
+  res.friction_mu = stuck ? p_.friction.static_mu : p_.friction.kinetic_mu;
   res.force_on_tool = on_tool;
   res.point = q;
   res.normal = n;

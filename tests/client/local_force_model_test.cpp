@@ -1,6 +1,8 @@
 // The local force model against its definition: linear in the displacement, push-only, clamped.  // SPDX-License-Identifier: Apache-2.0
 #include "viscera/client/local_force_model.hpp"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 using namespace viscera;
@@ -32,6 +34,24 @@ TEST(LocalForceModel, PushesOnlyAndNeverBeyondTheDeviceLimit) {
   EXPECT_TRUE(deep.clamped);
   protocol::Force free_space;
   EXPECT_EQ(client::render_local_model(free_space, {0, 0, 0}, {0, 0, -1}, 10.0).force[2], 0.0);
+}
+
+TEST(LocalForceModel, AModelWithFrictionHoldsSidewaysUpToTheConeAndSlidesOnIt) {
+  // A stuck contact's model: 2 N along +z, 200 N/m in every direction, mu 0.3. Moved sideways by
+  // dx, the tangential force is 200 dx (linear) until it reaches 0.3 x 2 N at 3 mm; beyond, it
+  // stays on the cone, in the direction it pulls, while the normal force is unchanged.
+  protocol::Force f = contact();
+  f.stiffness = {200.0, 0, 0, 0, 200.0, 0, 0, 0, 200.0};
+  f.friction_mu = 0.3;
+  for (const double dx : {0.001, 0.0029, 0.004, 0.02}) {
+    const auto r = client::render_local_model(f, {0, 0, 0.01}, {dx, 0, 0.01}, 10.0);
+    EXPECT_NEAR(r.force[2], 2.0, 1e-12) << dx;
+    EXPECT_NEAR(r.force[0], -std::min(200.0 * dx, 0.3 * 2.0), 1e-12) << dx;
+    EXPECT_EQ(r.force[1], 0.0);
+  }
+  // Without friction (0: the penalty contact, an older server) the model is rendered as it is.
+  f.friction_mu = 0.0;
+  EXPECT_NEAR(client::render_local_model(f, {0, 0, 0.01}, {0.02, 0, 0.01}, 10.0).force[0], -4.0, 1e-12);
 }
 
 TEST(LocalForceRenderer, BlendsFromTheOldModelToTheNewOneWithoutAJump) {

@@ -40,11 +40,13 @@ TEST(Messages, RoundTripsEveryMessage) {
   f.cutting = true;
   f.cut_edge_strain = 0.31;
   f.tip_strain = 0.12;
+  f.friction_mu = 0.15;
   const auto fd = decode_force(encode(f), &why);
   ASSERT_TRUE(fd) << why;
   EXPECT_TRUE(fd->cutting);
   EXPECT_EQ(fd->cut_edge_strain, 0.31);
   EXPECT_EQ(fd->tip_strain, 0.12);
+  EXPECT_EQ(fd->friction_mu, 0.15);
   EXPECT_EQ(fd->force[2], 3.0);
   EXPECT_TRUE(fd->in_contact);
   EXPECT_EQ(fd->stiffness[4], 200);
@@ -60,6 +62,9 @@ TEST(Messages, RoundTripsEveryMessage) {
     Force t = f;
     t.tip_strain = bad;
     EXPECT_FALSE(decode_force(encode(t), &why)) << bad;
+    Force u = f;
+    u.friction_mu = bad;  // a friction coefficient below 0, not a number, or beyond the scenes' 2
+    EXPECT_FALSE(decode_force(encode(u), &why)) << bad;
   }
   const auto s = decode_session_request(encode(SessionRequest{7, Action::release_instrument, 2}), &why);
   ASSERT_TRUE(s) << why;

@@ -57,6 +57,7 @@ TEST(SchemaEvolution, NewReaderReadsOldMessagesWithDefaults) {
   EXPECT_EQ(f->force[2], 2.5);
   EXPECT_EQ(f->stiffness[8], 400);
   EXPECT_EQ(f->penetration_m, 0.0);  // absent: the schema's default
+  EXPECT_EQ(f->friction_mu, 0.0);  // schema 20: an older server's model is rendered without a cone
   EXPECT_EQ(f->tick, 0u);  // an older server stamps no tick: a recording of it cannot be re-simulated
   EXPECT_EQ(f->max_edge_strain, 0.0);  // nor the organ's strain (schema 8)
   EXPECT_FALSE(f->cutting);  // nor a blade cutting (schema 17)

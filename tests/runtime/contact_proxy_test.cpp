@@ -127,10 +127,12 @@ TEST(ContactProxy, CoulombConeOnARigidPlateSticksBelowStaticAndSlidesAtKinetic) 
     EXPECT_NEAR(fn, k * depth, 1e-9);
     if (shift <= mu_s * depth - 1e-9) {  // within the static cone: stuck where it touched
       EXPECT_FALSE(proxy.sliding()) << "shift " << shift;
+      EXPECT_EQ(c.friction_mu, mu_s) << "the local model's cone: static while stuck";
       EXPECT_NEAR(proxy.centre(goal, plate.x).x(), start.x(), 1e-12);
       EXPECT_NEAR(ft, k * shift, 1e-9);
     } else {  // sliding: the proxy trails the goal by mu_k depth, the force on the kinetic cone
       EXPECT_TRUE(proxy.sliding()) << "shift " << shift;
+      EXPECT_EQ(c.friction_mu, mu_k);
       EXPECT_NEAR(ft / fn, mu_k, 1e-9) << "shift " << shift;
       EXPECT_NEAR(goal.x() - proxy.centre(goal, plate.x).x(), mu_k * depth, 1e-9);
     }

@@ -92,7 +92,9 @@ void bind_session(py::module_& m) {
                     "a cutting scalpel's: the largest edge strain of the tetrahedra it cut that tick, just after it cut them [-]")
       .def_readonly("tip_strain", &protocol::Force::tip_strain,
                     "the tissue's strain at the instrument after that tick: principal stretch strain |lambda - 1| averaged within the "
-                    "scene's strain radius of where it touches (0 out of contact) [-]");
+                    "scene's strain radius of where it touches (0 out of contact) [-]")
+      .def_readonly("friction_mu", &protocol::Force::friction_mu,
+                    "Coulomb friction at the contact: the tangential force is at most this times the normal one (0: none) [-]");
   py::class_<protocol::Event>(m, "Event", "A session event (server) or an annotation (client).")
       .def_property_readonly(
           "kind", [](const protocol::Event& e) { return std::string(protocol::event_name(e.kind)); },

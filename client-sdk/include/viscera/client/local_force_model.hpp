@@ -2,7 +2,9 @@
 // Rendering the server's local contact model at the device rate (docs/HAPTICS.md section 2): between
 // server updates and across network delay the client renders F(x) = F0 - K (x - x0), with x0 the
 // tip position the server computed F0 for and K = -dF/dx, pushing only out of the tissue (along
-// the contact normal) and never beyond the device's force limit.
+// the contact normal), within the contact's friction cone where it has friction
+// (Force::friction_mu: its tangential part at most mu times its normal part), and never beyond
+// the device's force limit.
 #include <limits>
 
 #include "viscera/protocol/messages.hpp"

@@ -51,6 +51,9 @@ struct Force {
   /// schema 19: +1 at each reset, scene load, material change, pause and resume: the organ under
   /// the tool jumped without the tool moving (a client fades its force in again); 0 from older servers
   std::uint32_t organ_epoch = 0;
+  /// schema 20: Coulomb friction at the contact (the contact proxy's): the rendered tangential
+  /// force is at most this times the normal force; 0 without friction, and from older servers
+  double friction_mu = 0;
 };
 
 enum class Action : std::int8_t {
@@ -272,7 +275,7 @@ struct LockstepResult {
 };
 
 /// The protocol's schema version: what this build writes and the newest it reads.
-inline constexpr int kSchemaVersion = 19;
+inline constexpr int kSchemaVersion = 20;
 
 std::vector<std::uint8_t> encode(const Command& c);
 std::vector<std::uint8_t> encode(const Force& f);

@@ -43,6 +43,8 @@ struct ContactResult {
   Vec3 deepest_weights = Vec3::Zero();  ///< its barycentric weights
   /// Friction holds the tool where it touches (ContactProxy): its stiffness is isotropic.
   bool stuck = false;
+  /// The friction cone the tool is on: static while stuck, kinetic while sliding; 0 without friction.
+  double friction_mu = 0;
   /// A scalpel's blade cutting: it passes through the tissue, and touches nothing.
   bool cutting = false;
   /// The tissue's strain within the scene's strain radius of where the instrument touches, after
