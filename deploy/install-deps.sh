@@ -20,6 +20,8 @@ packages=(
   nlohmann-json3-dev       # JSON for scene, material and data-set files
   python3                  # bench summary and test scripts that read JSON
   libpugixml-dev           # XML parsing of VTU meshes
+  libcgal-dev              # viscera-mesh: CGAL Mesh_3 on labelled images (a patient's organ from a CT label map)
+  libnifti2-dev            # viscera-mesh: the label maps (NIfTI-1 and -2, .nii and .nii.gz)
   libzstd-dev liblz4-dev   # MCAP chunk compression (zstd, lz4) in session recordings
   libssl-dev               # SHA-256 of the files a scene was built from (recordings name them); the console's HTTPS and WSS
   libboost-dev             # Boost.Beast: the console's HTTP and WebSocket server (header-only)

@@ -92,9 +92,7 @@ PlacedRegion tagged_region(const RegionSpec& spec, std::size_t k, const tissue::
                            const std::string& source) {
   const tissue::ElementSet* set = tissue::find_element_set(mesh, spec.element_set);
   if (!set) {
-    std::string known;
-    for (const tissue::ElementSet& s : mesh.element_sets)
-      known += (known.empty() ? "" : ", ") + std::to_string(s.tag) + (s.name.empty() ? "" : " '" + s.name + "'");
+    const std::string known = tissue::describe_element_sets(mesh);
     throw InputError(source, 0, field(k, ".elements"),
                      "'" + common::printable(spec.element_set) + "' is not a physical group of the organ's mesh (" +
                          (known.empty() ? "it tags no volume elements" : "its volume groups: " + known) + ")");

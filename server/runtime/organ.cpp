@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 
 #include "viscera/common/file_bytes.hpp"
 #include "viscera/common/input_error.hpp"
@@ -49,6 +50,33 @@ Box fixed_slab(const SceneSpec& s, const Box& bounds) {
   return slab;
 }
 
+/// The scene's fixed nodes: the boundary nodes in its slab, or those of the boundary faces of its
+/// fix_elements set's tetrahedra.
+std::vector<std::int32_t> fixed_nodes(const Organ& organ) {
+  const SceneSpec& s = organ.scene;
+  if (s.fix_elements.empty()) return surface_nodes_in_box(*organ.mesh, fixed_slab(s, organ.bounds));
+  const ElementSet* set = find_element_set(*organ.mesh, s.fix_elements);
+  if (!set) {
+    const std::string known = describe_element_sets(*organ.mesh);
+    throw InputError(s.source, 0, "organ.fix_elements",
+                     "'" + common::printable(s.fix_elements) + "' is not a physical group of the organ's mesh (" +
+                         (known.empty() ? "it tags no volume elements" : "its volume groups: " + known) + ")");
+  }
+  std::vector<char> in_set(organ.mesh->tet_count(), 0);
+  for (const std::int32_t e : set->tets) in_set[static_cast<std::size_t>(e)] = 1;
+  std::vector<std::int32_t> nodes;
+  for (std::size_t f = 0; f < organ.boundary.triangles.size(); ++f)
+    if (in_set[static_cast<std::size_t>(organ.boundary.owner_tet[f])])
+      nodes.insert(nodes.end(), organ.boundary.triangles[f].begin(), organ.boundary.triangles[f].end());
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  if (nodes.empty())
+    throw InputError(
+        s.source, 0, "organ.fix_elements",
+        "'" + common::printable(s.fix_elements) + "': none of its tetrahedra has a face on the organ's surface; nothing would hold the organ");
+  return nodes;
+}
+
 /// Model, integrator and compliance of `organ` from its scene, material and mesh, once a tick at
 /// `rate_hz` is known to fit the budget (a step that cannot run is refused before any is taken).
 /// `field` names what the user chose (the material file, or the parameter changed);
@@ -92,7 +120,7 @@ void build_physics(Organ& organ, double rate_hz, const TickBudget& budget, const
   }
   BoundaryConditions bc;
   bc.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
-  bc.fixed_nodes = surface_nodes_in_box(*organ.mesh, fixed_slab(s, organ.bounds));
+  bc.fixed_nodes = fixed_nodes(organ);
   // Safety 0.85 < sqrt(3)/2: the instruments' springs are taken implicitly (force_field).
   organ.integrator = std::make_unique<ExplicitIntegrator>(
       *organ.model, density, bc, ExplicitOptions{0.85, 0.0, s.damping_per_s, 2.0, s.global_stable_step, s.added_mass_fraction});
@@ -215,7 +243,11 @@ std::unique_ptr<Organ> build_organ(const SceneSpec& scene, const TickBudget& bud
   organ->material = read_material_file(scene.material);
   organ->bounds = bounding_box(*organ->mesh);
   organ->boundary = extract_boundary(*organ->mesh);
-  organ->regions = lay_out_regions(scene.regions, *organ->mesh, organ->boundary, fixed_slab(scene, organ->bounds), scene.source);
+  // A nodule drawn at random keeps out of the fixed slab; an organ held by its own faces has no slab.
+  const Box keep_out = scene.fix_elements.empty()
+                           ? fixed_slab(scene, organ->bounds)
+                           : Box{Vec3::Constant(std::numeric_limits<double>::infinity()), Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  organ->regions = lay_out_regions(scene.regions, *organ->mesh, organ->boundary, keep_out, scene.source);
   for (const RegionSpec& r : scene.regions) organ->region_materials.push_back(read_material_file(r.material));
   build_physics(*organ, scene.physics_rate_hz, budget, scene.source, "organ.material", scene.material);
   return organ;

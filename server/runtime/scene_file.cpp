@@ -25,6 +25,14 @@ std::array<double, 3> point(const JsonObject& o, const char* key) {
   return {v[0], v[1], v[2]};
 }
 
+/// The name or tag of an element set (a physical group of the mesh) at `key`, as text.
+std::string element_set(const JsonObject& o, const char* key) {
+  const json& set = o.value()[key];
+  if (set.is_string() && !set.get<std::string>().empty() && set.get<std::string>().size() <= 128) return set.get<std::string>();
+  if (set.is_number_integer() && set.get<long long>() > 0 && set.get<long long>() <= 2'147'483'647) return std::to_string(set.get<long long>());
+  o.fail(key, "'" + common::printable(set.dump()) + "' is neither the name (1-128 characters) nor the positive tag of a physical group of the mesh");
+}
+
 RegionSpec read_region(const JsonObject& r, const std::filesystem::path& dir, std::set<std::string>& names) {
   r.require_known({"name", "material", "sphere", "box", "elements"});
   RegionSpec region;
@@ -35,15 +43,8 @@ RegionSpec read_region(const JsonObject& r, const std::filesystem::path& dir, st
   if (int(r.has("sphere")) + int(r.has("box")) + int(r.has("elements")) != 1)
     r.fail("sphere", "a region is one of a \"sphere\", a \"box\" or \"elements\" (a tagged element set of the mesh)");
   if (r.has("elements")) {
-    const json& set = r.value()["elements"];
     region.shape = RegionSpec::Shape::elements;
-    if (set.is_string() && !set.get<std::string>().empty() && set.get<std::string>().size() <= 128)
-      region.element_set = set.get<std::string>();
-    else if (set.is_number_integer() && set.get<long long>() > 0 && set.get<long long>() <= 2'147'483'647)
-      region.element_set = std::to_string(set.get<long long>());
-    else
-      r.fail("elements",
-             "'" + common::printable(set.dump()) + "' is neither the name (1-128 characters) nor the positive tag of a physical group of the mesh");
+    region.element_set = element_set(r, "elements");
     return region;
   }
   if (r.has("box")) {
@@ -117,6 +118,7 @@ SceneSpec read_scene_file(const std::string& path) {
                    "contact_force_limit_n",
                    "grasp_stiffness_n_per_m",
                    "fix_slab",
+                   "fix_elements",
                    "regions",
                    "strain_radius_m",
                    "largest_edge_strain"});
@@ -143,6 +145,9 @@ SceneSpec read_scene_file(const std::string& path) {
   s.contact_force_limit_n = o.number("contact_force_limit_n", 0.1, 1000, 15.0);
   s.strain_radius_m = o.number("strain_radius_m", 0.001, 0.05, 0.02);
   s.largest_edge_strain = o.number("largest_edge_strain", 0.01, 1.5, 0.4);
+  if (o.has("fix_slab") && o.has("fix_elements"))
+    o.fail("fix_elements", "the organ is held either by a slab (fix_slab) or by an element set (fix_elements), not both");
+  if (o.has("fix_elements")) s.fix_elements = element_set(o, "fix_elements");
   if (o.has("fix_slab")) {
     const json& f = o.array("fix_slab");
     if (f.size() != 3 || !f[0].is_string() || !f[1].is_string() || !f[2].is_number())

@@ -221,6 +221,41 @@ TEST(MaterialRegions, ATaggedElementSetIsTheRegionOfTheElementsTheFileTagged) {
   EXPECT_NE(error("list", "[7]").find("organ.regions[0].elements"), std::string::npos);
 }
 
+// An organ held by an element set (fix_elements, as viscera-mesh writes for a patient's organ):
+// the nodes of its tetrahedra's boundary faces are fixed, the same nodes as the slab that holds
+// those tetrahedra (another code path: boundary nodes in a box), through the scene's refinement.
+TEST(MaterialRegions, AnOrganHeldByAnElementSetFixesTheBoundaryNodesOfItsTetrahedra) {
+  const TetMesh box = make_box_mesh(Vec3(0, 0, 0), Vec3(0.1, 0.02, 0.02), 10, 2, 2);
+  const std::string mesh_file = write("held-groups.msh", gmsh_with_groups(box, 0.07));
+  const std::string soft = isotropic("soft-held", 5e3, 1060);
+  const auto scene = [&](const std::string& name, const std::string& holding) {
+    return write(name + ".json", R"({"name": ")" + name + R"(", "organ": {"mesh": ")" + mesh_file + R"(", "material": ")" + soft +
+                                     R"(", "refine": 1, )" + holding + "}, \"instruments\": [{\"id\": 1}]}");
+  };
+  const auto held = build_organ(read_scene_file(scene("held-set", R"("fix_elements": "far end")")), kUntimed);
+  const auto slab = build_organ(read_scene_file(scene("held-slab", R"("fix_slab": ["x", "max", 0.3])")), kUntimed);
+  auto fixed = held->integrator->boundary_conditions().fixed_nodes, expected = slab->integrator->boundary_conditions().fixed_nodes;
+  std::sort(fixed.begin(), fixed.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(fixed, expected);
+  EXPECT_GT(fixed.size(), 20u);
+  const auto error = [&](const std::string& name, const std::string& holding) {
+    try {
+      build_organ(read_scene_file(scene(name, holding)), kUntimed);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("held-unknown", R"("fix_elements": "liver")")
+                .find("organ.fix_elements: 'liver' is not a physical group of the organ's mesh (its volume groups: 3, 7 'far end')"),
+            std::string::npos)
+      << error("held-unknown", R"("fix_elements": "liver")");
+  EXPECT_NE(error("held-both", R"("fix_elements": 7, "fix_slab": ["x", "max", 0.3])").find("organ.fix_elements: the organ is held either by a slab"),
+            std::string::npos);
+  EXPECT_NE(error("held-zero", R"("fix_elements": 0)").find("organ.fix_elements: '0' is neither the name"), std::string::npos);
+}
+
 // A region over the whole organ gives the organ made of the region's material, through the
 // server's own building path (the region's unrelaxed elasticity from the organ's relaxation);
 // a nodule changes the forces of its own elements only.

@@ -4,6 +4,13 @@
 
 namespace viscera::tissue {
 
+std::string describe_element_sets(const TetMesh& mesh) {
+  std::string known;
+  for (const ElementSet& s : mesh.element_sets)
+    known += (known.empty() ? "" : ", ") + std::to_string(s.tag) + (s.name.empty() ? "" : " '" + s.name + "'");
+  return known;
+}
+
 const ElementSet* find_element_set(const TetMesh& mesh, const std::string& name) {
   for (const ElementSet& set : mesh.element_sets)
     if (set.name == name || (!name.empty() && name == std::to_string(set.tag))) return &set;

@@ -83,6 +83,10 @@ struct SceneSpec {
   double max_tool_speed_m_s = 0.5;  ///< simulated tools follow commands at most this fast (simulated time)
   std::string fix_axis = "z", fix_side = "max";
   double fix_fraction = 0.2;
+  /// When set, instead of the slab: the name or tag of an element set (physical group) of the mesh;
+  /// the nodes of the boundary faces of its tetrahedra are fixed (a patient's organ where it is held,
+  /// written by viscera-mesh).
+  std::string fix_elements;
   std::vector<InstrumentSpec> instruments;
   std::vector<RegionSpec> regions;  ///< later regions take the elements they share with earlier ones
 };

@@ -34,6 +34,8 @@ struct TetMesh {
 
 /// The element set of that name or, when `name` is a decimal number, of that tag; nullptr if none.
 const ElementSet* find_element_set(const TetMesh& mesh, const std::string& name);
+/// The mesh's element sets for messages: "5 'liver', 4 'gallbladder'"; empty when it has none.
+std::string describe_element_sets(const TetMesh& mesh);
 
 /// Scales every node position by `factor` about the origin (meshes without units).
 void scale_mesh(TetMesh& mesh, double factor);
