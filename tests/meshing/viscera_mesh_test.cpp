@@ -161,7 +161,7 @@ TEST(VisceraMesh, APhantomsLabelsAreMeshedToTheirAnalyticVolumesAndSurfacesWithW
   EXPECT_GE(q.min_dihedral_deg, 5);
   EXPECT_NEAR(static_cast<double>(mesh.tet_count()) / 20000, 1, 0.1);
   // The report gives the distribution and each stage's time.
-  std::ifstream in(out + "/phantom-report.json");
+  std::ifstream in(out + "/reports/phantom.json");
   const auto report = nlohmann::json::parse(in);
   EXPECT_EQ(report["quality"]["min_dihedral_histogram_5deg"].size(), 15U);
   EXPECT_GT(report["stages_s"]["mesh_s"].get<double>(), 0);
@@ -263,7 +263,7 @@ TEST(VisceraMesh, ThePatientsLiverAndGallbladderKeepTheirVoxelVolumesConformAndF
   }
   ASSERT_GT(distance.size(), 500U);
   EXPECT_LT(common::percentile(distance, 0.95), diagonal);
-  std::ifstream in(out + "/liver-report.json");
+  std::ifstream in(out + "/reports/liver.json");
   const auto report = nlohmann::json::parse(in);
   EXPECT_LT(report["stages_s"]["total_s"].get<double>(), 60);
   EXPECT_GT(report["held"]["faces"].get<int>(), 0);

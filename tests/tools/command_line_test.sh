@@ -105,6 +105,18 @@ expect bench-thread-cpu-scene 2 "no scene 'nowhere'" -- "$src/bench/thread_cpu.s
 expect bench-thread-cpu-window 2 "SECONDS: '0'" -- "$src/bench/thread_cpu.sh" liver 0
 expect bench-palpation-help 0 "Usage: .*palpation.sh" -- "$src/bench/palpation.sh" --help
 expect bench-palpation-seeds 2 "SEEDS: 'three' is not a whole number" -- env SEEDS=three "$src/bench/palpation.sh"
+mesh="$build/tools/viscera-mesh/viscera-mesh"; labels="$src/data/label-maps/abdomen-totalsegmentator/example_seg.nii.gz"
+expect mesh-help 0 "Usage: viscera-mesh LABELMAP" -- "$mesh" --help
+expect mesh-no-organ 2 "--organ: which labels" -- "$mesh" "$labels" --material "$src/data/materials/liver.json" --out "$tmp/m"
+expect mesh-bad-label 2 "--organ: 'liver' is not a label" -- "$mesh" "$labels" --organ liver --material "$src/data/materials/liver.json" --out "$tmp/m"
+expect mesh-bad-region 2 "--region: '4:gallbladder' is not LABEL:NAME:MATERIAL" -- "$mesh" "$labels" --organ 5 --region 4:gallbladder --material x --out "$tmp/m"
+expect mesh-region-name 2 "--region: the name '../up'" -- "$mesh" "$labels" --organ 5 --region 4:../up:x.json --material x --out "$tmp/m"
+expect mesh-both-sizes 2 "--edge-mm and --tets" -- "$mesh" "$labels" --organ 5 --tets 5000 --edge-mm 5 --material x --out "$tmp/m"
+expect mesh-frame 2 "--frame: 'world'" -- "$mesh" "$labels" --organ 5 --frame world --material x --out "$tmp/m"
+expect mesh-nodule 2 "--nodule: '90:x.json'" -- "$mesh" "$labels" --organ 5 --nodule 90:x.json --material x --out "$tmp/m"
+expect mesh-no-material 2 "nowhere.json: no such file" -- "$mesh" "$labels" --organ 5 --material "$tmp/nowhere.json" --out "$tmp/m"
+expect bench-patient-help 0 "Usage: .*patient_organ.sh" -- "$src/bench/patient_organ.sh" --help
+expect bench-patient-runs 2 "RUNS: 'x'" -- env RUNS=x "$src/bench/patient_organ.sh"
 expect lab-help 0 "Usage: viscera-lab analyze" -- "$lab" --help
 expect lab-no-command 2 "missing command" -- "$lab" --out "$tmp/o"
 expect lab-no-out 2 "--out OUT_DIR is required" -- "$lab" analyze "$src/data/titin-passive-muscle"

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
                                   "mesh of the organ's labels (CGAL Mesh_3, one physical group per label, the interfaces conforming), a scene file\n"
                                   "(materials per label, where the organ is held, the instruments), a report (each label's mesh volume against its\n"
                                   "voxels, the surface's distance to the label boundary, element quality, the explicit step, each stage's time) and\n"
-                                  "a picture (docs/MESHING.md). Writes OUT/NAME.msh, NAME.json, NAME-report.json and NAME.svg.\n"
+                                  "a picture (docs/MESHING.md). Writes OUT/NAME.msh, NAME.json, NAME.svg and reports/NAME.json.\n"
                                   "Exit status 2: bad arguments or input (one line names the file, field and value).");
   cl.usage(
       "viscera-mesh LABELMAP.nii[.gz] --organ LABELS --material FILE --out DIR [--name NAME] [--region LABEL:NAME:FILE,...] "
@@ -79,6 +79,9 @@ int main(int argc, char** argv) {
   cl.flag("organ-name", "NAME", "the organ's physical group", "organ");
   cl.flag("material", "FILE", "the organ's material file (data/materials/liver-viscoelastic.json)");
   cl.flag("region", "LABEL:NAME:FILE,...", "labels inside the organ with a material of their own (4:gallbladder:gallbladder.json)");
+  cl.flag("nodule", "MM:FILE",
+          "a spherical nodule of this radius and material under the organ's upper surface, 2-5 mm deep, its centre drawn by the "
+          "server (seed 1): the palpation exercise's region 'nodule'");
   cl.flag("tets", "N", "about this many tetrahedra (200 to 2,000,000); the edge length is found by up to 4 meshings", "12000");
   cl.flag("edge-mm", "MM", "instead of --tets: the tetrahedra's edge length bound [mm]");
   cl.flag("facet-distance-mm", "MM", "how far the surface may stray from the label boundary [mm] (default: the smallest voxel edge)");
@@ -108,6 +111,18 @@ int main(int argc, char** argv) {
       throw UsageError("--organ-name: '" + viscera::common::printable(r.organ_name) + "' is not 1-64 letters, digits, '.', '_' or '-'");
     r.material = cl.text("material");
     if (cl.given("region")) r.regions = region_list(cl.text("region"));
+    for (const auto& region : r.regions)
+      if (cl.given("nodule") && region.name == "nodule") throw UsageError("--region: the name 'nodule' is --nodule's; name the region otherwise");
+    if (cl.given("nodule")) {
+      const std::string v = cl.text("nodule");
+      const std::size_t colon = v.find(':');
+      char* stop = nullptr;
+      const double mm = colon == std::string::npos ? 0 : std::strtod(v.substr(0, colon).c_str(), &stop);
+      if (colon == std::string::npos || colon == 0 || *stop != '\0' || !(mm >= 1 && mm <= 50) || colon + 1 == v.size())
+        throw UsageError("--nodule: '" + viscera::common::printable(v) + "' is not RADIUS_MM:MATERIAL with a radius of 1-50 mm");
+      r.nodule_radius_m = mm * 1e-3;
+      r.nodule_material = v.substr(colon + 1);
+    }
     if (cl.given("edge-mm") && cl.given("tets")) throw UsageError("--edge-mm and --tets: give one (the size, or the count)");
     if (cl.given("edge-mm"))
       r.edge_m = cl.number_in("edge-mm", 0.1, 500) * 1e-3;

@@ -90,15 +90,17 @@ int make_organ(const OrganRequest& q) {
     if (!q.quiet) std::printf("viscera-mesh: %s\n", line.c_str());
     std::fflush(stdout);
   };
-  // Outputs are checked before any work: a long run never ends in a refusal.
+  // Outputs are checked before any work: a long run never ends in a refusal. The report lies in a
+  // folder of its own: the server lists every .json beside a scene as a scene it can load.
   const std::filesystem::path dir(q.out_dir);
   const std::string mesh_file = (dir / (q.name + ".msh")).string(), scene_file = (dir / (q.name + ".json")).string(),
-                    report_file = (dir / (q.name + "-report.json")).string(), picture_file = (dir / (q.name + ".svg")).string();
+                    report_file = (dir / "reports" / (q.name + ".json")).string(), picture_file = (dir / (q.name + ".svg")).string();
   std::vector<std::string> inputs{q.label_map, q.material};
   for (const RegionLabel& r : q.regions) inputs.push_back(r.material);
+  if (q.nodule_radius_m > 0) inputs.push_back(q.nodule_material);
   for (const std::string& input : inputs)
     if (!std::filesystem::is_regular_file(input)) throw InputError(input, 0, "", "no such file");
-  common::create_output_folder(q.out_dir, "--out");
+  common::create_output_folder((dir / "reports").string(), "--out");
   for (const auto& [file, what] :
        {std::pair{mesh_file, "the mesh"}, {scene_file, "the scene"}, {report_file, "the report"}, {picture_file, "the picture"}}) {
     common::refuse_existing_output(file, q.replace, "--replace");
@@ -243,6 +245,11 @@ int make_organ(const OrganRequest& q) {
   json regions = json::array();
   for (const RegionLabel& r : q.regions)
     regions.push_back({{"name", r.name}, {"material", relative_to(r.material, q.out_dir)}, {"elements", r.name}});
+  if (q.nodule_radius_m > 0)
+    regions.push_back(
+        {{"name", "nodule"},
+         {"material", relative_to(q.nodule_material, q.out_dir)},
+         {"sphere", {{"radius_m", q.nodule_radius_m}, {"random_center", {{"seed", 1}, {"depth_m", {0.002, 0.005}}, {"facing", {0, 0, 1}}}}}}});
   json organ = {{"mesh", q.name + ".msh"},        {"scale_m_per_unit", 1},       {"material", relative_to(q.material, q.out_dir)},
                 {"model", "gps_energy"},          {"stable_step", "global"},     {"volume_term", 0.5},
                 {"damping_per_s", 2.0},           {"gravity_m_s2", 0},           {"contact_stiffness_n_per_m", 1000},

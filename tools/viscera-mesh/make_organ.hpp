@@ -20,6 +20,8 @@ struct OrganRequest {
   std::string organ_name = "organ";
   std::string material;
   std::vector<RegionLabel> regions;
+  double nodule_radius_m = 0;  ///< 0: none
+  std::string nodule_material;
   std::size_t target_tets = 12000;  ///< used when edge_m is 0
   double edge_m = 0;
   double facet_distance_m = 0;  ///< 0: the smallest voxel edge
