@@ -29,6 +29,7 @@ std::string gmsh_text(const LabelledMesh& mesh, const std::vector<PhysicalGroup>
   for (const auto& p : mesh.nodes) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   char line[256];
   std::vector<std::pair<int, std::pair<std::int32_t, bool>>> ordered;
+  ordered.reserve(entity.size());
   for (const auto& [key, tag] : entity) ordered.push_back({tag, key});
   std::sort(ordered.begin(), ordered.end());
   for (const auto& [tag, key] : ordered) {

@@ -34,7 +34,7 @@ void copy_labels(const void* data, std::int64_t n, std::vector<std::int32_t>& ou
       if (static_cast<long double>(x) > 2'147'483'647.0L || static_cast<long double>(x) < -2'147'483'648.0L)
         throw InputError(path, 0, "voxel " + std::to_string(k), std::to_string(x) + " is beyond the labels of 32 bits");
     }
-    out[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(x);
+    out[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(x);  // NOLINT(bugprone-signed-char-misuse): int8 voxels are signed labels
   }
 }
 

@@ -178,6 +178,7 @@ int make_organ(const OrganRequest& q) {
   for (const std::int32_t l : q.organ_labels) names.emplace_back(l, q.organ_name);
   for (const RegionLabel& r : q.regions) names.emplace_back(r.label, r.name);
   std::vector<VolumeTarget> targets;
+  targets.reserve(labels.size());
   json restoration = json::array();
   for (const std::int32_t l : labels) targets.push_back({l, static_cast<double>(counts.at(l)) * map.voxel_volume_m3()});
   std::map<std::int32_t, double> meshed_volume;
@@ -259,6 +260,7 @@ int make_organ(const OrganRequest& q) {
   const json scene = {{"name", q.name}, {"domain_id", 0}, {"physics_rate_hz", 1000}, {"organ", organ}, {"instruments", instruments_json()}};
   common::write_file_text(scene_file, scene.dump(2) + "\n");
   std::vector<PictureLabel> legend;
+  legend.reserve(names.size());
   for (const auto& [label, name] : names) legend.push_back({label, name});
   std::vector<char> held_flag(mesh.tets.size(), 0);
   for (const std::int32_t e : held.tets) held_flag[static_cast<std::size_t>(e)] = 1;

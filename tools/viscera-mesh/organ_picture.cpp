@@ -13,6 +13,7 @@ namespace viscera::meshing {
 std::string organ_picture_svg(const LabelledMesh& mesh, const std::vector<PictureLabel>& labels, const std::vector<char>& held,
                               const std::string& title) {
   std::vector<std::int32_t> all;
+  all.reserve(labels.size());
   for (const PictureLabel& l : labels) all.push_back(l.label);
   std::vector<std::int32_t> owner;
   const auto faces = label_boundary(mesh, all, &owner);

@@ -36,6 +36,7 @@ std::vector<RestoredOffset> restore_label_volumes(LabelledMesh& mesh, const std:
   std::vector<VolumeTarget> order = targets;
   std::sort(order.begin(), order.end(), [](const VolumeTarget& a, const VolumeTarget& b) { return a.volume_m3 < b.volume_m3; });
   std::vector<RestoredOffset> applied;
+  applied.reserve(order.size());
   for (const VolumeTarget& t : order) applied.push_back({t.label, 0});
   // Tetrahedra around each node: what a move must keep positive.
   std::vector<std::vector<std::int32_t>> around(mesh.nodes.size());
