@@ -265,7 +265,9 @@ TEST(VisceraMesh, ThePatientsLiverAndGallbladderKeepTheirVoxelVolumesConformAndF
   EXPECT_LT(common::percentile(distance, 0.95), diagonal);
   std::ifstream in(out + "/reports/liver.json");
   const auto report = nlohmann::json::parse(in);
-  EXPECT_LT(report["stages_s"]["total_s"].get<double>(), 60);
+  if (VISCERA_TIMED) {
+    EXPECT_LT(report["stages_s"]["total_s"].get<double>(), 60);
+  }
   EXPECT_GT(report["held"]["faces"].get<int>(), 0);
   std::printf(
       "patient: %zu tetrahedra; liver %+.2f%%, gallbladder %+.2f%% of their voxels; %zu shared faces; liver surface p95 %.2f mm (diagonal %.2f); "

@@ -116,9 +116,10 @@ int main(int argc, char** argv) {
     if (cl.given("nodule")) {
       const std::string v = cl.text("nodule");
       const std::size_t colon = v.find(':');
+      const std::string radius = colon == std::string::npos ? std::string() : v.substr(0, colon);
       char* stop = nullptr;
-      const double mm = colon == std::string::npos ? 0 : std::strtod(v.substr(0, colon).c_str(), &stop);
-      if (colon == std::string::npos || colon == 0 || *stop != '\0' || !(mm >= 1 && mm <= 50) || colon + 1 == v.size())
+      const double mm = radius.empty() ? 0 : std::strtod(radius.c_str(), &stop);
+      if (radius.empty() || *stop != '\0' || !(mm >= 1 && mm <= 50) || colon + 1 == v.size())
         throw UsageError("--nodule: '" + viscera::common::printable(v) + "' is not RADIUS_MM:MATERIAL with a radius of 1-50 mm");
       r.nodule_radius_m = mm * 1e-3;
       r.nodule_material = v.substr(colon + 1);
