@@ -96,16 +96,22 @@ double LabelBoundaryDistance::operator()(const Eigen::Vector3d& p) const {
   }
 }
 
+double label_volume(const LabelledMesh& mesh, std::int32_t label) {
+  double v = 0;
+  for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
+    if (mesh.label[e] != label) continue;
+    const auto& t = mesh.tets[e];
+    const Eigen::Vector3d& a = mesh.nodes[t[0]];
+    v += (mesh.nodes[t[1]] - a).dot((mesh.nodes[t[2]] - a).cross(mesh.nodes[t[3]] - a)) / 6;
+  }
+  return v;
+}
+
 LabelFidelity label_fidelity(const LabelMap& map, const LabelledMesh& mesh, std::int32_t label) {
   LabelFidelity f;
   f.label = label;
-  for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
-    if (mesh.label[e] != label) continue;
-    ++f.tets;
-    const auto& t = mesh.tets[e];
-    const Eigen::Vector3d& a = mesh.nodes[t[0]];
-    f.mesh_volume_m3 += (mesh.nodes[t[1]] - a).dot((mesh.nodes[t[2]] - a).cross(mesh.nodes[t[3]] - a)) / 6;
-  }
+  f.tets = static_cast<std::size_t>(std::count(mesh.label.begin(), mesh.label.end(), label));
+  f.mesh_volume_m3 = label_volume(mesh, label);
   const auto counts = map.counts();
   const auto it = counts.find(label);
   f.voxel_volume_m3 = it == counts.end() ? 0 : static_cast<double>(it->second) * map.voxel_volume_m3();

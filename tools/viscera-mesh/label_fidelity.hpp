@@ -18,6 +18,9 @@ namespace viscera::meshing {
 std::vector<std::array<std::int32_t, 3>> label_boundary(const LabelledMesh& mesh, const std::vector<std::int32_t>& labels,
                                                         std::vector<std::int32_t>* owner = nullptr);
 
+/// The volume of the tetrahedra of `label` [m^3].
+double label_volume(const LabelledMesh& mesh, std::int32_t label);
+
 struct LabelFidelity {
   std::int32_t label = 0;
   std::size_t tets = 0;

@@ -73,8 +73,10 @@ LabelledMesh mesh_labels(const LabelMap& map, const LabelMeshRequest& request) {
   const double size_mm = request.edge_m * 1e3;
   const Criteria criteria(p::facet_angle = 25, p::facet_size = size_mm, p::facet_distance = request.facet_distance_m * 1e3,
                           p::cell_radius_edge_ratio = 3, p::cell_size = size_mm);
-  const auto perturb = p::perturb(p::sliver_bound = request.sliver_bound_deg);
-  const auto exude = p::exude(p::sliver_bound = request.sliver_bound_deg);
+  // No time limits: CGAL's default stops perturbation and exudation after as long as the refinement
+  // took, which makes the mesh depend on how busy the machine is (seen: 11,696 and 11,692 tetrahedra).
+  const auto perturb = p::perturb(p::time_limit = 0, p::sliver_bound = request.sliver_bound_deg);
+  const auto exude = p::exude(p::time_limit = 0, p::sliver_bound = request.sliver_bound_deg);
   const C3t3 c3t3 = request.optimize ? CGAL::make_mesh_3<C3t3>(domain, criteria, perturb, exude, p::no_lloyd(), p::odt(p::max_iteration_number = 20))
                                      : CGAL::make_mesh_3<C3t3>(domain, criteria, perturb, exude, p::no_lloyd(), p::no_odt());
 

@@ -24,18 +24,26 @@ namespace {
 using viscera::common::InputError;
 using viscera::common::UsageError;
 
-std::vector<std::int32_t> label_list(const std::string& flag, const std::string& text) {
-  std::vector<std::int32_t> out;
+/// The comma-separated items of a flag's value (an empty item stays, to be refused by its reader).
+std::vector<std::string> items(const std::string& text) {
+  std::vector<std::string> out;
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, end - start);
+    out.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+std::vector<std::int32_t> label_list(const std::string& flag, const std::string& text) {
+  std::vector<std::int32_t> out;
+  for (const std::string& item : items(text)) {
     char* stop = nullptr;
     const long long v = std::strtoll(item.c_str(), &stop, 10);
     if (item.empty() || *stop != '\0' || v < -2'147'483'648LL || v > 2'147'483'647LL || v == 0)
       throw UsageError("--" + flag + ": '" + viscera::common::printable(item) + "' is not a label (a non-zero integer)");
     out.push_back(static_cast<std::int32_t>(v));
-    start = end + 1;
   }
   return out;
 }
@@ -43,10 +51,7 @@ std::vector<std::int32_t> label_list(const std::string& flag, const std::string&
 /// --region LABEL:NAME:MATERIAL[,LABEL:NAME:MATERIAL...]
 std::vector<viscera::meshing::RegionLabel> region_list(const std::string& text) {
   std::vector<viscera::meshing::RegionLabel> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, end - start);
+  for (const std::string& item : items(text)) {
     const std::size_t a = item.find(':'), b = a == std::string::npos ? a : item.find(':', a + 1);
     if (b == std::string::npos) throw UsageError("--region: '" + viscera::common::printable(item) + "' is not LABEL:NAME:MATERIAL");
     viscera::meshing::RegionLabel r;
@@ -57,7 +62,6 @@ std::vector<viscera::meshing::RegionLabel> region_list(const std::string& text) 
       throw UsageError("--region: the name '" + viscera::common::printable(r.name) + "' is not 1-64 letters, digits, '.', '_' or '-'");
     if (r.material.empty()) throw UsageError("--region: '" + viscera::common::printable(item) + "' names no material file");
     out.push_back(r);
-    start = end + 1;
   }
   return out;
 }

@@ -21,17 +21,6 @@ bool all_positive(const LabelledMesh& mesh, const std::vector<std::int32_t>& tet
 
 }  // namespace
 
-double label_volume(const LabelledMesh& mesh, std::int32_t label) {
-  double v = 0;
-  for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
-    if (mesh.label[e] != label) continue;
-    const auto& t = mesh.tets[e];
-    const Eigen::Vector3d& a = mesh.nodes[t[0]];
-    v += (mesh.nodes[t[1]] - a).dot((mesh.nodes[t[2]] - a).cross(mesh.nodes[t[3]] - a)) / 6;
-  }
-  return v;
-}
-
 std::vector<RestoredOffset> restore_label_volumes(LabelledMesh& mesh, const std::vector<VolumeTarget>& targets) {
   std::vector<VolumeTarget> order = targets;
   std::sort(order.begin(), order.end(), [](const VolumeTarget& a, const VolumeTarget& b) { return a.volume_m3 < b.volume_m3; });

@@ -25,7 +25,4 @@ struct RestoredOffset {
 /// sweeps. An offset that would invert a tetrahedron is halved until none is (or given up).
 std::vector<RestoredOffset> restore_label_volumes(LabelledMesh& mesh, const std::vector<VolumeTarget>& targets);
 
-/// The volume of the tetrahedra of `label` [m^3].
-double label_volume(const LabelledMesh& mesh, std::int32_t label);
-
 }  // namespace viscera::meshing
