@@ -5,7 +5,8 @@
 // With --adequacy, the adequacy verdict instead (issue 36): how often the final model is said not to
 // explain the data, on truths inside the catalogue (should be rare) and outside it (permanent set,
 // instrument drift, rate thinning, grip slip: should be nearly always), seeds from --first-seed.
-//   lab_accuracy [--seeds N] [--none N] [--dir DIR] [--adequacy] [--first-seed K]
+// With --history, the honest gain's causes on sessions whose history carries (issue 60).
+//   lab_accuracy [--seeds N] [--none N] [--dir DIR] [--adequacy | --history] [--first-seed K]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -52,11 +53,38 @@ void adequacy_table(const std::function<Analysis(test::LabTruth, double, unsigne
   std::printf("\nInside the catalogue: said not explained on %d of %d sets; outside it: on %d of %d.\n", flagged[0], total[0], flagged[1], total[1]);
 }
 
+/// The history table (issue 60): per truth, how often the causes named on the honest gain (the
+/// nested leave-one-out decides) are the truth's, with the session simulated in its order, and
+/// with the lab blind to it (every test taken to start on an untouched specimen).
+void history_table(const std::function<Dataset(test::LabTruth, unsigned)>& generate, int seeds, int first_seed) {
+  std::printf("| truth | named right, history carried | named right, blind to history | named instead (carried) |\n|---|---|---|---|\n");
+  for (test::LabTruth truth : {test::LabTruth::softening, test::LabTruth::recovering_softening, test::LabTruth::none,
+                               test::LabTruth::exponential_stiffening, test::LabTruth::asymmetry, test::LabTruth::broadband}) {
+    int right[2] = {0, 0};
+    std::map<std::string, int> instead;
+    for (int s = first_seed; s < first_seed + seeds; ++s) {
+      Dataset d = generate(truth, static_cast<unsigned>(s));
+      for (int blind = 0; blind < 2; ++blind) {
+        d.history = blind ? History::reset : History::carried;
+        Analysis a = analyze(d, {}, {.specimen = false, .nested = true, .bootstrap_replicates = 0});
+        a.causes = a.named_causes();
+        const bool ok = test::names_expected_causes(truth, a.causes);
+        right[blind] += ok;
+        if (!blind && !ok) ++instead[causes_of(a)];
+      }
+    }
+    std::string other;
+    for (const auto& [k, v] : instead) other += (other.empty() ? "" : ", ") + k + " (" + std::to_string(v) + ")";
+    std::printf("| %s | %d of %d | %d of %d | %s |\n", test::name(truth), right[0], seeds, right[1], seeds, other.c_str());
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int seeds = 20, nones = 100, first_seed = 1;
-  bool adequacy = false;
+  bool adequacy = false, history = false;
   std::string dir = (std::filesystem::temp_directory_path() / "viscera_lab_accuracy").string();
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -64,14 +92,21 @@ int main(int argc, char** argv) {
       adequacy = true;
       continue;
     }
+    if (a == "--history") {
+      history = true;
+      continue;
+    }
     if (a == "--help" || a == "-h") {
       std::printf(
-          "Usage: lab_accuracy [--seeds N] [--none N] [--dir DIR] [--adequacy] [--first-seed K]\n"
+          "Usage: lab_accuracy [--seeds N] [--none N] [--dir DIR] [--adequacy | --history] [--first-seed K]\n"
           "Runs viscera-lab on data sets from the independent generator of tests/lab (N seeds per truth and effect size,\n"
           "and N 'none' sets) and prints accuracy per truth, the confusion between causes and the false-positive rate\n"
           "as Markdown. Defaults: 20 seeds, 100 none sets, data sets written under the system's temporary folder.\n"
           "--adequacy: instead, per truth inside and outside the catalogue of causes, how often the final model is said not to\n"
-          "explain the data (N seeds from K, default 1).\n");
+          "explain the data (N seeds from K, default 1).\n"
+          "--history: instead, per truth (first-load softening, and causes without history as controls), how often the causes\n"
+          "named on the honest gain (nested leave-one-out) are right, the session simulated in its order against the lab blind\n"
+          "to it (N seeds from K).\n");
       return 0;
     }
     if (k + 1 >= argc) {
@@ -103,6 +138,18 @@ int main(int argc, char** argv) {
     test::write_lab_dataset(seed, truth, size, folder);
     return analyze(read_dataset(folder), {}, {.specimen = false, .nested = false, .bootstrap_replicates = 0});
   };
+  if (history) {
+    history_table(
+        [&](test::LabTruth truth, unsigned seed) {
+          const std::string folder = dir + "/" + test::name(truth) + "_history_" + std::to_string(seed);
+          std::filesystem::remove_all(folder);
+          test::write_lab_dataset(seed, truth, 1.0, folder);
+          return read_dataset(folder);
+        },
+        seeds, first_seed);
+    std::fprintf(stderr, "[%6.0f s] done\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    return 0;
+  }
   if (adequacy) {
     adequacy_table(run, seeds, first_seed);
     std::fprintf(stderr, "[%6.0f s] done\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());

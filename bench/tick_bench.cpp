@@ -7,10 +7,12 @@
 // Material/...: the same tick with the organ switched to each mechanism the lab can hand over.
 // Contact/...: the tick with two probes pressed into the organ, by the penalty contact or the
 // proxy, against none.
-// Run: build/bench/tick_bench [--benchmark_filter=liver-12k]
+// Run: build/bench/tick_bench [--benchmark_filter=liver-12k]; VISCERA_TICK_SCENE=FILE adds Tick/... of that scene file.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -61,7 +63,9 @@ void elements(benchmark::State& st, const std::string& scene_name) {
 }
 
 void tick(benchmark::State& st, const std::string& scene_name, int threads) {
-  runtime::SceneSpec scene = runtime::read_scene_file(std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
+  // A bundled scene by name, or any scene file (VISCERA_TICK_SCENE).
+  runtime::SceneSpec scene =
+      runtime::read_scene_file(scene_name.ends_with(".json") ? scene_name : std::string(VISCERA_DATA_DIR) + "/scenes/" + scene_name + ".json");
   scene.physics_threads = threads;
   run_ticks(st, *runtime::build_organ(scene), scene.physics_rate_hz, 1.0);
   st.counters["tick_budget_us"] = 1e6 / scene.physics_rate_hz;
@@ -244,6 +248,13 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMicrosecond)
           ->UseRealTime();
   }
+  // Tick/FILE/...: a scene of the user's (a patient's organ from viscera-mesh) beside the bundled ones.
+  if (const char* extra = std::getenv("VISCERA_TICK_SCENE"); extra && *extra)
+    for (const int threads : {1, 2})
+      benchmark::RegisterBenchmark(("Tick/" + std::filesystem::path(extra).stem().string() + "/threads:" + std::to_string(threads)).c_str(), tick,
+                                   std::string(extra), threads)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
   // The hand-over and the buffers with the 16 chunks of 16 threads, on one and two: their sum in
   // the node loop's ranges against on the calling thread before it.
   for (const bool summed_first : {false, true})

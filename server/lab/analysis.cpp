@@ -15,6 +15,7 @@
 #include "viscera/lab/noise_check.hpp"
 #include "viscera/lab/specimen_check.hpp"
 #include "viscera/lab/stress_controlled.hpp"
+#include "viscera/lab/test_history.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 
 namespace viscera::lab {
@@ -40,20 +41,38 @@ struct SofteningEvidence {
   double z = 0.0;
   int bins = 0;
   long virgin = 0, below_peak = 0;
+  bool across_tests = false;
 };
-SofteningEvidence softening_evidence(const MaterialModel& model, const Dataset& d, double noise_pa) {
+SofteningEvidence softening_evidence(const MaterialModel& model, const Dataset& d, double noise_pa, bool across_tests) {
   constexpr int kBins = 10;
   double max_strain = 0;
   for (const auto& t : d.tests)
     for (double e : t.strain) max_strain = std::max(max_strain, std::abs(e));
   SofteningEvidence ev;
+  ev.across_tests = across_tests;
   double diff = 0.0, var = 0.0;
-  for (const auto& t : d.tests) {  // within each test: the same rates, the same protocol
+  double sum_v[kBins] = {}, sum_b[kBins] = {};
+  long n_v[kBins] = {}, n_b[kBins] = {};
+  const auto compare_bins = [&] {
+    for (int b = 0; b < kBins; ++b) {
+      if (n_v[b] > 0 && n_b[b] > 0) {
+        diff += sum_v[b] / static_cast<double>(n_v[b]) - sum_b[b] / static_cast<double>(n_b[b]);
+        var += noise_pa * noise_pa * (1.0 / static_cast<double>(n_v[b]) + 1.0 / static_cast<double>(n_b[b]));
+        ++ev.bins;
+        ev.virgin += n_v[b];
+        ev.below_peak += n_b[b];
+      }
+      sum_v[b] = sum_b[b] = 0;
+      n_v[b] = n_b[b] = 0;
+    }
+  };
+  // Within each test, each starting untouched (the same rates, the same protocol); or across the
+  // tests, each starting where the ones before it left its specimen: first loading is then mostly
+  // in one test and reloading in the next ones, so the bins gather every test's samples.
+  for (const auto& t : d.tests) {
     if (t.control != Control::strain) continue;
-    double sum_v[kBins] = {}, sum_b[kBins] = {};
-    long n_v[kBins] = {}, n_b[kBins] = {};
     const auto y = predict_stress(model, t);
-    double peak_t = 0, peak_c = 0;
+    double peak_t = across_tests ? t.before_tension : 0.0, peak_c = across_tests ? t.before_compression : 0.0;
     for (std::size_t k = 0; k < y.size(); ++k) {
       const double e = t.strain[k], a = std::abs(e), r = (t.stress_pa[k] - y[k]) * (e >= 0 ? 1 : -1);
       const double peak = e >= 0 ? peak_t : peak_c;
@@ -71,15 +90,9 @@ SofteningEvidence softening_evidence(const MaterialModel& model, const Dataset& 
       }
       (e >= 0 ? peak_t : peak_c) = std::max(peak, a);
     }
-    for (int b = 0; b < kBins; ++b)
-      if (n_v[b] > 0 && n_b[b] > 0) {
-        diff += sum_v[b] / static_cast<double>(n_v[b]) - sum_b[b] / static_cast<double>(n_b[b]);
-        var += noise_pa * noise_pa * (1.0 / static_cast<double>(n_v[b]) + 1.0 / static_cast<double>(n_b[b]));
-        ++ev.bins;
-        ev.virgin += n_v[b];
-        ev.below_peak += n_b[b];
-      }
+    if (!across_tests) compare_bins();
   }
+  compare_bins();
   ev.z = var > 0 ? diff / std::sqrt(var) : 0.0;
   return ev;
 }
@@ -93,7 +106,7 @@ std::string evidence(Mechanism m, const MaterialModel& model, const Dataset& d) 
     for (double e : t.strain) max_strain = std::max(max_strain, std::abs(e));
   for (const auto& t : d.tests) {
     const auto y = predict_stress(model, t);
-    double peak_t = 0, peak_c = 0;
+    double peak_t = t.before_tension, peak_c = t.before_compression;
     for (std::size_t k = 0; k < y.size(); ++k) {
       const double r = t.stress_pa[k] - y[k], e = t.strain[k];
       if (k > 1 && std::abs(e - t.strain[k - 1]) < 1e-4 * max_strain && std::abs(t.strain[k - 1] - t.strain[k - 2]) < 1e-4 * max_strain) {
@@ -269,12 +282,17 @@ Selection select_mechanisms(const ModelEvaluation& start, const Dataset& d, doub
       if (m == Mechanism::first_load_softening) {
         // Softening only where the data show it: on reloading below the previous peak, at the
         // same strain, the stress differs from first loading's.
-        const SofteningEvidence se = softening_evidence(current.model, d, noise_pa);
-        char text[300];
+        // Where the tests carry their specimen's history, it may also have recovered between
+        // them: both looks, the stronger kept.
+        SofteningEvidence se = softening_evidence(current.model, d, noise_pa, false);
+        if (current.model.history_carried)
+          if (const SofteningEvidence across = softening_evidence(current.model, d, noise_pa, true); across.z > se.z) se = across;
+        char text[320];
         std::snprintf(text, sizeof text,
-                      "; at the same strain, first loading against reloading below the previous peak: z = %.2f over %d strain bins (%ld and %ld "
-                      "samples)%s",
-                      se.z, se.bins, se.virgin, se.below_peak, se.z > kSofteningZ ? "" : ": not the evidence softening needs (z > 3)");
+                      "; at the same strain, first loading against reloading below the previous peak (%s): z = %.2f over %d strain bins (%ld "
+                      "and %ld samples)%s",
+                      se.across_tests ? "across the session's tests" : "within each test", se.z, se.bins, se.virgin, se.below_peak,
+                      se.z > kSofteningZ ? "" : ": not the evidence softening needs (z > 3)");
         c.evidence += text;
         if (above_noise && se.z <= kSofteningZ) {
           above_noise = false;
@@ -435,7 +453,9 @@ Analysis analyze(const Dataset& measured, const std::function<void(const std::st
   const auto say = [&](const std::string& s) {
     if (progress) progress(s);
   };
-  const Dataset d = decimate(measured, options.max_fit_points);
+  Dataset with_history = measured;  // each test's start, from the commands of the tests before it
+  carry_history(with_history);
+  const Dataset d = decimate(with_history, options.max_fit_points);
   Analysis a;
   for (std::size_t k = 0; k < d.tests.size(); ++k)
     if (d.tests[k].time_s.size() < measured.tests[k].time_s.size()) {

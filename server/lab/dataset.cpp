@@ -16,6 +16,7 @@
 #include "viscera/common/json_input.hpp"
 #include "viscera/common/number_text.hpp"
 #include "viscera/lab/csv_lines.hpp"
+#include "viscera/lab/test_history.hpp"
 
 namespace viscera::lab {
 
@@ -28,6 +29,7 @@ using nlohmann::json;
 
 const char* to_string(Mode m) { return m == Mode::uniaxial ? "uniaxial" : "simple_shear"; }
 const char* to_string(Control c) { return c == Control::strain ? "strain" : "stress"; }
+const char* to_string(History h) { return h == History::carried ? "carried" : "reset"; }
 
 namespace {
 
@@ -245,7 +247,7 @@ Dataset read_dataset(const std::string& folder) {
   if (!std::filesystem::exists(meta)) throw InputError(meta, 0, "", "cannot open file (is " + folder + " a data set folder?)");
   const json j = common::read_json_file(meta);
   const JsonObject top(j, meta);
-  top.require_known({"name", "mode", "contact", "specimen", "tests", "max_test_duration_s", "import"});
+  top.require_known({"name", "mode", "contact", "history", "specimen", "tests", "max_test_duration_s", "import"});
   Dataset d;
   d.folder = folder;
   d.name = top.text("name", std::filesystem::path(folder).filename().string());
@@ -253,6 +255,7 @@ Dataset read_dataset(const std::string& folder) {
   d.mode = top.choice("mode", {"uniaxial", "simple_shear"}, "") == "uniaxial" ? Mode::uniaxial : Mode::simple_shear;
   d.platens = top.choice("contact", {"bonded", "platens"}, "bonded") == "platens";
   if (d.platens && d.mode != Mode::uniaxial) top.fail("contact", "\"platens\" needs \"mode\": \"uniaxial\" (platens compress; they do not shear)");
+  d.history = top.choice("history", {"carried", "reset"}, "carried") == "carried" ? History::carried : History::reset;
   d.specimen = read_specimen(top.object("specimen"), nullptr);
   // Longer tests exist (creep over days) but are rare; a span beyond a day is more often a time
   // column in another unit, so it must be declared.
@@ -286,6 +289,7 @@ Dataset read_dataset(const std::string& folder) {
                                " is a stretch, but \"contact\": \"platens\" compresses (compression is negative strain and stress; "
                                "viscera-lab import --compression-positive negates exports that count it positive)");
     }
+  carry_history(d);
   return d;
 }
 
@@ -295,6 +299,7 @@ void write_dataset(const Dataset& d, const std::string& folder) {
   j["name"] = d.name;
   j["mode"] = to_string(d.mode);
   if (d.platens) j["contact"] = "platens";
+  j["history"] = to_string(d.history);
   if (!d.import_note.empty()) j["import"] = d.import_note;
   const auto specimen = [](const Specimen& sp) {
     return json{{"length_m", sp.length_m}, {"width_m", sp.width_m}, {"thickness_m", sp.thickness_m}, {"density_kg_m3", sp.density_kg_m3}};

@@ -21,9 +21,11 @@ TestData decimate_test(const TestData& t, std::size_t max_points) {
     const double dt = (t.time_s[k] - t.time_s[k - 1]) / span_t, de = (t.strain[k] - t.strain[k - 1]) / span_e;
     s[k] = s[k - 1] + std::sqrt(dt * dt + de * de);
   }
-  TestData out;
-  out.file = t.file;
-  out.control = t.control;
+  TestData out = t;  // its file, control, specimen and history; the rows chosen below
+  out.time_s.clear();
+  out.strain.clear();
+  out.stress_pa.clear();
+  out.stress_sd_pa.clear();
   const double noise = noise_level_pa(t);
   std::size_t last = n;  // index kept last
   for (std::size_t j = 0; j < max_points; ++j) {

@@ -254,11 +254,13 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
   m.stiffening_b = 0.0;
   m.compression_ratio = 1.0;
   m.softening_d = 0.0;
+  m.softening_kept = 1.0;
   m.contact_strain = 0.0;
   std::vector<Nonlinear> params;
   if (m.has(Mechanism::strain_stiffening)) params.push_back({&m.stiffening_b, 0.05, 200.0, true});
   if (m.has(Mechanism::tension_compression_asymmetry)) params.push_back({&m.compression_ratio, 0.05, 20.0, true});
   if (m.has(Mechanism::first_load_softening)) params.push_back({&m.softening_d, 0.0, 0.95, false});
+  if (m.has(Mechanism::first_load_softening) && m.history_carried) params.push_back({&m.softening_kept, 0.0, 1.0, false});
   // A gap of up to a third of the specimen's height (contact taken up over the first 30%).
   if (m.has(Mechanism::contact_take_up)) params.push_back({&m.contact_strain, 0.0, 0.3, false});
   if (params.empty()) {
@@ -278,6 +280,7 @@ MaterialModel fit_model(const MaterialModel& structure, const std::vector<const 
       m.stiffening_b = 0.0;
       m.compression_ratio = 1.0;
       m.softening_d = 0.0;
+      m.softening_kept = 1.0;
       m.contact_strain = 0.0;
       for (int round = 0; round < (params.size() > 1 ? 3 : 1); ++round)
         for (const auto& q : params) search(m, p, q);

@@ -58,12 +58,14 @@ int MaterialModel::parameter_count() const {
   int n = 2 + (has(Mechanism::broadband_relaxation) ? static_cast<int>(relaxation_time_s.size()) : 0);
   for (Mechanism m : kMechanisms)
     if (has(m) && m != Mechanism::broadband_relaxation) ++n;
+  if (has(Mechanism::first_load_softening) && history_carried) ++n;  // the kept fraction
   return n;
 }
 
 MaterialModel for_dataset(MaterialModel m, const Dataset& d) {
   m.odd_only = d.mode == Mode::simple_shear;
   m.platens = d.platens;
+  m.history_carried = std::any_of(d.tests.begin(), d.tests.end(), [](const TestData& t) { return t.before_tension + t.before_compression > 0; });
   return m;
 }
 
@@ -127,9 +129,16 @@ double ElasticShape::strain_for(double s) const {
   return 0.5 * (lo + hi);
 }
 
-std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<double>& strain) {
-  std::vector<double> s(strain.size());
+ElasticShape shape_at_start(const MaterialModel& m, const TestData& t) {
   ElasticShape shape{m};
+  const double kept = m.has(Mechanism::first_load_softening) ? m.softening_kept : 1.0;
+  shape.advance(kept * t.before_tension);
+  shape.advance(-kept * t.before_compression);
+  return shape;
+}
+
+std::vector<double> elastic_shape(ElasticShape shape, const std::vector<double>& strain) {
+  std::vector<double> s(strain.size());
   for (std::size_t k = 0; k < strain.size(); ++k) {
     s[k] = shape.value(strain[k]);
     shape.advance(strain[k]);
@@ -142,7 +151,7 @@ Eigen::MatrixXd basis(const MaterialModel& m, const TestData& t) {
   const std::size_t L = m.has(Mechanism::broadband_relaxation) ? m.relaxation_time_s.size() : 0;
   Eigen::MatrixXd A(n, static_cast<Eigen::Index>(2 + L));
   const CommandPath path = command_path(t.time_s, t.strain);
-  const std::vector<double> s = elastic_shape(m, path.value);
+  const std::vector<double> s = elastic_shape(shape_at_start(m, t), path.value);
   std::vector<double> h(L, 0.0);
   std::size_t next = 0;  // the next sample's index
   for (std::size_t j = 0; j < s.size(); ++j) {

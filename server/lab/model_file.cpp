@@ -31,7 +31,10 @@ void write_model(const std::string& path, const MaterialModel& m, const std::str
     j["stiffening_b"] = m.stiffening_b;
   }
   if (m.has(Mechanism::tension_compression_asymmetry)) j["compression_ratio"] = m.compression_ratio;
-  if (m.has(Mechanism::first_load_softening)) j["softening_d"] = m.softening_d;
+  if (m.has(Mechanism::first_load_softening)) {
+    j["softening_d"] = m.softening_d;
+    j["softening_kept"] = m.softening_kept;
+  }
   if (m.has(Mechanism::contact_take_up)) j["contact_strain"] = m.contact_strain;
   common::write_file_text(path, j.dump(2) + "\n");
 }
@@ -41,7 +44,7 @@ MaterialModel read_model(const std::string& path) {
   if (!j.is_object()) throw common::InputError(path, 0, "", "not a JSON object (a model.json written by viscera-lab analyze)");
   const common::JsonObject top(j, path);
   top.require_known({"model", "fitted_to", "units", "mechanisms", "modulus_pa", "viscosity_pa_s", "relaxation_time_s", "relaxation_modulus_pa",
-                     "stiffening_form", "stiffening_b", "compression_ratio", "softening_d", "contact_strain"});
+                     "stiffening_form", "stiffening_b", "compression_ratio", "softening_d", "softening_kept", "contact_strain"});
   // Each value in the range a fit can produce (finite; open ends checked where they matter).
   const double big = 1e300;
   const auto numbers = [&](const char* key, bool positive) {
@@ -77,6 +80,7 @@ MaterialModel read_model(const std::string& path) {
   if (m.has(Mechanism::first_load_softening)) {
     m.softening_d = top.number("softening_d", 0.0, 1.0);
     if (!(m.softening_d < 1)) top.fail("softening_d", "1 is outside [0, 1)");
+    m.softening_kept = top.number("softening_kept", 0.0, 1.0, 1.0);  // files from before it: nothing recovers
   }
   if (m.has(Mechanism::contact_take_up)) m.contact_strain = top.number("contact_strain", 0.0, 1.0);
   return m;

@@ -14,6 +14,7 @@ std::vector<ParameterEstimate> parameters_of(const MaterialModel& m) {
   if (m.has(Mechanism::strain_stiffening)) out.push_back({"B", "-", m.stiffening_b});
   if (m.has(Mechanism::tension_compression_asymmetry)) out.push_back({"r", "-", m.compression_ratio});
   if (m.has(Mechanism::first_load_softening)) out.push_back({"d", "-", m.softening_d});
+  if (m.has(Mechanism::first_load_softening) && m.history_carried) out.push_back({"k (kept between tests)", "-", m.softening_kept});
   if (m.has(Mechanism::broadband_relaxation))
     for (std::size_t l = 0; l < m.relaxation_time_s.size(); ++l) {
       char name[64];

@@ -7,6 +7,7 @@
 #include "viscera/lab/fit.hpp"
 #include "viscera/lab/format_figures.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
+#include "viscera/lab/test_history.hpp"
 #include "viscera/tissue/integrator/simulation_error.hpp"
 
 namespace viscera::lab {
@@ -38,8 +39,9 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d, const 
           format_figures(", %.4g s of history; at most %.0f s)", t.time_s.back() - t.time_s.front(), kSpecimenSecondsPerTest));
       const SpecimenResult r = simulate_specimen(m, d, t, &calibration, kSpecimenSecondsPerTest);
       if (t.control == Control::strain && departure.empty()) {
-        // Where the specimen first leaves the law by more than a tenth of the test's largest stress.
-        const std::vector<double> law = predict_stress(m, t);
+        // Where the specimen first leaves the law by more than a tenth of the test's largest stress
+        // (both from an untouched specimen).
+        const std::vector<double> law = predict_stress(m, untouched(t));
         double peak = 0.0;
         for (const double s : law) peak = std::max(peak, std::abs(s));
         for (std::size_t i = 0; i < r.stress_pa.size() && i < law.size(); ++i)
@@ -57,6 +59,10 @@ SpecimenCheck check_on_specimen(const MaterialModel& m, const Dataset& d, const 
     }
     c.ran = true;
     c.note += c.note.empty() && !departure.empty() ? departure.substr(2) : departure;
+    if (m.has(Mechanism::first_load_softening) && m.history_carried)
+      c.note += std::string(c.note.empty() ? "" : "; ") +
+                "the specimen runs each test from an untouched state, the law with what the tests before it left (first-load softening "
+                "carried between tests): their errors differ by that history";
   } catch (const tissue::SimulationError& e) {
     c.note = "the specimen simulation failed on " + (c.files.size() < d.tests.size() ? d.tests[c.files.size()].file : std::string("a test")) + ": " +
              e.what() + "; only the material-point law is reported";

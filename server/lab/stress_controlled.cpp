@@ -62,7 +62,7 @@ std::vector<double> predict_strain(const MaterialModel& m, const TestData& t) {
   const CommandPath path = command_path(t.time_s, t.stress_pa);
   std::vector<double> strain;
   strain.reserve(t.time_s.size());
-  ElasticShape shape{m};
+  ElasticShape shape = shape_at_start(m, t);
   std::size_t next = 0;
   for (std::size_t j = 0; j < path.time_s.size(); ++j) {
     if (j > 0) {

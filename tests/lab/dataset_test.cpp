@@ -76,6 +76,7 @@ TEST(Dataset, BadInputNamesFileLineAndField) {
       {"twice", R"({"mode": "uniaxial", "mode": "simple_shear", "specimen": {}, "tests": []})", kCsv, "dataset.json: mode: given twice"},
       {"header-binary", kJson, "\x01\x02time\n0,0,0\n", "a.csv:1: time_s: column missing (the first line, '\\x01\\x02time', must name"},
       {"mode", R"({"mode": "torsion", "specimen": {}, "tests": []})", kCsv, "dataset.json: mode: 'torsion'"},
+      {"history", R"({"mode": "uniaxial", "history": "sometimes", "specimen": {}, "tests": []})", kCsv, "dataset.json: history: 'sometimes'"},
       {"dims", R"({"mode": "uniaxial", "specimen": {"length_m": 10000, "width_m": 0.002, "thickness_m": 0.002, "density_kg_m3": 1000}, "tests": []})",
        kCsv, "specimen.length_m: 10000 is outside [1e-06, 10]"},
       {"control",

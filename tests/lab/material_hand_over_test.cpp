@@ -21,6 +21,7 @@
 #include "viscera/lab/material_export.hpp"
 #include "viscera/lab/specimen_simulation.hpp"
 #include "viscera/lab/stress_controlled.hpp"
+#include "viscera/lab/test_history.hpp"
 #include "viscera/tissue/material/material_file.hpp"
 #include "viscera/tissue/viscoelastic/viscoelastic_material.hpp"
 
@@ -42,7 +43,10 @@ double hand_over_error(const MaterialModel& m, const Dataset& measured, const st
   const viscera::tissue::Material material = viscera::tissue::read_material_file(path);
   const viscera::tissue::ViscoelasticSetup setup = viscera::tissue::make_viscoelastic(material.elasticity, *material.viscoelasticity, path);
   double worst = 0.0;
-  for (const TestData& t : d.tests) {
+  for (const TestData& session_test : d.tests) {
+    // The specimen runs each test from an untouched state, and so does the law here (a session's
+    // history is the data set's, not the material's).
+    const TestData t = untouched(session_test);
     const SpecimenResult r = simulate_specimen(setup.gps, setup.unrelaxed_elasticity, d, t, 120.0);
     const bool strain_control = t.control == Control::strain;
     const std::vector<double> law = predict_measured(m, t);

@@ -57,7 +57,11 @@ void bind_lab(py::module_& m) {
           "stress_pa", [](const TestData& t) { return copy_of(t.stress_pa); }, "[Pa] stress of each row")
       .def_property_readonly(
           "stress_sd_pa", [](const TestData& t) { return copy_of(t.stress_sd_pa); },
-          "[Pa] the stress's standard deviation per row (empty if not given)");
+          "[Pa] the stress's standard deviation per row (empty if not given)")
+      .def_readonly("before_tension", &TestData::before_tension,
+                    "the largest tension strain [-] its specimen went through in the tests before it (history carried)")
+      .def_readonly("before_compression", &TestData::before_compression,
+                    "the largest compression strain [-] (as a positive number) its specimen went through in the tests before it");
   py::class_<Dataset>(m, "Dataset", "A measured data set (dataset.json and one CSV per test).")
       .def_readonly("name", &Dataset::name, "its name")
       .def_readonly("folder", &Dataset::folder, "the data set's folder")
@@ -67,6 +71,9 @@ void bind_lab(py::module_& m) {
       .def_property_readonly(
           "contact", [](const Dataset& d) { return std::string(d.platens ? "platens" : "bonded"); },
           "bonded, or platens (compressed between platens it was not bonded to: they cannot pull)")
+      .def_property_readonly(
+          "history", [](const Dataset& d) { return std::string(to_string(d.history)); },
+          "carried (the tests on one specimen in the listed order, each starting where the last left it) or reset")
       .def_readonly("tests", &Dataset::tests, "the tests, in dataset.json's order");
   m.def("read_dataset", &read_dataset, py::arg("folder"),
         "Reads DATASET_DIR/dataset.json and its CSVs; raises InputError naming file, line and field.");

@@ -171,10 +171,10 @@ struct Elastic {
   }
 };
 
-// Stress at the sample times under strain control.
-std::vector<double> stress_under_strain(const LabDatasetTruth& tr, const Command& c, const std::vector<double>& times) {
+// Stress at the sample times under strain control, the specimen's history in `f` (moved to the
+// end of the command).
+std::vector<double> stress_under_strain(const LabDatasetTruth& tr, Elastic& f, const Command& c, const std::vector<double>& times) {
   std::vector<double> out;
-  Elastic f{tr};
   double walked = 0.0;
   for (double t : times) {
     // The history, walked finely up to t.
@@ -199,13 +199,14 @@ std::vector<double> stress_under_strain(const LabDatasetTruth& tr, const Command
     }
     out.push_back(sigma);
   }
+  const double h = std::max((c.end() - walked) / 50, 1e-6);
+  for (double u = walked + h; u < c.end(); u += h) f.advance(c.at(u), h);
   return out;
 }
 
 // Strain at the sample times under stress control: backward Euler at `substeps` per sample
 // interval, Newton on the strain each step; relaxation terms h_l exact for a linear strain step.
-std::vector<double> strain_under_stress(const LabDatasetTruth& tr, const Command& c, const std::vector<double>& times, int substeps) {
-  Elastic f{tr};
+std::vector<double> strain_under_stress(const LabDatasetTruth& tr, Elastic f, const Command& c, const std::vector<double>& times, int substeps) {
   double e = 0.0, t = 0.0, hl[2] = {0, 0};
   std::vector<double> out;
   for (double target : times) {
@@ -298,20 +299,26 @@ LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, co
       {"ramp_compression.csv", ramp_hold(-strain * between(0.5, 1.0), between(0.1, 1.0), between(10, 30))},
       {"cycles_growing.csv", growing_cycles(strain, between(1.0, 4.0))},
   };
+  // The session: the tests in the order listed on one specimen, 60 s apart, unloaded between them:
+  // the specimen's history (first loading's peaks, a permanent set, a slipped grip) carries from
+  // one test to the next, a recovering softening recovers in the rests. A drifting load cell's
+  // zero moves by 4-12% of the peak stress over the session.
+  constexpr double kRest = 60.0;
+  d.history = History::carried;
+  Elastic specimen{tr};
   std::vector<std::vector<double>> times, stresses;
   double peak = 0;
   for (const auto& s : strain_tests) {
     times.push_back(sample_times(s.c, rng));
-    stresses.push_back(stress_under_strain(tr, s.c, times.back()));
+    stresses.push_back(stress_under_strain(tr, specimen, s.c, times.back()));
+    specimen.advance(0.0, kRest);
     for (double v : stresses.back()) peak = std::max(peak, std::abs(v));
   }
-  // The session: the tests in the order listed, 60 s apart; a drifting load cell's zero moves by
-  // 4-12% of the peak stress over it.
   std::vector<double> session_start;
   double session_s = 0;
   for (const auto& s : strain_tests) {
     session_start.push_back(session_s);
-    session_s += s.c.end() + 60.0;
+    session_s += s.c.end() + kRest;
   }
   if (truth == LabTruth::instrument_drift) {
     tr.drift_pa_per_s = (u(rng) < 0.5 ? -1.0 : 1.0) * peak * between(0.04, 0.12) * size / session_s;
@@ -351,7 +358,7 @@ LabDatasetTruth write_lab_dataset(unsigned seed, LabTruth truth, double size, co
     // the command, so the specimen carries the command less the drift (linear between knots).
     Command applied = c;
     for (std::size_t k = 0; k < applied.t.size(); ++k) applied.v[k] -= tr.drift_pa_per_s * (session_s + applied.t[k]);
-    const std::vector<double> exact = strain_under_stress(tr, applied, creep.time_s, 1000);
+    const std::vector<double> exact = strain_under_stress(tr, specimen, applied, creep.time_s, 1000);
     double largest = 0;
     for (double e : exact) largest = std::max(largest, std::abs(e));
     tr.strain_noise = largest * between(0.005, 0.02);

@@ -200,6 +200,8 @@ Truth write_dataset_of(unsigned seed, const std::string& folder, bool power_law)
   d.mode = seed % 2 || tr.effect == Effect::tension_compression_asymmetry ? Mode::uniaxial : Mode::simple_shear;
   tr.odd = d.mode == Mode::simple_shear;
   d.specimen = {0.01, 0.01, 0.003, 1050};
+  // Each test on an untouched specimen: the truth's first-load history starts afresh in each.
+  d.history = History::reset;
   // Protocols: ramp-holds at two rates in tension and one in compression, cycles at two rates in
   // tension and compression, and a creep test.
   const double slow = between(3.0, 8.0), fast = between(0.2, 0.6);

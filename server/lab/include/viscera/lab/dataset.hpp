@@ -10,6 +10,11 @@ namespace viscera::lab {
 
 enum class Mode { uniaxial, simple_shear };
 enum class Control { strain, stress };
+/// What a test starts from ("history" in dataset.json). carried (the default): the tests on one
+/// specimen were made on it in the listed order, and each starts in the state the ones before left
+/// (test_history.hpp); reset: each test starts from an untouched specimen (a fresh one, or one
+/// that recovered fully between tests).
+enum class History { carried, reset };
 
 struct Specimen {
   double length_m = 0, width_m = 0, thickness_m = 0, density_kg_m3 = 0;
@@ -22,6 +27,9 @@ struct TestData {
   /// the data set's); absent: the data set's. Real data sets hold several specimens of different sizes.
   std::optional<Specimen> specimen;
   std::vector<double> time_s, strain, stress_pa, stress_sd_pa;  ///< sd empty if not given
+  /// The largest tension and compression strains (both >= 0) the test's specimen went through in
+  /// the tests before it (History::carried; carry_history() sets them, 0 for a first test).
+  double before_tension = 0.0, before_compression = 0.0;
 };
 
 struct Dataset {
@@ -31,6 +39,7 @@ struct Dataset {
   /// "contact": "platens" in dataset.json: the specimen was compressed between platens it was not
   /// bonded to (they take up contact, and cannot pull); "bonded" (the default): glued or gripped.
   bool platens = false;
+  History history = History::carried;
   Specimen specimen;
   std::vector<TestData> tests;
 };
@@ -55,5 +64,6 @@ double noise_of_reading(const std::vector<double>& v);
 
 const char* to_string(Mode m);
 const char* to_string(Control c);
+const char* to_string(History h);
 
 }  // namespace viscera::lab

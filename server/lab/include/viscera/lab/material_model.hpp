@@ -19,7 +19,10 @@
 //                                 isotropic solid's shear stress is odd in the shear strain)
 //   tension_compression_asymmetry s = eps (eps >= 0), r eps (eps < 0)
 //   first_load_softening          s = eps on the virgin curve, (1 - d (1 - |eps|/m)) eps below the
-//                                 previous extreme m (Ogden-Roxburgh-like softening on reloading)
+//                                 previous extreme m (Ogden-Roxburgh-like softening on reloading);
+//                                 where tests carry their specimen's history (test_history.hpp), a
+//                                 test starts with m = k times the extreme of the tests before it:
+//                                 the fraction k kept through the rests (1: none recovers, 0: all)
 //   contact_take_up               a property of the test, not of the tissue, offered only where the
 //                                 data set declares platens (a specimen compressed between plates it
 //                                 is not bonded to): the platens close a gap c before they load it,
@@ -62,10 +65,14 @@ struct MaterialModel {
   /// cannot pull, so every predicted stress is min(0, sigma), and contact_take_up is a candidate.
   /// Set from the data set.
   bool platens = false;
+  /// Some test starts where earlier tests on its specimen left it (TestData::before_tension,
+  /// before_compression): first-load softening's kept fraction is then a parameter. Set from the data set.
+  bool history_carried = false;
   StiffeningForm stiffening_form = StiffeningForm::exponential;
   double stiffening_b = 0.0;
   double compression_ratio = 1.0;
   double softening_d = 0.0;
+  double softening_kept = 1.0;  ///< first_load_softening: k, the fraction of the earlier tests' extremes a test starts with
   double contact_strain = 0.0;  ///< contact_take_up: the gap the platens close before they load, as a strain
   double modulus_pa = 0.0;
   double viscosity_pa_s = 0.0;
@@ -79,7 +86,8 @@ struct MaterialModel {
   int parameter_count() const;
 };
 
-/// The model as it applies to a data set's tests: odd_only from its mode, platens from its contact.
+/// The model as it applies to a data set's tests: odd_only from its mode, platens from its contact,
+/// history_carried from its tests.
 MaterialModel for_dataset(MaterialModel m, const Dataset& d);
 
 /// The strain the specimen itself undergoes at the test's strain eps: eps, or with contact_take_up
@@ -98,8 +106,12 @@ struct ElasticShape {
   void advance(double eps);
 };
 
-/// Elastic shape s at every sample of a strain history.
-std::vector<double> elastic_shape(const MaterialModel& m, const std::vector<double>& strain);
+/// The shape at the start of test t, with what the tests before it left on its specimen
+/// (TestData::before_tension and before_compression; test_history.hpp).
+ElasticShape shape_at_start(const MaterialModel& m, const TestData& t);
+
+/// Elastic shape s at every sample of a strain history, from `start`.
+std::vector<double> elastic_shape(ElasticShape start, const std::vector<double>& strain);
 
 /// Columns of the linear model at the samples: s, ds/dt, h_l for each tau_l, along the strain's
 /// command path (command_path.hpp).

@@ -4,7 +4,9 @@
 // through tension and compression, a creep-recovery test under stress control with 0.05 s stress
 // ramps, non-uniform sampling dense after every change of the command (never on the change
 // itself), uniaxial or simple shear, specimens of several sizes, noise 0.5-2% of the peak of the
-// measured quantity, a noise column in two data sets of three.
+// measured quantity, a noise column in two data sets of three. The tests are one session on one
+// specimen, 60 s apart and unloaded between them: what a test leaves (first loading's peaks, a
+// permanent set, a slipped grip) is where the next one starts (dataset.json "history": "carried").
 //
 // The truths are written here, not taken from the lab's forms: linear damping on the strain rate,
 //     sigma = f(eps, history) + eta d eps/dt + hereditary relaxation on the strain,
