@@ -419,6 +419,9 @@ std::string verdict_of(const Analysis& a, bool odd_only) {
          "isotropic solid's shear stress is odd in the shear strain).";
   if (a.supported_model().has(Mechanism::strain_stiffening))
     v << " Stiffening form chosen by the fit: " << name(a.supported_model().stiffening_form) << ".";
+  if (const MaterialModel& m = a.supported_model(); m.has(Mechanism::first_load_softening) && m.history_carried)
+    v << " The tests were one session on their specimen: each starts with " << 100 * m.softening_kept
+      << "% of the largest strain the tests before it reached as the softening's memory (100%: nothing recovered between tests).";
   if (a.supported_model().platens) {
     v << " Between platens: the model's stress is never a pull (contact is lost where it would pull)";
     if (a.supported_model().has(Mechanism::contact_take_up))

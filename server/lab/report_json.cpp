@@ -129,6 +129,7 @@ json report_json(const Analysis& a, const Dataset& d, double seconds, const Mate
   json j;
   j["dataset"] = a.dataset;
   j["mode"] = to_string(d.mode);
+  j["history"] = to_string(d.history);
   j["noise_pa"] = a.noise_pa;
   j["noise"] = noise_json(a);
   j["baseline"] = figures(a.baseline);
