@@ -42,6 +42,9 @@ def test_analyze_gives_the_programs_report(tmp_path: Path) -> None:
     lines: List[str] = []
     d = viscera.lab.read_dataset(TITIN)
     assert d.name.startswith("titin-passive-muscle") and len(d.tests) == 4 and d.contact == "bonded"
+    # One specimen's tests in the listed order (the default history): each starts where the last left it.
+    assert d.history == "carried" and d.tests[0].before_tension == 0.0
+    assert d.tests[2].before_tension == pytest.approx(max(d.tests[0].strain.max(), d.tests[1].strain.max()), rel=1e-3)
     a = viscera.lab.analyze(d, progress=lines.append)
     assert len(lines) >= 3, "progress lines arrive while it runs"
     figures_equal(written, a.report)
