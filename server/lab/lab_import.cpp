@@ -205,6 +205,7 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   d.name = o.name.empty() ? std::filesystem::path(folder).filename().string() : o.name;
   d.mode = o.mode;
   d.platens = o.platens;
+  d.history = o.history;
   d.specimen = o.specimen;
   std::set<std::string> names;
   std::string offsets;
@@ -233,6 +234,7 @@ Dataset import_dataset(const std::vector<std::string>& files, const ImportOption
   if (o.zero_displacement) d.import_note += "; displacement from each test's first row";
   if (o.compression_positive) d.import_note += "; compression positive in the exports: force and displacement negated";
   if (o.platens) d.import_note += "; between platens (contact: platens)";
+  if (o.history == History::reset) d.import_note += "; each test on an untouched specimen (history: reset)";
   if (!o.specimen_of.empty())
     d.import_note +=
         "; " + std::to_string(o.specimen_of.size()) + " tests on their own specimens (each test's \"specimen\"; its geometry converts it)";

@@ -140,6 +140,10 @@ expect lab-import-no-geometry 2 "import needs --length-m" -- "$lab" import "$tmp
 # A compression between platens exported with compression positive: negated, and declared.
 expect lab-import-platens 0 "export.csv: 5 rows, 4 s, strain -0.1 to 0, stress -1e+04 to 0 Pa" -- "$lab" import "$tmp/export.txt" --out "$tmp/platens" "${import[@]}" --platens --compression-positive
 expect lab-import-platens-declared 0 '"contact": "platens"' -- cat "$tmp/platens/dataset.json"
+expect lab-import-history-default 0 '"history": "carried"' -- cat "$tmp/platens/dataset.json"
+expect lab-import-history-reset 0 "export.csv: 5 rows" -- "$lab" import "$tmp/export.txt" --out "$tmp/reset" "${import[@]}" --history reset
+expect lab-import-history-reset-declared 0 '"history": "reset"' -- cat "$tmp/reset/dataset.json"
+expect lab-import-history-bad 2 "--history: 'sometimes' is not carried or reset" -- "$lab" import "$tmp/export.txt" --out "$tmp/i13" "${import[@]}" --history sometimes
 # Declared between platens but stretched (the sign not flipped): the file, the row and the strain.
 expect lab-import-platens-stretch 2 "export.txt:3: Disp: 0.0005 m is a stretch" -- "$lab" import "$tmp/export.txt" --out "$tmp/i5" "${import[@]}" --platens
 # A table of specimens: each export converted with its own length; mistakes named by table, row and column.

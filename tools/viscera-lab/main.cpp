@@ -93,6 +93,9 @@ void run_import(const std::vector<std::string>& positional, const std::string& o
   o.zero_displacement = cl.has("zero-displacement");
   if (cl.has("specimens")) o.specimen_of = read_specimen_table(cl.text("specimens"), o.specimen);
   o.platens = cl.has("platens");
+  const std::string history = cl.text("history");
+  if (history != "carried" && history != "reset") throw UsageError("--history: '" + history + "' is not carried or reset");
+  o.history = history == "carried" ? History::carried : History::reset;
   o.compression_positive = cl.has("compression-positive");
   const Dataset d = import_dataset(files, o, out);
   for (const auto& t : d.tests)
@@ -131,7 +134,8 @@ int main(int argc, char** argv) {
       "viscera-lab analyze DATASET_DIR --out OUT_DIR\n       viscera-lab predict MODEL_JSON DATASET_DIR --out OUT_DIR\n"
       "       viscera-lab import EXPORT... --out DATASET_DIR --length-m L --width-m W --thickness-m T --time COLUMN[:UNIT]\n"
       "                          --force COLUMN[:UNIT] --displacement COLUMN[:UNIT] [--mode uniaxial|simple_shear] [--control strain|stress]\n"
-      "                          [--specimens TABLE] [--tare] [--zero-displacement] [--platens] [--compression-positive]");
+      "                          [--specimens TABLE] [--tare] [--zero-displacement] [--platens] [--compression-positive]\n"
+      "                          [--history carried|reset]");
   cl.flag("out", "DIR", "output folder (required)");
   cl.option_switch("quiet", "no progress lines");
   cl.option_switch("replace", "analyze, predict: write into an --out folder that holds files already (its files of the same names are replaced)");
@@ -155,6 +159,10 @@ int main(int argc, char** argv) {
           "import: a CSV table of the specimens, a row per export: file (its file name) and any of length_m, width_m,\n"
           "  thickness_m, density_kg_m3 (an empty cell: the --length-m ... value); each test is converted with its own");
   cl.option_switch("compression-positive", "import: the exports count compression as positive force and displacement (both are negated)");
+  cl.flag("history", "H",
+          "import: carried (the exports, in the order given, are one specimen's session: each test starts where the last left it)\n"
+          "  | reset (each test on an untouched specimen); a test with its own row in --specimens starts untouched either way",
+          "carried");
   cl.allow_positional(1000);
   const auto usage_error = [](const std::string& what) {
     std::fprintf(stderr, "viscera-lab: %s (see --help)\n", what.c_str());

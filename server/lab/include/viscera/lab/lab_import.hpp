@@ -41,6 +41,9 @@ struct ImportOptions {
   bool zero_displacement = false;
   /// Compressed between platens it is not bonded to (dataset.json "contact": "platens").
   bool platens = false;
+  /// What each test starts from (dataset.json "history"): carried, the exports in the order given
+  /// being the session's on one specimen; or reset, each on an untouched specimen.
+  History history = History::carried;
   /// The exports count compression as positive force and displacement: both are negated (the data
   /// set's compression is negative strain and stress).
   bool compression_positive = false;
